@@ -1,0 +1,54 @@
+# vipvflow: the user-facing commands. Each target calls one documented CLI command;
+# every target depends on `setup`, so each works alone on a fresh clone.
+PYTHON ?= python3
+VENV   ?= .venv
+BIN    := $(VENV)/bin
+YEAR   ?= 2024
+CONF   ?= conf/demo.yaml
+SCHEDULER ?=
+WORKERS ?=
+RUN    ?= out/demo/$(YEAR)
+DB_DIR ?= data/pg
+
+.PHONY: setup simulate test bench data app db db-stop clean help
+help:
+	@echo "make setup                    create $(VENV) and install vipvflow with its test extras"
+	@echo "make simulate YEAR=2024 [CONF=conf/demo.yaml] [SCHEDULER=tcp://host:8786] [WORKERS=N]"
+	@echo "make test                     run the test suite"
+	@echo "make bench                    run benchmarks/, write benchmarks/results/*.json"
+	@echo "make data                     fetch the real datasets of data_manifest.yaml (needs a network)"
+	@echo "make app [RUN=out/demo/2024]  start the web app on a finished run"
+	@echo "make db / make db-stop        start / stop a local PostgreSQL+PostGIS for mirroring"
+
+setup: $(VENV)/.installed
+
+$(VENV)/.installed: pyproject.toml
+	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
+	$(BIN)/python -m pip install -q --upgrade pip
+	$(BIN)/python -m pip install -q -e '.[test]'
+	touch $@
+
+simulate: setup
+	$(BIN)/vipvflow simulate --config $(CONF) --year $(YEAR) \
+		$(if $(SCHEDULER),--scheduler $(SCHEDULER)) $(if $(WORKERS),--workers $(WORKERS))
+
+test: setup
+	$(BIN)/python -m pytest $(PYTEST_ARGS)
+
+bench: setup
+	$(BIN)/python -m benchmarks $(BENCH_ARGS)
+
+data: setup
+	$(BIN)/vipvflow data fetch --manifest data_manifest.yaml
+
+app: setup
+	$(BIN)/vipvflow app $(RUN)
+
+db: setup
+	$(BIN)/vipvflow db start --dir $(DB_DIR)
+
+db-stop: setup
+	$(BIN)/vipvflow db stop --dir $(DB_DIR)
+
+clean:
+	rm -rf out data/demo

@@ -1,0 +1,83 @@
+"""The ``vipvflow`` command.
+
+Each subcommand lives in a module of :mod:`vipvflow.commands` that defines
+``register(subparsers)``; the subparser's ``func(args)`` does the work by calling the
+library.  Errors caused by input or configuration (:class:`vipvflow.errors.VipvError`)
+are printed as one line, never as a traceback.
+"""
+from __future__ import annotations
+
+import argparse
+import importlib
+import logging
+import sys
+
+from . import __version__
+from .errors import VipvError
+
+# subcommand modules in the order --help lists them
+COMMANDS = [
+    "demo",       # vipvflow demo-data
+    "ingest",     # vipvflow ingest city|gtfs|cams
+    "simulate",   # vipvflow simulate
+    "track",      # vipvflow track
+    "economics",  # vipvflow economics
+    "vecto",      # vipvflow vecto
+    "mirror",     # vipvflow mirror
+    "export",     # vipvflow export dynamizer
+    "app",        # vipvflow app
+    "config",     # vipvflow config
+]
+
+DESCRIPTION = """\
+Solar energy harvested by PV modules on the roofs of an electric bus fleet along its real
+routes in a real 3D city (CityGML LoD2 + GTFS + CAMS radiation), set against what the
+buses consume.
+
+typical use:
+  vipvflow demo-data --out data/demo --year 2024     generate the embedded demo city
+  vipvflow simulate --config conf/demo.yaml --year 2024
+  vipvflow simulate --config conf/luxembourg.yaml --year 2024 --scheduler tcp://host:8786
+"""
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="vipvflow", description=DESCRIPTION,
+        formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--version", action="version", version=f"vipvflow {__version__}")
+    parser.add_argument("-v", "--verbose", action="count", default=0,
+                        help="more log output (-vv for debug)")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    for name in COMMANDS:
+        try:
+            module = importlib.import_module(f"vipvflow.commands.{name}")
+        except ModuleNotFoundError as exc:
+            if exc.name == f"vipvflow.commands.{name}":
+                continue
+            raise
+        module.register(sub)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    logging.basicConfig(
+        level=[logging.WARNING, logging.INFO, logging.DEBUG][min(args.verbose, 2)],
+        format="%(levelname)s %(name)s: %(message)s")
+    if not getattr(args, "func", None):
+        parser.print_help()
+        return 0
+    try:
+        return int(args.func(args) or 0)
+    except VipvError as exc:
+        print(f"vipvflow {args.command}: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("vipvflow: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

@@ -1,0 +1,1 @@
+"""Subcommands of the ``vipvflow`` CLI, one module each (see :mod:`vipvflow.cli`)."""

@@ -1,0 +1,24 @@
+"""``vipvflow ingest city|gtfs|cams``: turn raw inputs into the stage files under a data dir.
+
+The three subcommands live in ``ingest_city``, ``ingest_gtfs`` and ``ingest_cams``; each
+defines ``register(subparsers)``.
+"""
+from __future__ import annotations
+
+import importlib
+
+PARTS = ["ingest_city", "ingest_gtfs", "ingest_cams"]
+
+
+def register(sub):
+    p = sub.add_parser("ingest", help="ingest CityGML, GTFS or CAMS files into a data dir")
+    inner = p.add_subparsers(dest="what", metavar="WHAT")
+    for name in PARTS:
+        try:
+            module = importlib.import_module(f"vipvflow.commands.{name}")
+        except ModuleNotFoundError as exc:
+            if exc.name == f"vipvflow.commands.{name}":
+                continue
+            raise
+        module.register(inner)
+    p.set_defaults(func=lambda args: p.print_help())

@@ -1,0 +1,283 @@
+"""Scenario configuration: one schema, validated on load.
+
+``conf/default.yaml`` holds every default; a scenario YAML (``conf/demo.yaml``,
+``conf/luxembourg.yaml``) overrides any part of it.  Catalog entries (vehicles in
+``conf/vehicles.yaml``, PV systems in ``conf/pv_systems.yaml``) are chosen by name.
+A wrong key or value raises :class:`ConfigError` naming the file, the key and the reason.
+"""
+from __future__ import annotations
+
+import copy
+import hashlib
+import json
+import os
+from pathlib import Path
+from typing import Any, Literal
+
+import yaml
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+
+from .errors import ConfigError
+
+REPO_ROOT = Path(__file__).resolve().parents[2]
+CONF_DIR = Path(os.environ.get("VIPVFLOW_CONF_DIR", REPO_ROOT / "conf"))
+
+
+class _Model(BaseModel):
+    model_config = ConfigDict(extra="forbid", validate_assignment=True)
+
+
+class DemoSpec(_Model):
+    """The embedded demo scenario, generated when its files are missing."""
+
+    enabled: bool = False
+    seed: int = 42
+    size: Literal["full", "small"] = "full"
+
+
+class Inputs(_Model):
+    citygml: list[Path] = Field(default_factory=list)
+    citygml_crs: str | None = None
+    gtfs: Path | None = None
+    cams: list[Path] = Field(default_factory=list)
+
+
+class Albedo(_Model):
+    """Broadband albedo per surface type (dimensionless, 0..1)."""
+
+    roof: float = Field(0.15, ge=0, le=1)
+    wall: float = Field(0.30, ge=0, le=1)
+    ground: float = Field(0.20, ge=0, le=1)
+    road: float = Field(0.10, ge=0, le=1)
+    closure: float = Field(0.0, ge=0, le=1)
+    terrain: float = Field(0.20, ge=0, le=1)
+    vegetation: float = Field(0.18, ge=0, le=1)
+    other: float = Field(0.20, ge=0, le=1)
+
+
+class CityCfg(_Model):
+    tile_size_m: float = Field(500.0, gt=0)
+    buffer_m: float = Field(300.0, ge=0)
+    albedo: Albedo = Field(default_factory=Albedo)
+    planarity_tolerance_m: float = Field(0.10, gt=0)
+    min_area_m2: float = Field(0.01, ge=0)
+
+
+class CycleCfg(_Model):
+    dt_s: float = Field(2.0, gt=0)
+    max_accel_mps2: float = Field(1.0, gt=0)
+    max_decel_mps2: float = Field(1.3, gt=0)
+    speed_limit_kmh: float = Field(50.0, gt=0)
+    dwell_s: float = Field(20.0, ge=0)
+
+
+class TrajectoryCfg(_Model):
+    segment_length_m: float = Field(10.0, gt=0)
+    roof_height_m: float = Field(3.2, ge=0)
+    default_elevation_m: float = 300.0
+    timing: Literal["stop_times", "driving_cycle"] = "stop_times"
+    cycle: CycleCfg = Field(default_factory=CycleCfg)
+
+
+class IrradianceCfg(_Model):
+    diffuse_model: Literal["isotropic", "sky_view_factor"] = "isotropic"
+    reflection: bool = True
+    reflection_rays: int = Field(64, ge=0)
+    svf_rays: int = Field(128, gt=0)
+    ray_length_m: float = Field(300.0, gt=0)
+    ray_offset_m: float = Field(0.05, ge=0)
+    max_reflector_groups: int = Field(3, ge=0)
+    seed: int = 7
+
+
+class PVSystem(_Model):
+    """A PV system on the bus roof (catalog entry of ``conf/pv_systems.yaml``)."""
+
+    name: str = ""
+    technology: str = "c-Si"
+    kwp: float = Field(gt=0)
+    roof_area_m2: float = Field(gt=0)
+    area_share: float = Field(gt=0, le=1)
+    performance_ratio: float = Field(gt=0, le=1)
+    gamma_pdc_per_k: float = -0.0037
+    inverter_efficiency: float = Field(0.96, gt=0, le=1)
+    system_losses_percent: float = Field(14.0, ge=0, lt=100)
+    temperature_model: str = "sapm_open_rack_glass_polymer"
+
+
+class PVCfg(_Model):
+    system: str = "csi_3p5kwp"
+    mode: Literal["paper", "pvlib"] = "paper"
+    overrides: dict[str, Any] = Field(default_factory=dict)
+
+
+class VehicleCfg(_Model):
+    model: str = "ecitaro_12m"
+    overrides: dict[str, Any] = Field(default_factory=dict)
+
+
+class EconomicsCfg(_Model):
+    cost_eur_per_wp: float = Field(1.5, ge=0)
+    tariff_eur_per_kwh: float = Field(0.21, ge=0)
+    soc_window: tuple[float, float] = (0.2, 0.8)
+
+    @model_validator(mode="after")
+    def _window(self):
+        lo, hi = self.soc_window
+        if not 0 <= lo < hi <= 1:
+            raise ValueError("soc_window must be [low, high] with 0 <= low < high <= 1")
+        return self
+
+
+class DaskCfg(_Model):
+    scheduler: str | None = None
+    n_workers: int | None = Field(None, gt=0)
+    threads_per_worker: int | None = Field(None, gt=0)
+    memory_limit: str = "auto"
+    bvh_cache_size: int = Field(8, gt=0)
+
+
+class DbCfg(_Model):
+    dsn: str | None = None
+
+
+class Config(_Model):
+    scenario: str = "default"
+    data_dir: Path = Path("data/default")
+    out_dir: Path = Path("out")
+    demo: DemoSpec = Field(default_factory=DemoSpec)
+    inputs: Inputs = Field(default_factory=Inputs)
+    city: CityCfg = Field(default_factory=CityCfg)
+    trajectory: TrajectoryCfg = Field(default_factory=TrajectoryCfg)
+    irradiance: IrradianceCfg = Field(default_factory=IrradianceCfg)
+    pv: PVCfg = Field(default_factory=PVCfg)
+    vehicle: VehicleCfg = Field(default_factory=VehicleCfg)
+    economics: EconomicsCfg = Field(default_factory=EconomicsCfg)
+    dask: DaskCfg = Field(default_factory=DaskCfg)
+    db: DbCfg = Field(default_factory=DbCfg)
+
+    # where the values came from, for error messages and the run manifest
+    _source: str = "<defaults>"
+
+    def pv_system(self) -> PVSystem:
+        """The PV system chosen by ``pv.system``, with ``pv.overrides`` applied."""
+        catalog = _read_yaml(CONF_DIR / "pv_systems.yaml")
+        return _catalog_entry(catalog, self.pv.system, self.pv.overrides, PVSystem,
+                              CONF_DIR / "pv_systems.yaml", "pv.system")
+
+    def vehicle_params(self):
+        """The vehicle chosen by ``vehicle.model`` (a :class:`vipvflow.vehicle.VehicleParams`)."""
+        from .vehicle import VehicleParams
+
+        catalog = _read_yaml(CONF_DIR / "vehicles.yaml")
+        return _catalog_entry(catalog, self.vehicle.model, self.vehicle.overrides,
+                              VehicleParams, CONF_DIR / "vehicles.yaml", "vehicle.model")
+
+    def digest(self) -> str:
+        """A stable hash of the validated configuration (for run manifests)."""
+        text = json.dumps(self.model_dump(mode="json"), sort_keys=True)
+        return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+def _read_yaml(path: Path) -> dict:
+    try:
+        with open(path, encoding="utf-8") as fh:
+            data = yaml.safe_load(fh)
+    except FileNotFoundError:
+        raise ConfigError(f"{path}: file not found") from None
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        where = f" line {mark.line + 1}" if mark else ""
+        raise ConfigError(f"{path}:{where}: not valid YAML: {getattr(exc, 'problem', exc)}") from None
+    if data is None:
+        return {}
+    if not isinstance(data, dict):
+        raise ConfigError(f"{path}: top level must be a mapping of keys, got {type(data).__name__}")
+    return data
+
+
+def _merge(base: dict, over: dict) -> dict:
+    out = copy.deepcopy(base)
+    for key, value in over.items():
+        if isinstance(value, dict) and isinstance(out.get(key), dict) and key != "overrides":
+            out[key] = _merge(out[key], value)
+        else:
+            out[key] = copy.deepcopy(value)
+    return out
+
+
+def _has_path(data: dict, loc: tuple) -> bool:
+    node: Any = data
+    for part in loc:
+        if isinstance(node, dict) and part in node:
+            node = node[part]
+        elif isinstance(node, list) and isinstance(part, int) and part < len(node):
+            node = node[part]
+        else:
+            return False
+    return True
+
+
+def _format_errors(exc: ValidationError, files: list[tuple[Path, dict]], prefix: str = "") -> str:
+    lines = []
+    for err in exc.errors():
+        loc = tuple(err["loc"])
+        key = prefix + ".".join(str(p) for p in loc)
+        origin = next((str(f) for f, d in reversed(files) if _has_path(d, loc)), None)
+        if origin is None:
+            origin = str(files[-1][0])
+        msg = err["msg"]
+        if err["type"] == "extra_forbidden":
+            msg = "unknown key"
+        lines.append(f"{origin}: key '{key}': {msg}")
+    return "\n".join(lines)
+
+
+def _catalog_entry(catalog: dict, name: str, overrides: dict, model, path: Path, key: str):
+    if name not in catalog:
+        known = ", ".join(sorted(catalog)) or "none"
+        raise ConfigError(f"{path}: {key} '{name}' is not in the catalog (known: {known})")
+    data = _merge(catalog[name], overrides or {})
+    data.setdefault("name", name)
+    try:
+        return model.model_validate(data)
+    except ValidationError as exc:
+        raise ConfigError(_format_errors(exc, [(path, catalog[name])], prefix=f"{name}.")) from None
+
+
+def load_config(path: str | Path | None = None, overrides: dict | None = None) -> Config:
+    """Load ``conf/default.yaml``, apply the scenario file at *path* and *overrides*, validate.
+
+    Parameters
+    ----------
+    path : str or Path, optional
+        Scenario YAML. ``None`` gives the defaults alone.
+    overrides : dict, optional
+        Nested mapping applied last (command-line options).
+
+    Raises
+    ------
+    ConfigError
+        With ``file: key 'a.b': reason`` for every invalid key or value.
+    """
+    default_path = CONF_DIR / "default.yaml"
+    files = [(default_path, _read_yaml(default_path))]
+    if path is not None:
+        files.append((Path(path), _read_yaml(Path(path))))
+    if overrides:
+        files.append((Path("<command line>"), overrides))
+    merged: dict = {}
+    for _, data in files:
+        merged = _merge(merged, data)
+    try:
+        cfg = Config.model_validate(merged)
+    except ValidationError as exc:
+        raise ConfigError(_format_errors(exc, files)) from None
+    cfg._source = str(path) if path else str(default_path)
+    # validate catalog choices now, so a bad name fails at load time
+    cfg.pv_system()
+    try:
+        cfg.vehicle_params()
+    except ImportError:
+        pass
+    return cfg
