@@ -27,6 +27,8 @@ COMMANDS = [
     "export",     # vipvflow export dynamizer
     "app",        # vipvflow app
     "config",     # vipvflow config
+    "data",       # vipvflow data fetch
+    "db",         # vipvflow db start|stop
 ]
 
 DESCRIPTION = """\

@@ -129,6 +129,16 @@ class EconomicsCfg(_Model):
         return self
 
 
+class ClimateCfg(_Model):
+    """Ambient conditions for the vehicle's HVAC and the PV cell temperature."""
+
+    # Luxembourg-Findel monthly mean air temperature 1991-2020 normals (deg C), Jan..Dec
+    monthly_mean_temperature_c: list[float] = Field(
+        default_factory=lambda: [0.8, 1.6, 5.0, 8.9, 12.8, 16.1, 18.1, 17.6, 13.9, 9.6, 4.9, 1.7],
+        min_length=12, max_length=12)
+    wind_speed_mps: float = Field(3.0, ge=0)
+
+
 class DaskCfg(_Model):
     scheduler: str | None = None
     n_workers: int | None = Field(None, gt=0)
@@ -153,6 +163,7 @@ class Config(_Model):
     pv: PVCfg = Field(default_factory=PVCfg)
     vehicle: VehicleCfg = Field(default_factory=VehicleCfg)
     economics: EconomicsCfg = Field(default_factory=EconomicsCfg)
+    climate: ClimateCfg = Field(default_factory=ClimateCfg)
     dask: DaskCfg = Field(default_factory=DaskCfg)
     db: DbCfg = Field(default_factory=DbCfg)
 
