@@ -1,0 +1,184 @@
+"""Work done on a worker: per-tile geometry factors and per-(tile, month) irradiance and PV.
+
+Each task loads what it needs from disk (tile mesh, segments, radiation), keeps the heavy
+parts in per-process caches (the tile's Embree BVH, the radiation table), evaluates every
+pass of its partition with the irradiance engine and writes its partition files atomically.
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from functools import lru_cache
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from ..config import IrradianceCfg, PVSystem
+from .storage import geometry_path, partition_path, write_parquet
+
+#: per-pass energy columns (kWh) and irradiation columns (Wh/m2) summed in a partition
+VARIANTS = {
+    "": "total", "_clear": "total_clear",
+    "_unshaded": "total_unshaded", "_clear_unshaded": "total_clear_unshaded",
+}
+COMPONENTS = ["direct", "diffuse", "reflected", "total", "total_unshaded",
+              "direct_clear", "diffuse_clear", "reflected_clear", "total_clear",
+              "total_clear_unshaded", "ghi", "ghi_clear"]
+
+
+@dataclass(frozen=True)
+class RunContext:
+    """What a task needs to know about the run (small and picklable)."""
+
+    data_dir: str
+    run_dir: str
+    year: int
+    irradiance: dict
+    pv_system: dict
+    pv_mode: str
+    monthly_temperature_c: tuple
+    wind_speed_mps: float
+    timezone: str
+    bvh_cache_size: int = 8
+    route_of_trip: dict = field(default_factory=dict, compare=False, hash=False)
+
+
+@lru_cache(maxsize=4)
+def _segments(data_dir: str) -> pd.DataFrame:
+    cols = ["segment_id", "shape_id", "x", "y", "z", "x_end", "y_end", "z_end", "heading_deg",
+            "gradient", "length_m", "tile"]
+    seg = pd.read_parquet(Path(data_dir) / "gtfs" / "segments.parquet", columns=cols)
+    return seg.set_index("segment_id", drop=False).sort_index()
+
+
+@lru_cache(maxsize=2)
+def _radiation(data_dir: str, year: int):
+    from ..radiation import RadiationTable
+
+    return RadiationTable.load(data_dir, year)
+
+
+def _scene(ctx: RunContext, tile: str):
+    from ..shading import get_scene
+
+    return get_scene(ctx.data_dir, tile, cache_size=ctx.bvh_cache_size)
+
+
+def tile_geometry(ctx: RunContext, tile: str) -> pd.DataFrame:
+    """Per-segment geometry factors of a tile (sky view factor, reflector groups), computed
+    once per run and stored in ``parts/geometry/tile=<TILE>.parquet``."""
+    from ..irradiance import segment_geometry
+
+    path = geometry_path(Path(ctx.run_dir), tile)
+    if path.exists():
+        return pd.read_parquet(path)
+    seg = _segments(ctx.data_dir)
+    seg = seg[seg["tile"] == tile]
+    geom = segment_geometry(_scene(ctx, tile), seg, IrradianceCfg(**ctx.irradiance))
+    write_parquet(geom, path)
+    return geom
+
+
+def pv_energy_kwh(poa_wm2: np.ndarray, dt_s: np.ndarray, speed_mps: np.ndarray, month: int,
+                  ctx: RunContext) -> np.ndarray:
+    """PV energy per pass (kWh) in the run's PV mode."""
+    from .. import pv
+
+    system = PVSystem(**ctx.pv_system)
+    if ctx.pv_mode == "paper":
+        return pv.energy_paper(poa_wm2, dt_s, system.kwp, system.performance_ratio)
+    temp = ctx.monthly_temperature_c[month - 1]
+    return pv.energy_pvlib(poa_wm2, dt_s, system, temp_air_c=temp,
+                           wind_speed_mps=ctx.wind_speed_mps + speed_mps)
+
+
+def run_partition(ctx: RunContext, tile: str, month: str, geometry: pd.DataFrame | None = None) -> dict:
+    """Evaluate every pass of *tile* in *month* and write the partition's files.
+
+    Writes ``parts/trip/tile=T/month=M.parquet`` (per trip and service date: PV kWh for
+    all-sky, clear-sky and the unshaded references, and per component) and
+    ``parts/segment_month/...`` (per segment: passes, irradiation sums in Wh/m2, kWh) and
+    ``parts/hourly/...`` (per local hour: irradiation and pass time, for the daily pattern).
+    Returns a small summary for the progress view.
+    """
+    from ..irradiance import evaluate_passes
+    from ..trajectory import iter_passes
+
+    t0 = time.perf_counter()
+    run_dir = Path(ctx.run_dir)
+    if geometry is None:
+        geometry = tile_geometry(ctx, tile)
+    passes = iter_passes(ctx.data_dir, tile, month, ctx.year)
+    timings = {"passes_s": time.perf_counter() - t0}
+    n = len(passes)
+    seg = _segments(ctx.data_dir)
+    if n:
+        t1 = time.perf_counter()
+        irr = evaluate_passes(passes, seg, geometry, _radiation(ctx.data_dir, ctx.year),
+                              _scene(ctx, tile), IrradianceCfg(**ctx.irradiance))
+        timings["irradiance_s"] = time.perf_counter() - t1
+    else:
+        irr = pd.DataFrame({c: np.zeros(0, np.float32) for c in COMPONENTS})
+    t2 = time.perf_counter()
+    dt = passes["dt_s"].to_numpy(np.float64)
+    speed = passes["speed_mps"].to_numpy(np.float64)
+    mnum = int(month[5:7])
+    energy = {f"pv_kwh{suffix}": pv_energy_kwh(irr[col].to_numpy(np.float64), dt, speed, mnum, ctx)
+              for suffix, col in VARIANTS.items()}
+    for comp in ("direct", "diffuse", "reflected"):
+        energy[f"pv_kwh_{comp}"] = pv_energy_kwh(irr[comp].to_numpy(np.float64), dt, speed, mnum, ctx)
+    work = pd.DataFrame(energy)
+    work["trip_id"] = passes["trip_id"].to_numpy()
+    work["service_date"] = passes["service_date"].to_numpy()
+    work["segment_id"] = passes["segment_id"].to_numpy()
+    work["seconds"] = dt
+    for comp in COMPONENTS:
+        # irradiation (Wh/m2) received during the pass
+        work[f"h_{comp}"] = irr[comp].to_numpy(np.float64) * dt / 3600.0
+
+    kwh_cols = [c for c in work.columns if c.startswith("pv_kwh")]
+    h_cols = [f"h_{c}" for c in COMPONENTS]
+    trip = (work.groupby(["trip_id", "service_date"], sort=True, observed=True)[kwh_cols + ["seconds"]]
+            .sum().reset_index())
+    trip["tile"] = tile
+    segm = work.groupby("segment_id", sort=True)[kwh_cols + h_cols + ["seconds"]].sum()
+    segm.insert(0, "n_passes", work.groupby("segment_id", sort=True).size().astype(np.int64))
+    segm = segm.reset_index()
+    segm["month"] = month
+    segm["tile"] = tile
+
+    local = pd.to_datetime(passes["t_utc"].to_numpy(np.float64), unit="s", utc=True).tz_convert(ctx.timezone)
+    work["hour"] = np.asarray(local.hour, dtype=np.int8)
+    hourly = work.groupby("hour", sort=True)[h_cols + ["seconds"]].sum().reset_index()
+    hourly["month"] = month
+    hourly["tile"] = tile
+    timings["reduce_s"] = time.perf_counter() - t2
+
+    t3 = time.perf_counter()
+    write_parquet(hourly, partition_path(run_dir, "hourly", tile, month))
+    write_parquet(trip, partition_path(run_dir, "trip", tile, month))
+    # segment_month last: its presence marks the partition complete
+    write_parquet(segm, partition_path(run_dir, "segment_month", tile, month))
+    timings["write_s"] = time.perf_counter() - t3
+
+    by_route: dict[str, float] = {}
+    if ctx.route_of_trip and len(trip):
+        routes = trip["trip_id"].map(ctx.route_of_trip)
+        by_route = trip.groupby(routes)["pv_kwh"].sum().to_dict()
+    return {"tile": tile, "month": month, "passes": n, "trips": int(len(trip)),
+            "kwh": float(trip["pv_kwh"].sum()) if len(trip) else 0.0,
+            "kwh_by_route": by_route, "timings": timings,
+            "elapsed_s": time.perf_counter() - t0}
+
+
+def partition_done(run_dir: Path, tile: str, month: str) -> bool:
+    return all(partition_path(run_dir, kind, tile, month).exists()
+               for kind in ("hourly", "trip", "segment_month"))
+
+
+def worker_bvh_builds() -> dict:
+    """BVH builds per tile in this process (collected from every worker after a run)."""
+    from .. import shading
+
+    return dict(getattr(shading, "BVH_BUILDS", {}))

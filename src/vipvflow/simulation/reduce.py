@@ -1,0 +1,154 @@
+"""Reduce the partitions of a run into its outputs.
+
+Per trip (trip x service date): PV kWh joined with the vehicle model's consumption;
+per segment-month (with geometry, for maps); per route-direction-month; per vehicle block
+and day; and the fleet-year summary with coverage, avoided charging cycles and payback.
+"""
+from __future__ import annotations
+
+import logging
+from pathlib import Path
+
+import geopandas as gpd
+import numpy as np
+import pandas as pd
+
+from ..config import Config
+from .storage import write_json, write_parquet
+
+log = logging.getLogger(__name__)
+
+
+def _read_parts(run_dir: Path, kind: str) -> pd.DataFrame:
+    files = sorted((run_dir / "parts" / kind).glob("tile=*/month=*.parquet"))
+    if not files:
+        return pd.DataFrame()
+    return pd.concat([pd.read_parquet(f) for f in files], ignore_index=True)
+
+
+def trip_consumption(cfg: Config, data_dir: Path, year: int) -> pd.DataFrame:
+    """Battery energy per trip pattern and month (kWh) from the vehicle model run over each
+    pattern's 2 s driving cycle at the month's mean ambient temperature."""
+    from ..trajectory import pattern_cycles
+    from ..vehicle import simulate_cycle
+
+    params = cfg.vehicle_params()
+    temps = cfg.climate.monthly_mean_temperature_c
+    rows = []
+    for pattern_id, cycle in pattern_cycles(data_dir, cfg.trajectory).items():
+        for m in range(1, 13):
+            e = simulate_cycle(cycle, params, ambient_c=temps[m - 1])
+            rows.append({"pattern_id": pattern_id, "month": f"{year}-{m:02d}",
+                         "consumption_kwh": e["battery_kwh"], "traction_kwh": e["traction_kwh"],
+                         "recuperated_kwh": e["recuperated_kwh"], "aux_kwh": e["aux_kwh"]})
+    return pd.DataFrame(rows)
+
+
+def reduce_run(cfg: Config, year: int, run_dir: Path, say=print) -> dict:
+    """Write trip_energy, segments, segment_month, route_month, block_day, monthly, hourly
+    outputs, ``summary.json`` and ``report.html``; return the summary."""
+    from ..economics import fleet_economics
+    from .report import write_report
+
+    data_dir = Path(cfg.data_dir)
+    trips_meta = pd.read_parquet(data_dir / "gtfs" / "trips.parquet")
+
+    # --- per trip and service date
+    parts = _read_parts(run_dir, "trip")
+    kwh_cols = [c for c in parts.columns if c.startswith("pv_kwh")] + ["seconds"]
+    trip = parts.groupby(["trip_id", "service_date"], sort=True)[kwh_cols].sum().reset_index()
+    trip = trip.merge(trips_meta[["trip_id", "route_id", "route_short_name", "direction_id",
+                                  "shape_id", "service_id", "block_id", "pattern_id", "start_s"]],
+                      on="trip_id", how="left", validate="many_to_one")
+    trip["month"] = pd.to_datetime(trip["service_date"]).dt.strftime("%Y-%m")
+    cons = trip_consumption(cfg, data_dir, year)
+    trip = trip.merge(cons, on=["pattern_id", "month"], how="left", validate="many_to_one")
+    trip["coverage"] = trip["pv_kwh"] / trip["consumption_kwh"]
+    write_parquet(trip, run_dir / "trip_energy.parquet")
+
+    # --- segments with their geometry factors
+    segments = gpd.read_parquet(data_dir / "gtfs" / "segments.parquet")
+    geom_files = sorted((run_dir / "parts" / "geometry").glob("tile=*.parquet"))
+    if geom_files:
+        geo = pd.concat([pd.read_parquet(f) for f in geom_files], ignore_index=True)
+        keep = [c for c in geo.columns if c == "segment_id" or geo[c].dtype.kind in "fiub"]
+        segments = segments.merge(geo[keep], on="segment_id", how="left")
+    write_parquet(segments, run_dir / "segments.parquet")
+
+    # --- segment-month (GeoParquet for maps)
+    sm = _read_parts(run_dir, "segment_month")
+    sm["shading_loss"] = 1.0 - sm["h_total"] / sm["h_total_unshaded"].where(sm["h_total_unshaded"] > 0)
+    sm["shading_loss_clear"] = 1.0 - sm["h_total_clear"] / sm["h_total_clear_unshaded"].where(
+        sm["h_total_clear_unshaded"] > 0)
+    shape_route = (trips_meta.drop_duplicates("shape_id")[["shape_id", "route_short_name", "direction_id"]])
+    smg = segments[["segment_id", "shape_id", "geometry"]].merge(sm, on="segment_id", how="inner")
+    smg = gpd.GeoDataFrame(smg.merge(shape_route, on="shape_id", how="left"),
+                           geometry="geometry", crs=segments.crs)
+    write_parquet(smg, run_dir / "segment_month.parquet")
+
+    # --- route-direction-month
+    agg = {c: "sum" for c in kwh_cols + ["consumption_kwh"]}
+    rm = (trip.groupby(["route_id", "route_short_name", "direction_id", "month"], sort=True)
+          .agg(trips=("trip_id", "size"), **{c: (c, "sum") for c in agg}).reset_index())
+    rm["coverage"] = rm["pv_kwh"] / rm["consumption_kwh"]
+    rm["shading_loss"] = 1 - rm["pv_kwh"] / rm["pv_kwh_unshaded"].where(rm["pv_kwh_unshaded"] > 0)
+    write_parquet(rm, run_dir / "route_month.parquet")
+
+    # --- vehicle block per day
+    bd = (trip.groupby(["block_id", "service_date"], sort=True)
+          .agg(trips=("trip_id", "size"), pv_kwh=("pv_kwh", "sum"),
+               pv_kwh_clear=("pv_kwh_clear", "sum"), consumption_kwh=("consumption_kwh", "sum"),
+               first_departure_s=("start_s", "min")).reset_index())
+    write_parquet(bd, run_dir / "block_day.parquet")
+
+    # --- daily pattern by hour and month
+    hourly = _read_parts(run_dir, "hourly")
+    h_cols = [c for c in hourly.columns if c.startswith("h_")]
+    hp = hourly.groupby(["month", "hour"], sort=True)[h_cols + ["seconds"]].sum().reset_index()
+    for c in h_cols:  # mean irradiance while buses are on the road at that hour (W/m2)
+        hp["g_" + c[2:]] = hp[c] * 3600.0 / hp["seconds"].where(hp["seconds"] > 0)
+    write_parquet(hp, run_dir / "hourly_pattern.parquet")
+
+    # --- fleet-year
+    pv = cfg.pv_system()
+    vehicle = cfg.vehicle_params()
+    n_buses = int(trip.groupby("service_date")["block_id"].nunique().max())
+    eco = fleet_economics(
+        pv_kwh=float(trip["pv_kwh"].sum()), demand_kwh=float(trip["consumption_kwh"].sum()),
+        n_buses=n_buses, kwp=pv.kwp, battery_kwh=vehicle.battery_kwh,
+        soc_window=cfg.economics.soc_window, cost_eur_per_wp=cfg.economics.cost_eur_per_wp,
+        tariff_eur_per_kwh=cfg.economics.tariff_eur_per_kwh)
+    tot = sm[[c for c in sm.columns if c.startswith("h_")]].sum()
+    monthly = (trip.groupby("month", sort=True)
+               .agg(trips=("trip_id", "size"), pv_kwh=("pv_kwh", "sum"), pv_kwh_clear=("pv_kwh_clear", "sum"),
+                    pv_kwh_unshaded=("pv_kwh_unshaded", "sum"),
+                    pv_kwh_clear_unshaded=("pv_kwh_clear_unshaded", "sum"),
+                    consumption_kwh=("consumption_kwh", "sum")).reset_index())
+    usable = vehicle.battery_kwh * (cfg.economics.soc_window[1] - cfg.economics.soc_window[0])
+    monthly["avoided_charging_cycles"] = monthly["pv_kwh"] / usable
+    monthly["kwh_per_kwp_allsky"] = monthly["pv_kwh"] / (pv.kwp * n_buses)
+    monthly["kwh_per_kwp_clearsky"] = monthly["pv_kwh_clear"] / (pv.kwp * n_buses)
+    write_parquet(monthly, run_dir / "monthly.parquet")
+
+    summary = {
+        "scenario": cfg.scenario, "year": year, "pv_mode": cfg.pv.mode,
+        "diffuse_model": cfg.irradiance.diffuse_model,
+        "routes": int(trip["route_id"].nunique()), "trips": int(len(trip)), "buses": n_buses,
+        "segments": int(len(segments)), "passes": int(sm["n_passes"].sum()),
+        "kwp_per_bus": pv.kwp,
+        "pv_kwh_allsky": float(trip["pv_kwh"].sum()),
+        "pv_kwh_clearsky": float(trip["pv_kwh_clear"].sum()),
+        "pv_kwh_allsky_unshaded": float(trip["pv_kwh_unshaded"].sum()),
+        "kwh_per_kwp_allsky": float(trip["pv_kwh"].sum() / (pv.kwp * n_buses)),
+        "kwh_per_kwp_clearsky": float(trip["pv_kwh_clear"].sum() / (pv.kwp * n_buses)),
+        "irradiation_kwh_m2": {k[2:]: float(v) / 1000.0 for k, v in tot.items()},
+        "shading_loss_allsky": float(1 - tot["h_total"] / tot["h_total_unshaded"]),
+        "shading_loss_clearsky": float(1 - tot["h_total_clear"] / tot["h_total_clear_unshaded"]),
+        "unshaded_to_ghi_allsky": float(tot["h_total_unshaded"] / tot["h_ghi"]),
+        "unshaded_to_ghi_clearsky": float(tot["h_total_clear_unshaded"] / tot["h_ghi_clear"]),
+        "reflected_share": float(tot["h_reflected"] / tot["h_total"]),
+        **eco,
+    }
+    write_json(summary, run_dir / "summary.json")
+    write_report(run_dir, summary, monthly, smg, hp, rm)
+    return summary

@@ -1,0 +1,199 @@
+"""Run a scenario-year on a Dask cluster: prepare, map over partitions, reduce, write."""
+from __future__ import annotations
+
+import json
+import logging
+import os
+import sys
+import time
+from pathlib import Path
+
+import pandas as pd
+
+from ..config import Config
+from .partition import RunContext, partition_done, run_partition, tile_geometry, worker_bvh_builds
+from .storage import write_json
+
+log = logging.getLogger(__name__)
+
+
+def run_dir_of(cfg: Config, year: int) -> Path:
+    return Path(cfg.out_dir) / cfg.scenario / str(year)
+
+
+def _months(year: int) -> list[str]:
+    return [f"{year}-{m:02d}" for m in range(1, 13)]
+
+
+def _reset_if_config_changed(run_dir: Path, digest: str) -> None:
+    """Partitions are reused only by a run of the same configuration."""
+    stamp = run_dir / "parts" / "config_digest.txt"
+    if stamp.exists() and stamp.read_text().strip() != digest:
+        import shutil
+
+        shutil.rmtree(run_dir / "parts")
+    stamp.parent.mkdir(parents=True, exist_ok=True)
+    stamp.write_text(digest)
+
+
+def make_client(cfg: Config, scheduler: str | None, n_workers: int | None):
+    """A client of the given scheduler, or of a LocalCluster sized to the machine."""
+    from distributed import Client, LocalCluster
+
+    scheduler = scheduler or cfg.dask.scheduler
+    if scheduler:
+        return Client(scheduler), None
+    n = n_workers or cfg.dask.n_workers or os.cpu_count() or 1
+    cluster = LocalCluster(n_workers=n, threads_per_worker=cfg.dask.threads_per_worker or 1,
+                           processes=True, memory_limit=cfg.dask.memory_limit,
+                           dashboard_address=":0", silence_logs=logging.ERROR)
+    return Client(cluster), cluster
+
+
+class FleetView:
+    """Progress over partitions plus, per route, the partitions, trips and kWh done so far."""
+
+    def __init__(self, total: int, stream=sys.stderr, every_s: float = 2.0):
+        self.total, self.done, self.stream, self.every_s = total, 0, stream, every_s
+        self.routes: dict[str, dict] = {}
+        self._last = 0.0
+        self.t0 = time.perf_counter()
+
+    def update(self, res: dict) -> None:
+        self.done += 1
+        for route, kwh in res.get("kwh_by_route", {}).items():
+            r = self.routes.setdefault(route, {"partitions": 0, "kwh": 0.0})
+            r["partitions"] += 1
+            r["kwh"] += kwh
+        now = time.perf_counter()
+        if now - self._last >= self.every_s or self.done == self.total:
+            self._last = now
+            self.draw()
+
+    def draw(self) -> None:
+        width = 30
+        filled = int(width * self.done / max(self.total, 1))
+        bar = "#" * filled + "-" * (width - filled)
+        routes = "  ".join(f"{k}: {v['partitions']}p {v['kwh']:,.0f} kWh"
+                           for k, v in sorted(self.routes.items()))
+        print(f"\r[{bar}] {self.done}/{self.total} partitions  "
+              f"{time.perf_counter() - self.t0:5.0f}s  {routes}", end="", file=self.stream, flush=True)
+        if self.done == self.total:
+            print(file=self.stream)
+
+
+def run_simulation(cfg: Config, year: int, scheduler: str | None = None,
+                   n_workers: int | None = None, say=print, max_partitions: int | None = None) -> Path:
+    """Compute the scenario's fleet-year and write all outputs; returns the run directory.
+
+    An interrupted run resumes: finished partitions (written atomically) are not recomputed.
+    *max_partitions* stops after that many new partitions (for tests of resuming).
+    """
+    from .prepare import ensure_demo, ensure_ingested
+    from .reduce import reduce_run
+
+    t_start = time.perf_counter()
+    timings: dict[str, float] = {}
+    ensure_demo(cfg, year, say=say)
+    checksums = ensure_ingested(cfg, say=say)
+    timings["prepare_s"] = time.perf_counter() - t_start
+
+    data_dir = Path(cfg.data_dir)
+    run_dir = run_dir_of(cfg, year)
+    run_dir.mkdir(parents=True, exist_ok=True)
+    _reset_if_config_changed(run_dir, cfg.digest())
+    seg_tiles = pd.read_parquet(data_dir / "gtfs" / "segments.parquet", columns=["tile"])["tile"]
+    tiles = sorted(seg_tiles.unique())
+    feed = json.loads((data_dir / "gtfs" / "feed.json").read_text())
+    trips = pd.read_parquet(data_dir / "gtfs" / "trips.parquet", columns=["trip_id", "route_id"])
+    ctx = RunContext(
+        data_dir=str(data_dir.resolve()), run_dir=str(run_dir.resolve()), year=year,
+        irradiance=cfg.irradiance.model_dump(), pv_system=cfg.pv_system().model_dump(),
+        pv_mode=cfg.pv.mode, monthly_temperature_c=tuple(cfg.climate.monthly_mean_temperature_c),
+        wind_speed_mps=cfg.climate.wind_speed_mps, timezone=feed["timezone"],
+        bvh_cache_size=cfg.dask.bvh_cache_size,
+        route_of_trip=dict(zip(trips["trip_id"], trips["route_id"].astype(str))))
+
+    todo = [(t, m) for t in tiles for m in _months(year) if not partition_done(run_dir, t, m)]
+    total = len(tiles) * 12
+    if max_partitions is not None:
+        todo = todo[:max_partitions]
+    client, cluster = make_client(cfg, scheduler, n_workers)
+    try:
+        say(f"dask dashboard: {client.dashboard_link}")
+        say(f"{len(tiles)} tiles x 12 months = {total} partitions, {len(todo)} to compute "
+            f"({total - len(todo)} already done) with {len(client.scheduler_info()['workers'])} workers")
+        t_map = time.perf_counter()
+        results = _map(client, ctx, todo)
+        timings["map_s"] = time.perf_counter() - t_map
+        builds = client.run(worker_bvh_builds)
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()
+    if not all(partition_done(run_dir, t, m) for t in tiles for m in _months(year)):
+        say("stopped before all partitions were computed; run the same command again to resume")
+        return run_dir
+    t_red = time.perf_counter()
+    summary = reduce_run(cfg, year, run_dir, say=say)
+    timings["reduce_s"] = time.perf_counter() - t_red
+    timings["total_s"] = time.perf_counter() - t_start
+    _write_manifest(cfg, year, run_dir, checksums, timings, results, builds)
+    say(_summary_line(summary))
+    say(f"outputs in {run_dir}")
+    return run_dir
+
+
+def _map(client, ctx: RunContext, todo: list[tuple[str, str]]) -> list[dict]:
+    from distributed import as_completed
+
+    geometry = {}
+    futures = []
+    for tile in sorted({t for t, _ in todo}):
+        geometry[tile] = client.submit(tile_geometry, ctx, tile, key=f"geometry-{tile}")
+    for tile, month in todo:
+        futures.append(client.submit(run_partition, ctx, tile, month, geometry[tile],
+                                     key=f"irradiance-{tile}-{month}"))
+    view = FleetView(len(futures))
+    results = []
+    for fut in as_completed(futures):
+        res = fut.result()
+        results.append(res)
+        view.update(res)
+        fut.release()
+    return results
+
+
+def _write_manifest(cfg, year, run_dir, checksums, timings, results, builds) -> None:
+    from importlib import metadata
+
+    versions = {}
+    for name in ["vipvflow", "numpy", "pandas", "dask", "distributed", "geopandas", "pyarrow",
+                 "embreex", "trimesh", "pvlib", "gtfs-kit", "lxml"]:
+        try:
+            versions[name] = metadata.version(name)
+        except metadata.PackageNotFoundError:
+            versions[name] = None
+    stage = {}
+    for res in results:
+        for k, v in res.get("timings", {}).items():
+            stage[k] = stage.get(k, 0.0) + v
+    manifest = {
+        "scenario": cfg.scenario, "year": year, "config_digest": cfg.digest(),
+        "config": cfg.model_dump(mode="json"), "inputs_sha256": checksums, "versions": versions,
+        "timings_s": {k: round(v, 3) for k, v in timings.items()},
+        "partition_timings_s": {k: round(v, 3) for k, v in stage.items()},
+        "partitions_computed": len(results),
+        "passes_computed": int(sum(r["passes"] for r in results)),
+        "bvh_builds_per_worker": builds,
+        "created_utc": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
+    }
+    write_json(manifest, run_dir / "manifest.json")
+
+
+def _summary_line(s: dict) -> str:
+    return (f"annual yield {s['kwh_per_kwp_allsky']:.0f} kWh/kWp all-sky, "
+            f"{s['kwh_per_kwp_clearsky']:.0f} clear-sky; shading loss {100 * s['shading_loss_allsky']:.1f} %; "
+            f"PV covers {100 * s['coverage']:.2f} % of {s['fleet_demand_mwh']:.0f} MWh; "
+            f"{s['avoided_charging_cycles_per_bus']:.1f} charging cycles avoided per bus; "
+            f"payback {s['payback_years']:.1f} years")
