@@ -147,6 +147,20 @@ class DaskCfg(_Model):
     bvh_cache_size: int = Field(8, gt=0)
 
 
+class RunCfg(_Model):
+    """What part of the year to simulate (all months by default)."""
+
+    months: list[int] = Field(default_factory=lambda: list(range(1, 13)), min_length=1)
+
+    @model_validator(mode="after")
+    def _months(self):
+        bad = [m for m in self.months if not 1 <= m <= 12]
+        if bad:
+            raise ValueError(f"months must be 1..12, got {bad}")
+        self.__dict__["months"] = sorted(set(self.months))
+        return self
+
+
 class DbCfg(_Model):
     dsn: str | None = None
 
@@ -164,6 +178,7 @@ class Config(_Model):
     vehicle: VehicleCfg = Field(default_factory=VehicleCfg)
     economics: EconomicsCfg = Field(default_factory=EconomicsCfg)
     climate: ClimateCfg = Field(default_factory=ClimateCfg)
+    run: RunCfg = Field(default_factory=RunCfg)
     dask: DaskCfg = Field(default_factory=DaskCfg)
     db: DbCfg = Field(default_factory=DbCfg)
 

@@ -131,7 +131,7 @@ def reduce_run(cfg: Config, year: int, run_dir: Path, say=print) -> dict:
     write_parquet(monthly, run_dir / "monthly.parquet")
 
     summary = {
-        "scenario": cfg.scenario, "year": year, "pv_mode": cfg.pv.mode,
+        "scenario": cfg.scenario, "year": year, "months": cfg.run.months, "pv_mode": cfg.pv.mode,
         "diffuse_model": cfg.irradiance.diffuse_model,
         "routes": int(trip["route_id"].nunique()), "trips": int(len(trip)), "buses": n_buses,
         "segments": int(len(segments)), "passes": int(sm["n_passes"].sum()),

@@ -21,8 +21,8 @@ def run_dir_of(cfg: Config, year: int) -> Path:
     return Path(cfg.out_dir) / cfg.scenario / str(year)
 
 
-def _months(year: int) -> list[str]:
-    return [f"{year}-{m:02d}" for m in range(1, 13)]
+def _months(cfg: Config, year: int) -> list[str]:
+    return [f"{year}-{m:02d}" for m in cfg.run.months]
 
 
 def _reset_if_config_changed(run_dir: Path, digest: str) -> None:
@@ -114,14 +114,14 @@ def run_simulation(cfg: Config, year: int, scheduler: str | None = None,
         bvh_cache_size=cfg.dask.bvh_cache_size,
         route_of_trip=dict(zip(trips["trip_id"], trips["route_id"].astype(str))))
 
-    todo = [(t, m) for t in tiles for m in _months(year) if not partition_done(run_dir, t, m)]
-    total = len(tiles) * 12
+    todo = [(t, m) for t in tiles for m in _months(cfg, year) if not partition_done(run_dir, t, m)]
+    total = len(tiles) * len(cfg.run.months)
     if max_partitions is not None:
         todo = todo[:max_partitions]
     client, cluster = make_client(cfg, scheduler, n_workers)
     try:
         say(f"dask dashboard: {client.dashboard_link}")
-        say(f"{len(tiles)} tiles x 12 months = {total} partitions, {len(todo)} to compute "
+        say(f"{len(tiles)} tiles x {len(cfg.run.months)} months = {total} partitions, {len(todo)} to compute "
             f"({total - len(todo)} already done) with {len(client.scheduler_info()['workers'])} workers")
         t_map = time.perf_counter()
         results = _map(client, ctx, todo)
@@ -131,7 +131,7 @@ def run_simulation(cfg: Config, year: int, scheduler: str | None = None,
         client.close()
         if cluster is not None:
             cluster.close()
-    if not all(partition_done(run_dir, t, m) for t in tiles for m in _months(year)):
+    if not all(partition_done(run_dir, t, m) for t in tiles for m in _months(cfg, year)):
         say("stopped before all partitions were computed; run the same command again to resume")
         return run_dir
     t_red = time.perf_counter()
