@@ -1,0 +1,408 @@
+"""Irradiance on a bus roof: direct (ray-cast), diffuse and reflected light.
+
+The paper's model (sections 3.2.1 to 3.2.3):
+
+* (1) direct    ``E_b = DNI x max(cos AOI, 0) x V_sun`` with ``V_sun`` = 1 when the ray
+  from the roof point to the sun is not blocked (Embree occlusion query);
+* (2) diffuse   ``E_d = DHI x (1 + cos beta) / 2`` (isotropic sky, Liu & Jordan; pvlib
+  ``irradiance.isotropic``), or, as our extension, ``E_d = DHI x SVF`` with the
+  cosine-weighted sky view factor of the roof point (``diffuse_model: sky_view_factor``);
+* (3) reflected ``E_r = sum_j rho_j F_j E_j``: every surface seen from the roof reflects
+  (Lambertian, one bounce) the irradiance it receives, weighted by its view factor.  The
+  geometric part ``rho_j F_j`` is found once per segment with cosine-weighted rays and
+  grouped into a few reflector groups by orientation; ``E_j`` of a group is evaluated per
+  pass like a tilted plane (its own direct with one occlusion ray from a representative
+  point, isotropic sky diffuse, ground-reflected GHI).
+
+Roof plane: tilt ``beta = atan(|gradient|)``, facing downhill (a bus climbing tilts its roof
+backwards), azimuth from the heading.  All angles in degrees at the interfaces, azimuths
+clockwise from north; irradiances in W/m2; coordinates in metres (x east, y north, z up).
+
+References
+----------
+B. Y. H. Liu, R. C. Jordan (1963), The long-term average performance of flat-plate solar
+energy collectors, Solar Energy 7(2), 53-74.  pvlib: ``pvlib.irradiance.get_total_irradiance``
+(``model='isotropic'``), ``pvlib.irradiance.aoi``.
+"""
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from .config import IrradianceCfg
+
+_GOLDEN = (np.sqrt(5.0) - 1.0) / 2.0
+_CHUNK = 1 << 20        # passes per chunk in evaluate_passes
+_MIN_REFLECTOR_LIFT = 0.02   # m: a reflector's sun ray starts off its own surface
+
+
+# ---------------------------------------------------------------------------- roof plane
+def roof_plane(heading_deg, gradient):
+    """Roof tilt and azimuth from the heading and the road gradient.
+
+    Parameters
+    ----------
+    heading_deg : array, direction of travel (deg from north, clockwise)
+    gradient : array, dz/ds (dimensionless; > 0 climbing)
+
+    Returns
+    -------
+    tilt_deg, azimuth_deg : arrays
+        Tilt from horizontal and azimuth of the downhill direction the roof faces.
+    """
+    heading = np.asarray(heading_deg, np.float64)
+    g = np.asarray(gradient, np.float64)
+    tilt = np.degrees(np.arctan(np.abs(g)))
+    azimuth = np.where(g > 0, heading + 180.0, heading) % 360.0
+    return tilt, azimuth
+
+
+def plane_normal(tilt_deg, azimuth_deg) -> np.ndarray:
+    """Unit normal (east, north, up) of a plane of given tilt and azimuth, shape (n, 3)."""
+    t, a = np.radians(tilt_deg), np.radians(azimuth_deg)
+    return np.stack([np.sin(t) * np.sin(a), np.sin(t) * np.cos(a), np.cos(t)], axis=-1)
+
+
+def sun_vector(zenith_deg, azimuth_deg) -> np.ndarray:
+    """Unit vector towards the sun (east, north, up), shape (n, 3)."""
+    return plane_normal(zenith_deg, azimuth_deg)
+
+
+# ---------------------------------------------------------------------------- sampling
+def _basis(n: np.ndarray):
+    """Two unit tangents completing the normals *n* (m, 3) to right-handed frames."""
+    ref = np.where(np.abs(n[:, 0:1]) < 0.9, [[1.0, 0.0, 0.0]], [[0.0, 1.0, 0.0]])
+    t1 = np.cross(n, ref)
+    t1 /= np.linalg.norm(t1, axis=1, keepdims=True)
+    return t1, np.cross(n, t1)
+
+
+def cosine_directions(normals: np.ndarray, n_rays: int, rng: np.random.Generator) -> np.ndarray:
+    """Cosine-weighted hemisphere directions about each normal, shape (m, n_rays, 3).
+
+    Stratified: a golden-angle spiral of equal-area rings on the unit disk (Malley's method,
+    cosine-weighted), randomly rotated and jittered per normal.
+    """
+    m = len(normals)
+    k = np.arange(n_rays)
+    jitter = rng.random((m, n_rays))
+    u = (k[None] + jitter) / n_rays                            # radial strata
+    phi = 2 * np.pi * ((k[None] * _GOLDEN + rng.random((m, 1))) % 1.0)
+    r = np.sqrt(u)
+    lx, ly, lz = r * np.cos(phi), r * np.sin(phi), np.sqrt(np.clip(1 - u, 0, 1))
+    t1, t2 = _basis(np.asarray(normals, np.float64))
+    return (lx[..., None] * t1[:, None] + ly[..., None] * t2[:, None]
+            + lz[..., None] * normals[:, None])
+
+
+# ---------------------------------------------------------------------------- geometry
+def _roof_points(segments: pd.DataFrame) -> np.ndarray:
+    if {"x_end", "y_end", "z_end"} <= set(segments.columns):
+        return np.stack([(segments["x"].to_numpy(float) + segments["x_end"].to_numpy(float)) / 2,
+                         (segments["y"].to_numpy(float) + segments["y_end"].to_numpy(float)) / 2,
+                         (segments["z"].to_numpy(float) + segments["z_end"].to_numpy(float)) / 2], 1)
+    return segments[["x", "y", "z"]].to_numpy(np.float64)
+
+
+def _orientation_class(n: np.ndarray) -> np.ndarray:
+    """Orientation class of reflector normals: 0 up, 1 down, 2..9 eight azimuth sectors."""
+    az = np.degrees(np.arctan2(n[:, 0], n[:, 1])) % 360.0
+    sector = 2 + (((az + 22.5) % 360.0) // 45.0).astype(np.int64)
+    return np.where(n[:, 2] > 0.7, 0, np.where(n[:, 2] < -0.7, 1, sector))
+
+
+def segment_geometry(scene, segments: pd.DataFrame, cfg: IrradianceCfg | None = None,
+                     chunk: int = 4096) -> pd.DataFrame:
+    """Time-independent geometry of every segment: roof plane, sky view factor, reflectors.
+
+    Parameters
+    ----------
+    scene : vipvflow.shading.Scene
+    segments : DataFrame with ``segment_id, x, y, z, heading_deg, gradient`` (optional
+        ``x_end, y_end, z_end``: the roof point is then the segment's midpoint), metres
+    cfg : IrradianceCfg (``svf_rays``, ``reflection_rays``, ``max_reflector_groups``,
+        ``ray_length_m``, ``ray_offset_m``, ``seed``)
+
+    Returns
+    -------
+    DataFrame, one row per segment:
+        ``segment_id``; ``px, py, pz`` ray origin (roof point lifted by ``ray_offset_m``
+        along the normal, m); ``tilt_deg, azimuth_deg``; ``nx, ny, nz`` roof normal;
+        ``svf`` cosine-weighted sky view factor (sky above the horizon and not blocked;
+        (1 + cos tilt)/2 with no buildings); ``refl_vf`` albedo-weighted view factor of
+        all surfaces seen, ``refl_vf_se`` its Monte Carlo standard error; for each group
+        ``g < max_reflector_groups``: ``r{g}_w`` (sum albedo x view factor),
+        ``r{g}_nx, r{g}_ny, r{g}_nz`` (unit normal facing the roof), ``r{g}_x, r{g}_y,
+        r{g}_z`` (the group's hit point nearest its weighted mean, lifted off the
+        surface by ``max(ray_offset_m, 0.02 m)``).  Unused groups have
+        weight 0.
+    """
+    cfg = cfg or IrradianceCfg()
+    rng = np.random.default_rng(cfg.seed)
+    n_seg = len(segments)
+    tilt, azim = roof_plane(segments["heading_deg"].to_numpy(float),
+                            segments["gradient"].to_numpy(float))
+    normal = plane_normal(tilt, azim)
+    origin = _roof_points(segments) + cfg.ray_offset_m * normal
+    G = cfg.max_reflector_groups
+    svf = np.ones(n_seg, np.float64)
+    refl_vf = np.zeros(n_seg)
+    refl_se = np.zeros(n_seg)
+    gw = np.zeros((n_seg, G))
+    gn = np.tile(np.array([0.0, 0.0, 1.0]), (n_seg, G, 1)) if G else np.zeros((n_seg, 0, 3))
+    gp = np.repeat(origin[:, None], G, axis=1)
+    mesh = scene.mesh
+    tri_normal = np.asarray(mesh.normals, np.float64)
+    tri_albedo = np.asarray(mesh.albedo, np.float64)
+    for a in range(0, n_seg, chunk):
+        sl = slice(a, min(n_seg, a + chunk))
+        m = sl.stop - sl.start
+        o, nrm = origin[sl], normal[sl]
+        # sky view factor
+        d = cosine_directions(nrm, cfg.svf_rays, rng).reshape(-1, 3)
+        oo = np.repeat(o, cfg.svf_rays, axis=0)
+        blocked = scene.occluded(oo, d, cfg.ray_length_m)
+        sky = (~blocked) & (d[:, 2] > 0)
+        svf[sl] = sky.reshape(m, cfg.svf_rays).mean(axis=1)
+        if not (cfg.reflection and cfg.reflection_rays > 0 and G > 0):
+            continue
+        N = cfg.reflection_rays
+        d = cosine_directions(nrm, N, rng).reshape(-1, 3)
+        oo = np.repeat(o, N, axis=0)
+        tri, dist = scene.first_hit(oo, d, cfg.ray_length_m)
+        hit = tri >= 0
+        seg_of = np.repeat(np.arange(m), N)
+        x = np.zeros(len(tri))
+        x[hit] = tri_albedo[tri[hit]]
+        xs = x.reshape(m, N)
+        refl_vf[sl] = xs.mean(axis=1)
+        refl_se[sl] = xs.std(axis=1, ddof=1) / np.sqrt(N) if N > 1 else 0.0
+        hit &= x > 0
+        if not hit.any():
+            continue
+        hs, hd = seg_of[hit], d[hit]
+        hn = tri_normal[tri[hit]]
+        hn = np.where(((hn * hd).sum(1) > 0)[:, None], -hn, hn)     # the face the roof sees
+        hp = oo[hit] + dist[hit, None].astype(np.float64) * hd
+        w = x[hit] / N
+        cls = _orientation_class(hn)
+        C = 10
+        key = hs * C + cls
+        cw = np.bincount(key, w, m * C).reshape(m, C)
+        cn = np.stack([np.bincount(key, w * hn[:, j], m * C) for j in range(3)], -1).reshape(m, C, 3)
+        # keep the G heaviest classes; merge every other class into the kept one nearest
+        # in orientation
+        order = np.argsort(-cw, axis=1, kind="stable")
+        kept = order[:, :G]
+        rank = np.empty_like(order)
+        np.put_along_axis(rank, order, np.arange(C)[None].repeat(m, 0), axis=1)
+        kn = np.take_along_axis(cn, kept[..., None], axis=1)           # (m, G, 3)
+        kn_u = kn / np.maximum(np.linalg.norm(kn, axis=2, keepdims=True), 1e-12)
+        cn_u = cn / np.maximum(np.linalg.norm(cn, axis=2, keepdims=True), 1e-12)
+        kw = np.take_along_axis(cw, kept, axis=1)
+        sim = np.einsum("mcj,mgj->mcg", cn_u, kn_u) - 10.0 * (kw[:, None, :] <= 0)
+        target = np.where(rank < G, rank, np.argmax(sim, axis=2))      # (m, C) -> group
+        grp = target[hs, cls]
+        gkey = hs * G + grp
+        w_g = np.bincount(gkey, w, m * G).reshape(m, G)
+        n_g = np.stack([np.bincount(gkey, w * hn[:, j], m * G) for j in range(3)], -1).reshape(m, G, 3)
+        p_g = np.stack([np.bincount(gkey, w * hp[:, j], m * G) for j in range(3)], -1).reshape(m, G, 3)
+        nz = w_g > 0
+        n_g = np.where(nz[..., None], n_g / np.maximum(np.linalg.norm(n_g, axis=2, keepdims=True),
+                                                        1e-12), [0.0, 0.0, 1.0])
+        mean_p = p_g / np.maximum(w_g, 1e-300)[..., None]
+        # representative point: the group's hit point nearest its weighted mean
+        dev = np.linalg.norm(hp - mean_p.reshape(-1, 3)[gkey], axis=1)
+        srt = np.lexsort((dev, gkey))
+        first = srt[np.unique(gkey[srt], return_index=True)[1]]
+        rep = np.repeat(o[:, None], G, axis=1).reshape(-1, 3)
+        lift = max(cfg.ray_offset_m, _MIN_REFLECTOR_LIFT)
+        rep[gkey[first]] = hp[first] + lift * n_g.reshape(-1, 3)[gkey[first]]
+        gw[sl], gn[sl], gp[sl] = w_g, n_g, rep.reshape(m, G, 3)
+    out = {"segment_id": segments["segment_id"].to_numpy(np.int64),
+           "px": origin[:, 0], "py": origin[:, 1], "pz": origin[:, 2],
+           "tilt_deg": tilt.astype(np.float32), "azimuth_deg": azim.astype(np.float32),
+           "nx": normal[:, 0].astype(np.float32), "ny": normal[:, 1].astype(np.float32),
+           "nz": normal[:, 2].astype(np.float32), "svf": svf.astype(np.float32),
+           "refl_vf": refl_vf.astype(np.float32), "refl_vf_se": refl_se.astype(np.float32)}
+    for g in range(G):
+        out[f"r{g}_w"] = gw[:, g].astype(np.float32)
+        for j, c in enumerate("xyz"):
+            out[f"r{g}_n{c}"] = gn[:, g, j].astype(np.float32)
+        for j, c in enumerate("xyz"):
+            out[f"r{g}_{c}"] = gp[:, g, j]
+    return pd.DataFrame(out)
+
+
+COMPONENTS = ("direct", "diffuse", "reflected", "total", "direct_clear", "diffuse_clear",
+              "reflected_clear", "total_clear", "total_unshaded", "total_clear_unshaded")
+
+
+def pack_geometry(geometry: pd.DataFrame, cfg: IrradianceCfg, ground_albedo: float = 0.20) -> dict:
+    """Per-segment arrays for :func:`roof_irradiance`, with the time-independent parts of
+    eq. (3) folded in.
+
+    For a reflector group of weight ``w`` (sum albedo x view factor) and unit normal ``n``:
+    ``w E = dni max(s . (w n), 0) V + dhi w (1 + n_z)/2 + ghi w rho_g (1 - n_z)/2``, so a
+    segment needs ``w n`` per group and two sums: ``refl_sky = sum w (1 + n_z)/2`` and
+    ``refl_gnd = sum w rho_g (1 - n_z)/2``.
+    """
+    f32 = np.float32
+    G = cfg.max_reflector_groups if cfg.reflection else 0
+    G = min(G, sum(1 for c in geometry.columns if c.endswith("_w") and c.startswith("r")))
+    s = len(geometry)
+    wn = np.zeros((s, G, 3), f32)
+    pts = np.zeros((s, G, 3), np.float64)
+    sky = np.zeros(s, f32)
+    gnd = np.zeros(s, f32)
+    for g in range(G):
+        w = geometry[f"r{g}_w"].to_numpy(f32)
+        nz = geometry[f"r{g}_nz"].to_numpy(f32)
+        for j, c in enumerate("xyz"):
+            wn[:, g, j] = w * geometry[f"r{g}_n{c}"].to_numpy(f32)
+            pts[:, g, j] = geometry[f"r{g}_{c}"].to_numpy(np.float64)
+        sky += w * (1 + nz) / 2
+        gnd += w * f32(ground_albedo) * (1 - nz) / 2
+    return {"p": np.ascontiguousarray(geometry[["px", "py", "pz"]].to_numpy(np.float64)),
+            "n": np.ascontiguousarray(geometry[["nx", "ny", "nz"]].to_numpy(f32)),
+            "svf": geometry["svf"].to_numpy(f32), "refl_sky": sky, "refl_gnd": gnd,
+            "wn": wn, "group_p": pts, "has_group": (np.abs(wn).sum(axis=2) > 0)}
+
+
+def roof_irradiance(geometry, rows, sun: np.ndarray, rad: dict, scene, cfg: IrradianceCfg,
+                    ground_albedo: float = 0.20) -> dict:
+    """Irradiance components for arrays of passes (the hot path), eqs. (1)-(3).
+
+    Parameters
+    ----------
+    geometry : DataFrame from :func:`segment_geometry`, or its :func:`pack_geometry`
+    rows : (n,) int, row of *geometry* for each pass
+    sun : (n, 3) float32, unit vector towards the sun (east, north, up)
+    rad : dict of (n,) arrays ``ghi, dni, dhi, ghi_clear, dni_clear, dhi_clear`` (W/m2)
+    scene : vipvflow.shading.Scene
+    cfg : IrradianceCfg
+    ground_albedo : float, albedo of the ground seen by reflectors (used when packing)
+
+    Returns
+    -------
+    dict of (n,) float32 arrays, W/m2: :data:`COMPONENTS` and ``sun_visible`` (bool).
+    One occlusion ray per pass with the sun in front of the roof, one per lit reflector
+    group; the same visibility serves all-sky and clear-sky.
+    """
+    f32 = np.float32
+    geo = geometry if isinstance(geometry, dict) else pack_geometry(geometry, cfg, ground_albedo)
+    rows = np.asarray(rows, np.int64)
+    sun = np.asarray(sun, f32)
+    n = len(rows)
+    sx, sy, sz = sun[:, 0], sun[:, 1], sun[:, 2]
+    nrm = geo["n"][rows]
+    nz = nrm[:, 2]
+    rad = {k: np.nan_to_num(np.asarray(rad[k], f32)) for k in
+           ("dni", "dhi", "ghi", "dni_clear", "dhi_clear", "ghi_clear")}
+    dni, dhi, ghi = rad["dni"], rad["dhi"], rad["ghi"]
+    dnic, dhic, ghic = rad["dni_clear"], rad["dhi_clear"], rad["ghi_clear"]
+    up = sz > 0
+    lit_any = up & ((dni > 0) | (dnic > 0))
+    cos_aoi = np.einsum("ij,ij->i", nrm, sun)
+    np.maximum(cos_aoi, 0, out=cos_aoi)
+    cos_aoi *= up
+    cand = np.flatnonzero(lit_any & (cos_aoi > 0))
+    visible = np.zeros(n, bool)
+    if len(cand):
+        visible[cand] = ~scene.occluded(geo["p"][rows[cand]], sun[cand], cfg.ray_length_m)
+    iso = (f32(1) + nz) * f32(0.5)
+    sky = geo["svf"][rows] if cfg.diffuse_model == "sky_view_factor" else iso
+    direct_unsh, direct_unsh_c = dni * cos_aoi, dnic * cos_aoi
+    beam_v = cos_aoi * visible
+    direct, direct_c = dni * beam_v, dnic * beam_v
+    diffuse, diffuse_c = dhi * sky, dhic * sky
+    G = geo["wn"].shape[1] if (cfg.reflection and cfg.max_reflector_groups) else 0
+    if G:
+        rs, rg = geo["refl_sky"][rows], geo["refl_gnd"][rows]
+        refl, refl_c = dhi * rs + ghi * rg, dhic * rs + ghic * rg
+        lit = np.flatnonzero(lit_any)
+        if len(lit):
+            rl, sl = rows[lit], sun[lit]
+            beam = np.zeros(len(lit), f32)
+            for g in range(G):
+                has = geo["has_group"][rl, g]
+                sel = np.flatnonzero(has)
+                if not len(sel):
+                    continue
+                wc = np.einsum("ij,ij->i", geo["wn"][rl[sel], g], sl[sel])
+                front = wc > 0
+                sel, wc = sel[front], wc[front]
+                if not len(sel):
+                    continue
+                seen = ~scene.occluded(geo["group_p"][rl[sel], g], sl[sel], cfg.ray_length_m)
+                beam[sel] += wc * seen
+            refl[lit] += dni[lit] * beam
+            refl_c[lit] += dnic[lit] * beam
+    else:
+        refl = np.zeros(n, f32)
+        refl_c = np.zeros(n, f32)
+    return {"direct": direct, "diffuse": diffuse, "reflected": refl,
+            "total": direct + diffuse + refl,
+            "direct_clear": direct_c, "diffuse_clear": diffuse_c, "reflected_clear": refl_c,
+            "total_clear": direct_c + diffuse_c + refl_c,
+            "total_unshaded": direct_unsh + dhi * iso,
+            "total_clear_unshaded": direct_unsh_c + dhic * iso,
+            "sun_visible": visible}
+
+
+def evaluate_passes(passes: pd.DataFrame, segments: pd.DataFrame, geometry: pd.DataFrame,
+                    radiation_table, scene, cfg: IrradianceCfg | None = None,
+                    ground_albedo: float = 0.20, time_at: str = "mid") -> pd.DataFrame:
+    """Irradiance components on the roof for every pass (W/m2).
+
+    Parameters
+    ----------
+    passes : DataFrame with ``segment_id`` and ``t_utc`` (Unix s at the segment start);
+        with ``dt_s`` and ``time_at='mid'`` the sun and radiation are taken at the middle
+        of the time on the segment
+    segments : DataFrame of the segments (unused: *geometry* holds all per-segment data;
+        kept for the stage contract)
+    geometry : DataFrame from :func:`segment_geometry`; an optional ``rad_location`` column
+        (int, see :meth:`RadiationTable.nearest_location`) picks the CAMS location per segment
+    radiation_table : vipvflow.radiation.RadiationTable
+    scene : vipvflow.shading.Scene
+    cfg : IrradianceCfg
+    ground_albedo : float, albedo of the ground lighting the reflectors (eq. 3)
+    time_at : ``'mid'`` or ``'start'``
+
+    Returns
+    -------
+    DataFrame indexed like *passes*: ``direct, diffuse, reflected, total`` and the
+    ``_clear`` variants, ``total_unshaded``, ``total_clear_unshaded`` (float32, W/m2),
+    ``sun_visible`` (bool).
+    """
+    cfg = cfg or IrradianceCfg()
+    del segments
+    ids = geometry["segment_id"].to_numpy(np.int64)
+    pos = np.full(int(ids.max()) + 1 if len(ids) else 1, -1, np.int64)
+    pos[ids] = np.arange(len(ids))
+    seg = passes["segment_id"].to_numpy(np.int64)
+    if len(seg) and (seg.max() >= len(pos) or seg.min() < 0 or (pos[seg] < 0).any()):
+        raise KeyError("passes reference segments missing from the geometry")
+    row = pos[seg]
+    t = passes["t_utc"].to_numpy(np.float64)
+    if time_at == "mid" and "dt_s" in passes.columns:
+        t = t + 0.5 * passes["dt_s"].to_numpy(np.float64)
+    geo = pack_geometry(geometry, cfg, ground_albedo)
+    loc_col = geometry["rad_location"].to_numpy(np.int64) if "rad_location" in geometry else None
+    n = len(passes)
+    block = np.empty((n, len(COMPONENTS)), np.float32)
+    visible = np.empty(n, bool)
+    for a in range(0, n, _CHUNK):
+        sl = slice(a, min(n, a + _CHUNK))
+        r = row[sl]
+        loc = None if loc_col is None else loc_col[r]
+        rad = radiation_table.lookup(t[sl], location=loc, angles=False)
+        sun = np.stack([rad["sun_x"], rad["sun_y"], rad["sun_z"]], 1)
+        out = roof_irradiance(geo, r, sun, rad, scene, cfg, ground_albedo)
+        for j, k in enumerate(COMPONENTS):
+            block[sl, j] = out[k]
+        visible[sl] = out["sun_visible"]
+    df = pd.DataFrame(block, index=passes.index, columns=list(COMPONENTS), copy=False)
+    df["sun_visible"] = visible
+    return df

@@ -1,0 +1,90 @@
+"""PV energy from plane-of-array irradiance: the paper's performance-ratio model and pvlib.
+
+Paper mode (section 3.3): ``E = P_peak x G_poa / 1000 W/m2 x PR x dt``.
+pvlib mode: PVWatts DC power (``pvlib.pvsystem.pvwatts_dc``) at a cell temperature from
+the SAPM (``pvlib.temperature.sapm_cell``) or Faiman (``pvlib.temperature.faiman``) model,
+in which the wind speed is the bus's own speed plus the ambient wind, then the system
+losses and the PVWatts inverter (``pvlib.inverter.pvwatts``).
+"""
+from __future__ import annotations
+
+import numpy as np
+import pvlib
+
+from .config import PVSystem
+
+
+def energy_paper(poa_wm2, dt_s, kwp, performance_ratio=0.75):
+    """Energy with a constant performance ratio.
+
+    Parameters
+    ----------
+    poa_wm2 : array, plane-of-array irradiance (W/m2)
+    dt_s : array, time at that irradiance (s)
+    kwp : float, peak power (kW at 1000 W/m2)
+    performance_ratio : float (dimensionless)
+
+    Returns
+    -------
+    array, kWh
+    """
+    return (kwp * np.asarray(poa_wm2, np.float64) / 1000.0 * performance_ratio
+            * np.asarray(dt_s, np.float64) / 3600.0)
+
+
+def cell_temperature(poa_wm2, temp_air_c, wind_mps, model: str = "sapm_open_rack_glass_polymer"):
+    """Cell temperature (degC) from POA irradiance (W/m2), air temperature (degC) and wind (m/s).
+
+    ``model`` is ``sapm_<mounting>`` (a key of pvlib's SAPM parameter table) or ``faiman``.
+    """
+    if model == "faiman":
+        return pvlib.temperature.faiman(poa_wm2, temp_air_c, wind_mps)
+    if model.startswith("sapm_"):
+        p = pvlib.temperature.TEMPERATURE_MODEL_PARAMETERS["sapm"].get(model[5:])
+        if p is not None:
+            return pvlib.temperature.sapm_cell(poa_wm2, temp_air_c, wind_mps, **p)
+    known = ["faiman"] + [f"sapm_{k}" for k in pvlib.temperature.TEMPERATURE_MODEL_PARAMETERS["sapm"]]
+    raise ValueError(f"unknown temperature model {model!r} (known: {', '.join(known)})")
+
+
+def power_pvlib(poa_wm2, system: PVSystem, temp_air_c=15.0, vehicle_speed_mps=0.0,
+                wind_mps=0.0):
+    """AC power (W) and cell temperature (degC) with pvlib's PVWatts chain.
+
+    Parameters
+    ----------
+    poa_wm2 : array, plane-of-array irradiance (W/m2)
+    system : PVSystem (``kwp``, ``gamma_pdc_per_k``, ``system_losses_percent``,
+        ``inverter_efficiency``, ``temperature_model``)
+    temp_air_c : array or float, ambient temperature (degC)
+    vehicle_speed_mps : array or float, the bus's speed (m/s): relative air flow over the roof
+    wind_mps : array or float, ambient wind speed (m/s)
+
+    Returns
+    -------
+    p_ac_w, temp_cell_c : arrays
+    """
+    poa = np.asarray(poa_wm2, np.float64)
+    wind = np.abs(np.asarray(vehicle_speed_mps, np.float64)) + np.abs(np.asarray(wind_mps, np.float64))
+    tcell = np.asarray(cell_temperature(poa, temp_air_c, wind, system.temperature_model), np.float64)
+    pdc0 = system.kwp * 1000.0
+    pdc = pvlib.pvsystem.pvwatts_dc(poa, tcell, pdc0, system.gamma_pdc_per_k)
+    pdc = np.asarray(pdc, np.float64) * (1.0 - system.system_losses_percent / 100.0)
+    pac = pvlib.inverter.pvwatts(pdc, pdc0, eta_inv_nom=system.inverter_efficiency)
+    return np.clip(np.asarray(pac, np.float64), 0.0, None), tcell
+
+
+def energy_pvlib(poa_wm2, dt_s, system: PVSystem, temp_air_c=15.0, vehicle_speed_mps=0.0,
+                 wind_mps=0.0):
+    """Energy (kWh) with :func:`power_pvlib` held over each ``dt_s`` (s)."""
+    pac, _ = power_pvlib(poa_wm2, system, temp_air_c, vehicle_speed_mps, wind_mps)
+    return pac * np.asarray(dt_s, np.float64) / 3.6e6
+
+
+def energy(poa_wm2, dt_s, system: PVSystem, mode: str = "paper", **kwargs):
+    """kWh in the configured mode (``'paper'`` or ``'pvlib'``; kwargs go to pvlib mode)."""
+    if mode == "paper":
+        return energy_paper(poa_wm2, dt_s, system.kwp, system.performance_ratio)
+    if mode == "pvlib":
+        return energy_pvlib(poa_wm2, dt_s, system, **kwargs)
+    raise ValueError(f"unknown PV mode {mode!r}")

@@ -1,0 +1,549 @@
+"""CAMS solar radiation: read, check, put on a minute grid, look up per pass.
+
+Input files are CAMS Radiation Service (all-sky, with clear-sky columns) or CAMS McClear
+(clear-sky only) CSV files in the soda-pro format, read with
+:func:`pvlib.iotools.read_cams`.  CAMS gives the irradiation integrated over each
+observation period (Wh/m2); pvlib divides by the period length so every value here is the
+**mean irradiance over the period in W/m2**, stamped at the **centre of the period** (UTC).
+
+``ingest_cams`` puts each location's series on a regular one-minute grid (grid times are
+minute centres, ``hh:mm:30``; 15 min and hourly series are interpolated linearly between
+period centres) and writes ``radiation/radiation.parquet`` plus
+``radiation/ingest_report.json``.  :class:`RadiationTable` loads one year of it, computes the
+sun position once on the grid (pvlib, apparent zenith) and interpolates everything to pass
+times by index arithmetic.
+
+Quality flags (bit mask, column ``flag``): a gap (missing period or ``nan``), a negative
+value, GHI above 1.1 x the top-of-atmosphere horizontal irradiance, GHI above the clear-sky
+GHI by more than the margin, DNI above the extraterrestrial normal irradiance.  A flagged
+value is dropped and filled by linear interpolation between its good neighbours.
+
+References
+----------
+CAMS solar radiation time-series, Copernicus Atmosphere Monitoring Service,
+https://ads.atmosphere.copernicus.eu/datasets/cams-solar-radiation-timeseries
+"""
+from __future__ import annotations
+
+import json
+import logging
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pvlib
+
+from .errors import InputError
+
+log = logging.getLogger(__name__)
+
+#: irradiance columns kept (W/m2): all-sky and clear-sky global horizontal, direct normal,
+#: diffuse horizontal
+COLUMNS = ("ghi", "dni", "dhi", "ghi_clear", "dni_clear", "dhi_clear")
+
+FLAG_GAP = 1            # missing period or nan in the file
+FLAG_NEGATIVE = 2       # negative irradiance
+FLAG_GHI_TOA = 4        # GHI > 1.1 x top-of-atmosphere horizontal irradiance
+FLAG_GHI_CLEAR = 8      # GHI > clear-sky GHI x factor + offset
+FLAG_DNI_EXTRA = 16     # DNI > extraterrestrial normal irradiance
+FLAG_NO_ALLSKY = 32     # McClear only: all-sky columns are the clear-sky values
+
+#: GHI is flagged when above ``factor x ghi_clear + offset_wm2`` (cloud enhancement can
+#: exceed clear sky by tens of per cent for minutes)
+CLEAR_SKY_MARGIN = (1.5, 50.0)
+
+_REQUIRED = ("Clear sky GHI", "Clear sky DHI", "Clear sky BNI")
+_ALLSKY = ("GHI", "DHI", "BNI")
+_STEPS_S = {"1min": 60, "15min": 900, "1h": 3600}
+_GRID_S = 60
+
+
+# --------------------------------------------------------------------------- reading
+def _scan_header(path: Path) -> dict:
+    """Check the '#' header of a CAMS CSV; return the line numbers and values found."""
+    try:
+        fh = open(path, encoding="utf-8", errors="replace")
+    except OSError as exc:
+        raise InputError(f"{path}: cannot open CAMS file: {exc.strerror}") from None
+    info: dict = {"lines": {}}
+    with fh:
+        first_data = None
+        for no, line in enumerate(fh, start=1):
+            line = line.rstrip("\r\n")
+            if not line.startswith("#"):
+                if line.strip():
+                    first_data = (no, line)
+                    break
+                continue
+            body = line.lstrip("# ")
+            if body.startswith("Observation period"):
+                info["columns"] = body.split(";")
+                info["lines"]["columns"] = no
+            elif ": " in body:
+                key, value = body.split(": ", 1)
+                info[key.strip()] = value.strip()
+                info["lines"][key.strip()] = no
+    if "columns" not in info:
+        raise InputError(f"{path}: not a CAMS radiation/McClear CSV: no header line "
+                         "'# Observation period;...' naming the columns")
+    cols_line = info["lines"]["columns"]
+    missing = [c for c in _REQUIRED if c not in info["columns"]]
+    if missing:
+        raise InputError(f"{path}: line {cols_line}: column header lacks {', '.join(missing)}")
+    period = info.get("Summarization (integration) period")
+    if period is None:
+        raise InputError(f"{path}: header line '# Summarization (integration) period: ...' missing")
+    if period not in pvlib.iotools.sodapro.SUMMATION_PERIOD_TO_TIME_STEP:
+        raise InputError(f"{path}: line {info['lines']['Summarization (integration) period']}: "
+                         f"unknown summarization period {period!r}")
+    ref = info.get("Time reference", "")
+    if not (ref.startswith("Universal time") or ref.startswith("True solar time")):
+        where = f"line {info['lines']['Time reference']}" if "Time reference" in info else "header"
+        raise InputError(f"{path}: {where}: time reference must be 'Universal time (UT)' or "
+                         f"'True solar time (TST)', got {ref!r}")
+    for key in ("Latitude", "Longitude"):
+        full = next((k for k in info if isinstance(k, str) and k.startswith(key + " ")), None)
+        try:
+            info[key.lower()] = float(info[full])
+        except (TypeError, ValueError):
+            where = f"line {info['lines'][full]}" if full else "header"
+            raise InputError(f"{path}: {where}: {key} missing or not a number") from None
+    alt = next((k for k in info if isinstance(k, str) and k.startswith("Altitude")), None)
+    info["altitude"] = float(info[alt]) if alt else 0.0
+    if first_data is None:
+        raise InputError(f"{path}: no data rows after the header")
+    no, line = first_data
+    if line.count(";") + 1 != len(info["columns"]):
+        raise InputError(f"{path}: line {no}: {line.count(';') + 1} fields but the header "
+                         f"(line {cols_line}) names {len(info['columns'])} columns")
+    if not re.match(r"^\d{4}-\d\d-\d\dT[\d:.]+/\d{4}-\d\d-\d\dT[\d:.]+$", line.split(";")[0]):
+        raise InputError(f"{path}: line {no}: observation period {line.split(';')[0]!r} is "
+                         "not 'start/end' in ISO 8601")
+    info["time_reference"] = "TST" if ref.startswith("True solar") else "UT"
+    info["time_step"] = pvlib.iotools.sodapro.SUMMATION_PERIOD_TO_TIME_STEP[period]
+    return info
+
+
+def tst_to_utc(t_tst: pd.DatetimeIndex, longitude: float) -> pd.DatetimeIndex:
+    """Convert true solar time to UTC.
+
+    TST = UTC + longitude x 4 min/deg + equation of time (Spencer 1971, pvlib).
+
+    Parameters
+    ----------
+    t_tst : DatetimeIndex, naive or UTC-labelled, true solar time
+    longitude : float, degrees east
+    """
+    naive = t_tst.tz_localize(None) if t_tst.tz is not None else t_tst
+    # equation of time changes by < 30 s per day: evaluating it at the TST date is exact enough
+    eot_min = pvlib.solarposition.equation_of_time_spencer71(naive.day_of_year.to_numpy())
+    shift = pd.to_timedelta(longitude * 4.0 + np.asarray(eot_min), unit="min")
+    return (naive - shift).tz_localize("UTC")
+
+
+def read_cams_file(path, clear_sky_margin=CLEAR_SKY_MARGIN) -> tuple[pd.DataFrame, dict]:
+    """Read one CAMS Radiation or McClear CSV into mean irradiances with quality flags.
+
+    Parameters
+    ----------
+    path : str or Path
+        CAMS CSV (1 min, 15 min, 1 h, daily or monthly; UT or true solar time).
+    clear_sky_margin : (float, float)
+        GHI is flagged above ``factor x ghi_clear + offset`` (W/m2).
+
+    Returns
+    -------
+    frame : DataFrame
+        One row per observation period: ``t_start``, ``t_end``, ``t_centre``
+        (datetime64[ns, UTC]), ``ghi, dni, dhi, ghi_clear, dni_clear, dhi_clear`` (mean W/m2
+        over the period; all-sky NaN in a McClear file), ``toa`` (W/m2, horizontal),
+        ``flag`` (uint8 bit mask, see module doc).  Rows for missing periods are inserted
+        with NaN values and :data:`FLAG_GAP`.
+    meta : dict
+        ``file, latitude, longitude, altitude, time_step, time_reference, has_all_sky`` and the
+        counts ``rows, gaps, negative, ghi_above_toa, ghi_above_clear, dni_above_extra``.
+
+    Raises
+    ------
+    InputError
+        Naming the file and the header line or column that is wrong.
+    """
+    path = Path(path)
+    info = _scan_header(path)
+    try:
+        data, _ = pvlib.iotools.read_cams(path, integrated=False, label="left", map_variables=True)
+    except Exception as exc:  # pandas parse errors: name the file
+        raise InputError(f"{path}: cannot parse CAMS data rows: {exc}") from None
+    period = data["Observation period"].astype(str).str.split("/")
+    try:
+        start = pd.DatetimeIndex(pd.to_datetime(period.str[0], format="ISO8601"))
+        end = pd.DatetimeIndex(pd.to_datetime(period.str[1], format="ISO8601"))
+    except (ValueError, TypeError) as exc:
+        raise InputError(f"{path}: column 'Observation period': not ISO 8601 start/end ({exc})") from None
+    if info["time_reference"] == "TST":
+        start, end = tst_to_utc(start, info["longitude"]), tst_to_utc(end, info["longitude"])
+    else:
+        start = start.tz_localize("UTC") if start.tz is None else start.tz_convert("UTC")
+        end = end.tz_localize("UTC") if end.tz is None else end.tz_convert("UTC")
+    has_all = all(c in info["columns"] for c in _ALLSKY)
+    out = pd.DataFrame({"t_start": start, "t_end": end})
+    out["t_centre"] = out["t_start"] + (out["t_end"] - out["t_start"]) / 2
+    for col in COLUMNS:
+        if col in data.columns:
+            vals = pd.to_numeric(data[col], errors="coerce").to_numpy(np.float64)
+        else:
+            vals = np.full(len(data), np.nan)
+        out[col] = vals
+    out["toa"] = (pd.to_numeric(data["ghi_extra"], errors="coerce").to_numpy(np.float64)
+                  if "ghi_extra" in data.columns else np.nan)
+    bad_values = [c for c in COLUMNS if c in data.columns
+                  and pd.to_numeric(data[c], errors="coerce").isna().all()]
+    if bad_values and len(data) > 0:
+        raise InputError(f"{path}: column(s) {', '.join(bad_values)} hold no numbers")
+
+    step = _STEPS_S.get(info["time_step"])
+    if step is not None and len(out) > 1:
+        out = _insert_gap_rows(out, step)
+    flag = np.zeros(len(out), np.uint8)
+    core = list(COLUMNS) if has_all else ["ghi_clear", "dni_clear", "dhi_clear"]
+    vals = out[core].to_numpy()
+    flag[np.isnan(vals).any(axis=1)] |= FLAG_GAP
+    neg = (vals < 0).any(axis=1)
+    flag[neg] |= FLAG_NEGATIVE
+    dni_extra = pvlib.irradiance.get_extra_radiation(pd.DatetimeIndex(out["t_centre"])).to_numpy()
+    toa = out["toa"].to_numpy()
+    above_toa = np.zeros(len(out), bool)
+    for col in ("ghi", "ghi_clear"):
+        if col in core:
+            above_toa |= out[col].to_numpy() > 1.1 * toa + 1.0
+    flag[above_toa] |= FLAG_GHI_TOA
+    above_clear = np.zeros(len(out), bool)
+    if has_all:
+        fac, off = clear_sky_margin
+        above_clear = out["ghi"].to_numpy() > fac * out["ghi_clear"].to_numpy() + off
+        flag[above_clear] |= FLAG_GHI_CLEAR
+    above_extra = np.zeros(len(out), bool)
+    for col in ("dni", "dni_clear"):
+        if col in core:
+            above_extra |= out[col].to_numpy() > dni_extra + 1.0
+    flag[above_extra] |= FLAG_DNI_EXTRA
+    if not has_all:
+        flag |= FLAG_NO_ALLSKY
+    out["flag"] = flag
+    meta = {"file": str(path), "latitude": info["latitude"], "longitude": info["longitude"],
+            "altitude": info["altitude"], "time_step": info["time_step"],
+            "time_reference": info["time_reference"], "has_all_sky": has_all,
+            "rows": int(len(data)), "gaps": int(((flag & FLAG_GAP) > 0).sum()),
+            "negative": int(neg.sum()), "ghi_above_toa": int(above_toa.sum()),
+            "ghi_above_clear": int(np.asarray(above_clear).sum()),
+            "dni_above_extra": int(above_extra.sum()),
+            "start": str(out["t_start"].iloc[0]) if len(out) else None,
+            "end": str(out["t_end"].iloc[-1]) if len(out) else None}
+    return out, meta
+
+
+def _insert_gap_rows(frame: pd.DataFrame, step_s: int) -> pd.DataFrame:
+    """Insert NaN rows for periods missing from a regular series."""
+    t0 = frame["t_start"].to_numpy("datetime64[s]").astype(np.int64)
+    k = np.rint((t0 - t0[0]) / step_s).astype(np.int64)
+    n = int(k.max()) + 1
+    if n == len(frame) and (np.diff(k) == 1).all():
+        return frame.reset_index(drop=True)
+    full = pd.DataFrame({"t_start": pd.to_datetime(t0[0] + np.arange(n) * step_s, unit="s", utc=True)})
+    full["t_end"] = full["t_start"] + pd.Timedelta(seconds=step_s)
+    full["t_centre"] = full["t_start"] + pd.Timedelta(seconds=step_s / 2)
+    for col in frame.columns:
+        if col in ("t_start", "t_end", "t_centre"):
+            continue
+        arr = np.full(n, np.nan)
+        arr[k] = frame[col].to_numpy(np.float64)
+        full[col] = arr
+    return full
+
+
+# --------------------------------------------------------------------------- ingest
+def _to_minute_grid(frames: list[pd.DataFrame]) -> pd.DataFrame:
+    """Merge one location's frames onto the minute-centre grid (linear interpolation)."""
+    frame = pd.concat(frames, ignore_index=True).sort_values("t_centre", kind="stable")
+    tc = frame["t_centre"].to_numpy("datetime64[ms]").astype(np.int64) / 1000.0
+    t_lo = np.floor(frame["t_start"].min().timestamp() / _GRID_S) * _GRID_S
+    t_hi = np.ceil(frame["t_end"].max().timestamp() / _GRID_S) * _GRID_S
+    grid = np.arange(t_lo, t_hi, _GRID_S) + _GRID_S / 2
+    out = {"t_utc": grid.astype(np.int64)}
+    flag_in = frame["flag"].to_numpy(np.uint8)
+    has_all = ((flag_in & FLAG_NO_ALLSKY) == 0).any()
+    flag = np.zeros(len(grid), np.uint8)
+    # per grid minute, the flags of the period that contains it
+    ts = frame["t_start"].to_numpy("datetime64[ms]").astype(np.int64) / 1000.0
+    te = frame["t_end"].to_numpy("datetime64[ms]").astype(np.int64) / 1000.0
+    order = np.argsort(ts, kind="stable")
+    j = np.searchsorted(ts[order], grid, side="right") - 1
+    inside = (j >= 0) & (grid < te[order][np.clip(j, 0, None)])
+    flag[inside] = flag_in[order][j[inside]] & ~np.uint8(FLAG_NO_ALLSKY)
+    flag[~inside] |= FLAG_GAP
+    for col in COLUMNS:
+        v = frame[col].to_numpy(np.float64)
+        src = col
+        if not has_all and not col.endswith("_clear"):
+            v = frame[col + "_clear"].to_numpy(np.float64)
+            src = col + "_clear"
+        bad_bits = FLAG_GAP | FLAG_NEGATIVE | FLAG_GHI_TOA | FLAG_DNI_EXTRA
+        good = np.isfinite(v) & (v >= 0) & ((flag_in & bad_bits) == 0)
+        if src in ("ghi",):
+            good &= (flag_in & FLAG_GHI_CLEAR) == 0
+        if not good.any():
+            out[col] = np.full(len(grid), np.nan, np.float32)
+            continue
+        out[col] = np.interp(grid, tc[good], v[good]).astype(np.float32)
+    if not has_all:
+        flag |= FLAG_NO_ALLSKY
+    out["flag"] = flag
+    return pd.DataFrame(out)
+
+
+def ingest_cams(paths, data_dir, clear_sky_margin=CLEAR_SKY_MARGIN) -> dict:
+    """Read CAMS files and write ``radiation/radiation.parquet`` + ``ingest_report.json``.
+
+    Files of the same location (lat/lon to 4 decimals) are merged: a Radiation Service file
+    gives all-sky and clear-sky, a McClear file clear-sky only (all-sky is then set to the
+    clear-sky values and flagged :data:`FLAG_NO_ALLSKY`).  Daily and monthly files are read
+    by :func:`read_cams_file` but cannot drive a per-minute simulation and are refused here.
+
+    Parameters
+    ----------
+    paths : list of str or Path
+    data_dir : str or Path
+
+    Returns
+    -------
+    dict
+        The report (also written as JSON): per file the counts of flagged values, per
+        location the grid span and number of minutes.
+
+    Output columns: ``t_utc`` int64 (Unix s, minute centre), ``ghi, dni, dhi, ghi_clear,
+    dni_clear, dhi_clear`` float32 W/m2, ``flag`` uint8, ``lat, lon, altitude`` float64.
+    """
+    paths = [Path(p) for p in ([paths] if isinstance(paths, (str, Path)) else paths)]
+    if not paths:
+        raise InputError("ingest cams: no CAMS files given")
+    by_loc: dict = {}
+    files = []
+    for p in paths:
+        frame, meta = read_cams_file(p, clear_sky_margin)
+        if meta["time_step"] not in _STEPS_S:
+            raise InputError(f"{p}: time step {meta['time_step']} (daily/monthly means) cannot "
+                             "drive a per-pass simulation; give 1 min, 15 min or 1 h data")
+        key = (round(meta["latitude"], 4), round(meta["longitude"], 4))
+        by_loc.setdefault(key, {"frames": [], "alt": meta["altitude"]})["frames"].append(frame)
+        files.append(meta)
+    parts, locations = [], []
+    for (lat, lon), item in by_loc.items():
+        grid = _to_minute_grid(item["frames"])
+        grid["lat"], grid["lon"], grid["altitude"] = lat, lon, item["alt"]
+        parts.append(grid)
+        locations.append({"lat": lat, "lon": lon, "altitude": item["alt"], "minutes": len(grid),
+                          "start_utc": int(grid["t_utc"].iloc[0]) - _GRID_S // 2,
+                          "end_utc": int(grid["t_utc"].iloc[-1]) + _GRID_S // 2,
+                          "flagged_minutes": int((grid["flag"] & ~np.uint8(FLAG_NO_ALLSKY) > 0).sum()),
+                          "all_sky_from_clear_sky": bool((grid["flag"] & FLAG_NO_ALLSKY).any())})
+    table = pd.concat(parts, ignore_index=True)
+    out_dir = Path(data_dir) / "radiation"
+    out_dir.mkdir(parents=True, exist_ok=True)
+    target = out_dir / "radiation.parquet"
+    tmp = out_dir / "radiation.parquet.tmp"
+    table.to_parquet(tmp, index=False)
+    tmp.replace(target)
+    report = {"files": files, "locations": locations, "grid_step_s": _GRID_S,
+              "time_stamp": "centre of each minute (Unix s)", "units": "W/m2 mean over the minute",
+              "flags": {"gap": FLAG_GAP, "negative": FLAG_NEGATIVE, "ghi_above_toa": FLAG_GHI_TOA,
+                        "ghi_above_clear": FLAG_GHI_CLEAR, "dni_above_extra": FLAG_DNI_EXTRA,
+                        "all_sky_from_clear_sky": FLAG_NO_ALLSKY}}
+    tmp = out_dir / "ingest_report.json.tmp"
+    tmp.write_text(json.dumps(report, indent=2))
+    tmp.replace(out_dir / "ingest_report.json")
+    return report
+
+
+# --------------------------------------------------------------------------- lookup
+@dataclass
+class RadiationTable:
+    """Radiation and sun position on a regular time grid, for K locations.
+
+    Attributes
+    ----------
+    t0 : float, Unix s of grid point 0
+    step_s : float, grid step (s)
+    data : dict name -> (K, N) float32; ``ghi ... dhi_clear`` (W/m2) and the sun unit vector
+        ``sun_x, sun_y, sun_z`` (east, north, up; from pvlib apparent zenith and azimuth)
+    lat, lon : (K,) float64, degrees
+    """
+
+    t0: float
+    step_s: float
+    data: dict
+    lat: np.ndarray
+    lon: np.ndarray
+
+    def _packed(self):
+        """All series as one (K, N, C) float32 array: one gather per pass instead of C."""
+        cache = self.__dict__.get("_pack")
+        if cache is None or cache[0] != tuple(self.data) or any(
+                cache[2][c] is not self.data[c] for c in self.data):
+            names = tuple(self.data)
+            packed = np.ascontiguousarray(np.stack([self.data[c] for c in names], axis=-1),
+                                          dtype=np.float32)
+            cache = (names, packed, dict(self.data))
+            self.__dict__["_pack"] = cache
+        return cache[0], cache[1]
+
+    @property
+    def n(self) -> int:
+        return self.data["ghi"].shape[1]
+
+    @property
+    def t_end(self) -> float:
+        return self.t0 + (self.n - 1) * self.step_s
+
+    @classmethod
+    def from_grid(cls, t_utc, values: dict, lat, lon, altitude=0.0, sun_step_s: float = 300.0):
+        """Build from arrays on a regular grid; computes the sun position once.
+
+        Parameters
+        ----------
+        t_utc : (N,) Unix seconds, regular
+        values : dict of (N,) or (K, N) arrays, W/m2, keys :data:`COLUMNS`
+        lat, lon, altitude : float or (K,), degrees, m
+        sun_step_s : float
+            pvlib's solar position is evaluated every ``sun_step_s`` and the unit vector
+            interpolated (chord error below 1e-4 degrees for 5 min).
+        """
+        t = np.asarray(t_utc, dtype=np.float64)
+        lat = np.atleast_1d(np.asarray(lat, np.float64))
+        lon = np.atleast_1d(np.asarray(lon, np.float64))
+        alt = np.broadcast_to(np.asarray(altitude, np.float64), lat.shape)
+        step = float(t[1] - t[0]) if len(t) > 1 else 60.0
+        if len(t) > 2 and np.abs(np.diff(t) - step).max() > 1e-6:
+            raise ValueError("time grid is not regular")
+        data = {c: np.atleast_2d(np.asarray(values[c], np.float32)) for c in COLUMNS}
+        k = len(lat)
+        for c in COLUMNS:
+            if data[c].shape[0] != k:
+                data[c] = np.broadcast_to(data[c], (k, len(t))).copy()
+        sun = np.empty((3, k, len(t)), np.float32)
+        coarse = np.arange(t[0] - sun_step_s, t[-1] + 2 * sun_step_s, sun_step_s)
+        times = pd.to_datetime(np.round(coarse * 1e3).astype(np.int64), unit="ms", utc=True)
+        for i in range(k):
+            sp = pvlib.solarposition.get_solarposition(times, lat[i], lon[i], altitude=alt[i])
+            z, a = np.radians(sp["apparent_zenith"].to_numpy()), np.radians(sp["azimuth"].to_numpy())
+            for j, comp in enumerate((np.sin(z) * np.sin(a), np.sin(z) * np.cos(a), np.cos(z))):
+                sun[j, i] = np.interp(t, coarse, comp)
+        norm = np.sqrt((sun ** 2).sum(axis=0))
+        for j, name in enumerate(("sun_x", "sun_y", "sun_z")):
+            data[name] = sun[j] / norm
+        return cls(t0=float(t[0]), step_s=step, data=data, lat=lat, lon=lon)
+
+    @classmethod
+    def load(cls, data_dir, year: int, pad_days: float = 1.0) -> "RadiationTable":
+        """Load ``radiation/radiation.parquet`` for *year* (UTC, padded by *pad_days*).
+
+        Raises
+        ------
+        InputError
+            When the file is missing or does not cover any of the year.
+        """
+        path = Path(data_dir) / "radiation" / "radiation.parquet"
+        if not path.is_file():
+            raise InputError(f"{path}: not found; run 'vipvflow ingest cams' first")
+        lo = pd.Timestamp(f"{year}-01-01", tz="UTC").timestamp() - pad_days * 86400
+        hi = pd.Timestamp(f"{year + 1}-01-01", tz="UTC").timestamp() + pad_days * 86400
+        table = pd.read_parquet(path, filters=[("t_utc", ">=", int(lo)), ("t_utc", "<", int(hi))])
+        if table.empty:
+            raise InputError(f"{path}: holds no radiation for {year} (re-ingest CAMS data "
+                             f"covering {year})")
+        locs = table[["lat", "lon"]].drop_duplicates().to_numpy()
+        t_all = np.unique(table["t_utc"].to_numpy())
+        grid = np.arange(t_all[0], t_all[-1] + 1, _GRID_S, dtype=np.float64)
+        values = {c: np.full((len(locs), len(grid)), np.nan, np.float32) for c in COLUMNS}
+        alts = []
+        for i, (la, lo_) in enumerate(locs):
+            part = table[(table["lat"] == la) & (table["lon"] == lo_)]
+            idx = ((part["t_utc"].to_numpy() - grid[0]) // _GRID_S).astype(np.int64)
+            for c in COLUMNS:
+                values[c][i, idx] = part[c].to_numpy(np.float32)
+            alts.append(float(part["altitude"].iloc[0]) if "altitude" in part else 0.0)
+        covered = np.isfinite(values["ghi"]).mean()
+        if covered < 1.0:
+            log.warning("%s: %.1f %% of %d's minute grid has no radiation (NaN)", path,
+                        100 * (1 - covered), year)
+        return cls.from_grid(grid, values, locs[:, 0], locs[:, 1], np.array(alts))
+
+    @classmethod
+    def from_cams(cls, paths) -> "RadiationTable":
+        """Read CAMS files straight into a table (no data dir), for single runs and tracks."""
+        import tempfile
+
+        with tempfile.TemporaryDirectory() as tmp:
+            ingest_cams(paths, tmp)
+            table = pd.read_parquet(Path(tmp) / "radiation" / "radiation.parquet")
+        locs = table[["lat", "lon", "altitude"]].drop_duplicates().to_numpy()
+        grid = np.arange(table["t_utc"].min(), table["t_utc"].max() + 1, _GRID_S, dtype=np.float64)
+        values = {c: np.full((len(locs), len(grid)), np.nan, np.float32) for c in COLUMNS}
+        for i, (la, lo_, _) in enumerate(locs):
+            part = table[(table["lat"] == la) & (table["lon"] == lo_)]
+            idx = ((part["t_utc"].to_numpy() - grid[0]) // _GRID_S).astype(np.int64)
+            for c in COLUMNS:
+                values[c][i, idx] = part[c].to_numpy(np.float32)
+        return cls.from_grid(grid, values, locs[:, 0], locs[:, 1], locs[:, 2])
+
+    def nearest_location(self, lat, lon) -> np.ndarray:
+        """Index of the nearest table location for each point (degrees; great-circle)."""
+        lat = np.radians(np.atleast_1d(np.asarray(lat, np.float64)))[:, None]
+        lon = np.radians(np.atleast_1d(np.asarray(lon, np.float64)))[:, None]
+        la, lo = np.radians(self.lat)[None], np.radians(self.lon)[None]
+        h = (np.sin((la - lat) / 2) ** 2
+             + np.cos(lat) * np.cos(la) * np.sin((lo - lon) / 2) ** 2)
+        return np.argmin(h, axis=1).astype(np.int32)
+
+    def lookup(self, t_utc, location=None, angles: bool = True) -> dict:
+        """Interpolate radiation and sun position to times (linear, by index arithmetic).
+
+        Parameters
+        ----------
+        t_utc : array of float, Unix seconds
+        location : None, int or int array (index into ``lat``/``lon``; see
+            :meth:`nearest_location`); ``None`` means location 0
+        angles : bool, also return ``zenith`` and ``azimuth`` (degrees)
+
+        Returns
+        -------
+        dict of float32 arrays
+            ``ghi, dni, dhi, ghi_clear, dni_clear, dhi_clear`` (W/m2), ``sun_x, sun_y, sun_z``
+            (unit vector east/north/up), ``zenith`` (apparent, deg), ``azimuth`` (deg from
+            north, clockwise).  NaN outside the grid.
+        """
+        t = np.asarray(t_utc, dtype=np.float64)
+        f = (t - self.t0) / self.step_s
+        outside = ~((f >= 0) & (f <= self.n - 1))
+        f = np.clip(np.nan_to_num(f), 0, self.n - 1)
+        i = np.minimum(f.astype(np.int64), self.n - 2) if self.n > 1 else np.zeros(f.shape, np.int64)
+        w = (f - i).astype(np.float32)[:, None]
+        names, packed = self._packed()
+        if location is None or np.ndim(location) == 0:
+            rows = packed[0 if location is None else int(location)]
+            a, b = rows[i], rows[i + 1] if self.n > 1 else rows[i]
+        else:
+            loc = np.asarray(location, np.int64)
+            a = packed[loc, i]
+            b = packed[loc, i + 1] if self.n > 1 else a
+        v = a + w * (b - a)
+        if outside.any():
+            v[outside] = np.nan
+        vt = np.ascontiguousarray(v.T)          # contiguous columns for the callers' arithmetic
+        out = {name: vt[j] for j, name in enumerate(names)}
+        if angles:
+            sz = np.clip(out["sun_z"], -1, 1)
+            out["zenith"] = np.degrees(np.arccos(sz)).astype(np.float32)
+            out["azimuth"] = (np.degrees(np.arctan2(out["sun_x"], out["sun_y"])) % 360).astype(np.float32)
+        return out

@@ -1,0 +1,182 @@
+"""Roof irradiance against pvlib, analytic shading edges and analytic view factors."""
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import pvlib
+import pytest
+
+from vipvflow.config import IrradianceCfg
+from vipvflow.irradiance import (evaluate_passes, roof_irradiance, roof_plane, segment_geometry,
+                                 sun_vector)
+from vipvflow.radiation import COLUMNS, RadiationTable
+from vipvflow.shading import Scene, box_mesh
+
+LONG = 3000.0     # half length of "infinite" walls (m)
+
+
+def _segments(x, y, z, heading=0.0, gradient=0.0):
+    n = len(np.atleast_1d(x))
+    return pd.DataFrame({"segment_id": np.arange(n), "x": np.atleast_1d(x).astype(float),
+                         "y": np.broadcast_to(y, n).astype(float), "z": np.broadcast_to(z, n).astype(float),
+                         "heading_deg": np.broadcast_to(heading, n).astype(float),
+                         "gradient": np.broadcast_to(gradient, n).astype(float)})
+
+
+def _kernel(scene, geometry, rows, zenith, azimuth, rad, cfg, ground_albedo=0.2):
+    sun = sun_vector(zenith, azimuth).astype(np.float32)
+    return roof_irradiance(geometry, rows, sun, {k: np.asarray(v, np.float32) for k, v in rad.items()},
+                           scene, cfg, ground_albedo)
+
+
+def test_roof_faces_downhill():
+    tilt, az = roof_plane([0.0, 90.0, 90.0], [0.10, 0.10, -0.05])
+    assert np.allclose(tilt, np.degrees(np.arctan([0.10, 0.10, 0.05])))
+    assert np.allclose(az, [180.0, 270.0, 90.0])     # climbing north: roof tilts to the south
+
+
+def test_no_buildings_equals_pvlib_isotropic():
+    rng = np.random.default_rng(11)
+    n = 1000
+    tilt_true = rng.uniform(0, 35, n)
+    gradient = np.tan(np.radians(tilt_true)) * rng.choice([-1, 1], n)
+    heading = rng.uniform(0, 360, n)
+    segs = _segments(rng.uniform(0, 100, n), 0.0, 3.2, heading, gradient)
+    scene = Scene(box_mesh(np.zeros((0, 6))))
+    cfg = IrradianceCfg(svf_rays=16, reflection_rays=16)
+    geometry = segment_geometry(scene, segs, cfg)
+    zen, azi = rng.uniform(0, 89, n), rng.uniform(0, 360, n)
+    dni, dhi = rng.uniform(0, 900, n), rng.uniform(0, 300, n)
+    ghi = dhi + dni * np.cos(np.radians(zen))
+    rad = {"dni": dni, "dhi": dhi, "ghi": ghi, "dni_clear": dni * 1.1, "dhi_clear": dhi * 0.5,
+           "ghi_clear": ghi}
+    out = _kernel(scene, geometry, np.arange(n), zen, azi, rad, cfg)
+    surf_tilt, surf_az = roof_plane(heading, gradient)
+    ref = pvlib.irradiance.get_total_irradiance(surf_tilt, surf_az, zen, azi, dni, ghi, dhi,
+                                                albedo=0.0, model="isotropic")
+    ref_c = pvlib.irradiance.get_total_irradiance(surf_tilt, surf_az, zen, azi, dni * 1.1, ghi,
+                                                  dhi * 0.5, albedo=0.0, model="isotropic")
+    for got, want in ((out["total"], ref["poa_global"]), (out["total_unshaded"], ref["poa_global"]),
+                      (out["total_clear"], ref_c["poa_global"]), (out["direct"], ref["poa_direct"])):
+        np.testing.assert_allclose(got, want, rtol=1e-3, atol=1e-3)
+    assert (out["reflected"] == 0).all() and out["sun_visible"][ref["poa_direct"] > 0].all()
+
+
+def test_evaluate_passes_full_chain_matches_pvlib():
+    """Radiation table + sun position on the grid + pass times, no buildings."""
+    grid = np.arange(pd.Timestamp("2024-06-01", tz="UTC").timestamp(),
+                     pd.Timestamp("2024-06-03", tz="UTC").timestamp(), 60.0)
+    vals = {c: np.full(len(grid), v) for c, v in zip(COLUMNS, (600, 700, 150, 800, 850, 90))}
+    table = RadiationTable.from_grid(grid, vals, 49.61, 6.13, 300.0)
+    segs = _segments([0.0, 10.0, 20.0], 0.0, 3.2, [0.0, 90.0, 200.0], [0.0, 0.08, -0.03])
+    scene = Scene(box_mesh(np.zeros((0, 6))))
+    cfg = IrradianceCfg(svf_rays=16, reflection_rays=16)
+    geometry = segment_geometry(scene, segs, cfg)
+    rng = np.random.default_rng(5)
+    p = 300
+    passes = pd.DataFrame({"segment_id": rng.integers(0, 3, p),
+                           "t_utc": rng.uniform(grid[10], grid[-10], p), "dt_s": 2.0})
+    out = evaluate_passes(passes, segs, geometry, table, scene, cfg)
+    t_mid = pd.to_datetime((passes["t_utc"] + 1.0) * 1e9, utc=True)
+    sp = pvlib.solarposition.get_solarposition(t_mid, 49.61, 6.13, altitude=300.0)
+    tilt, az = roof_plane(segs["heading_deg"].to_numpy()[passes["segment_id"]],
+                          segs["gradient"].to_numpy()[passes["segment_id"]])
+    up = sp["apparent_zenith"].to_numpy() < 90
+    ref = pvlib.irradiance.get_total_irradiance(tilt, az, sp["apparent_zenith"].to_numpy(),
+                                                sp["azimuth"].to_numpy(), np.where(up, 700, 0),
+                                                600, 150, albedo=0.0, model="isotropic")
+    np.testing.assert_allclose(out["total"], ref["poa_global"], rtol=1e-3, atol=0.05)
+
+
+def test_long_wall_blocks_below_profile_angle():
+    H, D, zr = 15.0, 8.0, 3.2
+    scene = Scene(box_mesh([[D, -LONG, 0.0, D + 1.0, LONG, H]]))
+    cfg = IrradianceCfg(svf_rays=16, reflection_rays=0, ray_length_m=5000.0, ray_offset_m=0.05)
+    geometry = segment_geometry(scene, _segments(0.0, 0.0, zr), cfg)
+    rng = np.random.default_rng(3)
+    n = 4000
+    az = rng.uniform(20, 340, n)
+    el = rng.uniform(0.5, 70, n)
+    rad = {c: np.full(n, 500.0) for c in COLUMNS}
+    out = _kernel(scene, geometry, np.zeros(n, int), 90 - el, az, rad, cfg)
+    # profile angle in the wall's normal plane (the wall faces west, towards the roof)
+    c = np.cos(np.radians(az - 90.0))
+    east = c > 0.05
+    profile = np.degrees(np.arctan2(np.tan(np.radians(el)), np.where(east, c, 1.0)))
+    edge = np.degrees(np.arctan((H - zr - cfg.ray_offset_m) / D))
+    blocked = east & (profile < edge)
+    clear = np.abs(profile - edge) > 0.1
+    assert blocked.sum() > 300 and (~blocked).sum() > 300
+    np.testing.assert_array_equal(out["sun_visible"][clear], ~blocked[clear])
+    assert (out["direct"][blocked] == 0).all()
+
+
+@pytest.mark.parametrize("H,W", [(16.0, 20.0), (10.0, 30.0)])
+def test_canyon_sky_view_factor(H, W):
+    """Horizontal element on the centreline of an infinite canyon: SVF = W / sqrt(W^2 + 4 H^2).
+
+    2D view factor of an element to a strip seen between angles -a and +a from its normal:
+    (sin a - sin(-a)) / 2 = sin a with tan a = (W/2) / H, i.e. cos(atan(2H/W)).
+    """
+    zr = 3.0
+    scene = Scene(box_mesh([[-W / 2 - 1, -LONG, 0, -W / 2, LONG, zr + H],
+                            [W / 2, -LONG, 0, W / 2 + 1, LONG, zr + H]]))
+    cfg = IrradianceCfg(svf_rays=4096, reflection_rays=64, ray_length_m=10_000.0, ray_offset_m=0.0)
+    geometry = segment_geometry(scene, _segments([0.0], 0.0, zr, 0.0, 0.0), cfg)
+    expected = np.cos(np.arctan(2 * H / W))
+    assert geometry["svf"].iloc[0] == pytest.approx(expected, rel=0.02)
+
+
+def test_tilted_roof_open_sky_view_factor():
+    cfg = IrradianceCfg(svf_rays=1024, reflection_rays=8)
+    scene = Scene(box_mesh(np.zeros((0, 6))))
+    g = np.tan(np.radians([0.0, 10.0, 30.0]))
+    geometry = segment_geometry(scene, _segments([0, 1, 2], 0.0, 3.0, 45.0, g), cfg)
+    np.testing.assert_allclose(geometry["svf"], (1 + np.cos(np.arctan(g))) / 2, rtol=0.01)
+
+
+def test_reflection_from_large_wall_matches_view_factor():
+    """Horizontal roof at distance D from a wall of height H above it, albedo rho.
+
+    View factor roof -> wall (2D, infinite length): F = (1 - D / sqrt(D^2 + H^2)) / 2.
+    Reflected = rho F E_wall, E_wall = DNI cos(theta) + DHI / 2 + GHI rho_g / 2.
+    """
+    D, H, zr, rho, rho_g = 6.0, 25.0, 3.0, 0.4, 0.2
+    scene = Scene(box_mesh([[D, -LONG, 0.0, D + 2, LONG, zr + H]], albedo_wall=rho))
+    cfg = IrradianceCfg(svf_rays=64, reflection_rays=4096, ray_length_m=10_000.0, ray_offset_m=0.0,
+                        max_reflector_groups=3)
+    geometry = segment_geometry(scene, _segments([0.0], 0.0, zr), cfg)
+    F = (1 - D / np.hypot(D, H)) / 2
+    assert geometry["refl_vf"].iloc[0] == pytest.approx(rho * F, rel=0.03)
+    assert geometry["r0_w"].iloc[0] == pytest.approx(rho * F, rel=0.03)
+    assert geometry["r0_nx"].iloc[0] == pytest.approx(-1.0, abs=1e-6)
+    assert geometry["r1_w"].iloc[0] == 0
+    # sun in the west at 30 deg elevation lights the wall face (normal -x) at cos = 0.866
+    zen, az = np.array([60.0]), np.array([270.0])
+    dni, dhi = 700.0, 120.0
+    ghi = dhi + dni * np.cos(np.radians(60.0))
+    rad = {"dni": [dni], "dhi": [dhi], "ghi": [ghi], "dni_clear": [0.0], "dhi_clear": [dhi],
+           "ghi_clear": [dhi]}
+    out = _kernel(scene, geometry, np.array([0]), zen, az, rad, cfg, ground_albedo=rho_g)
+    e_wall = dni * np.sin(np.radians(60.0)) + dhi / 2 + ghi * rho_g / 2
+    assert out["reflected"][0] == pytest.approx(rho * F * e_wall, rel=0.05)
+    assert out["reflected_clear"][0] == pytest.approx(rho * F * (dhi / 2 + dhi * rho_g / 2), rel=0.05)
+    # sun in the east behind the wall: the wall face is dark, the roof is shaded
+    out = _kernel(scene, geometry, np.array([0]), zen, np.array([90.0]), rad, cfg, ground_albedo=rho_g)
+    assert out["reflected"][0] == pytest.approx(rho * F * (dhi / 2 + ghi * rho_g / 2), rel=0.05)
+    assert out["direct"][0] == 0
+
+
+def test_sky_view_factor_diffuse_mode():
+    H, W, zr = 16.0, 20.0, 3.0
+    scene = Scene(box_mesh([[-W / 2 - 1, -LONG, 0, -W / 2, LONG, zr + H],
+                            [W / 2, -LONG, 0, W / 2 + 1, LONG, zr + H]]))
+    iso = IrradianceCfg(svf_rays=1024, reflection_rays=256, ray_length_m=5000.0)
+    svf = iso.model_copy(update={"diffuse_model": "sky_view_factor"})
+    geometry = segment_geometry(scene, _segments([0.0], 0.0, zr), svf)
+    rad = {c: [300.0] for c in COLUMNS}
+    a = _kernel(scene, geometry, np.array([0]), np.array([40.0]), np.array([0.0]), rad, iso)
+    b = _kernel(scene, geometry, np.array([0]), np.array([40.0]), np.array([0.0]), rad, svf)
+    assert a["diffuse"][0] == pytest.approx(300.0)
+    assert b["diffuse"][0] == pytest.approx(300.0 * geometry["svf"].iloc[0])
+    assert b["total_unshaded"][0] == a["total_unshaded"][0]

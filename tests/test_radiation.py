@@ -1,0 +1,155 @@
+"""CAMS radiation: reading real pvlib CAMS files, quality flags, minute grid, lookup."""
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pandas as pd
+import pvlib
+import pytest
+
+from vipvflow.errors import InputError
+from vipvflow.radiation import (FLAG_GAP, FLAG_NEGATIVE, FLAG_NO_ALLSKY, RadiationTable,
+                                ingest_cams, read_cams_file)
+
+
+@pytest.fixture(scope="module")
+def cams(test_data):
+    return test_data / "cams"
+
+
+def _data_rows(path):
+    lines = path.read_text().splitlines(keepends=True)
+    head = [ln for ln in lines if ln.startswith("#")]
+    body = [ln for ln in lines if not ln.startswith("#")]
+    return head, body
+
+
+def test_one_minute_wh_to_w(cams):
+    frame, meta = read_cams_file(cams / "cams_radiation_1min_verbose.csv")
+    # first row: GHI 13.5893 Wh/m2 over one minute, BNI 14.2954, DHI 1.8837, clear GHI 14.1417
+    row = frame.iloc[0]
+    assert row["ghi"] == pytest.approx(13.5893 * 60, rel=1e-6)
+    assert row["dni"] == pytest.approx(14.2954 * 60, rel=1e-6)
+    assert row["dhi"] == pytest.approx(1.8837 * 60, rel=1e-6)
+    assert row["ghi_clear"] == pytest.approx(14.1417 * 60, rel=1e-6)
+    assert row["t_centre"] == pd.Timestamp("2020-06-01 12:00:30", tz="UTC")
+    assert meta["time_step"] == "1min" and meta["has_all_sky"]
+    assert meta["latitude"] == pytest.approx(55.7906) and meta["longitude"] == pytest.approx(12.5251)
+    assert meta["gaps"] == meta["negative"] == meta["dni_above_extra"] == 0
+
+
+def test_monthly_files(cams):
+    frame, meta = read_cams_file(cams / "cams_radiation_monthly.csv")
+    jan = frame.iloc[0]
+    assert jan["ghi"] == pytest.approx(15531.9336 / (31 * 24), rel=1e-6)
+    assert jan["dni_clear"] == pytest.approx(105764.5547 / (31 * 24), rel=1e-6)
+    feb = frame.iloc[1]                               # 2020 is a leap year: 29 days
+    assert feb["ghi"] == pytest.approx(33073.7422 / (29 * 24), rel=1e-6)
+    assert jan["t_centre"] == pd.Timestamp("2020-01-16 12:00", tz="UTC")
+    year, meta = read_cams_file(cams / "cams_mcclear_monthly_12rows_pvlib-2092f8b.csv")
+    assert len(year) == 12 and not meta["has_all_sky"]
+    assert year["ghi"].isna().all() and (year["ghi_clear"] > 0).all()
+    # the monthly means of a year cannot drive a minute simulation
+    with pytest.raises(InputError, match="monthly|daily"):
+        ingest_cams([cams / "cams_mcclear_monthly.csv"], "unused")
+
+
+def test_broken_header_names_problem(cams, tmp_path):
+    head, body = _data_rows(cams / "cams_radiation_1min_verbose.csv")
+    bad = tmp_path / "no_columns.csv"
+    bad.write_text("".join(h for h in head if not h.startswith("# Observation period")) + "".join(body))
+    with pytest.raises(InputError, match=r"no_columns\.csv.*Observation period"):
+        read_cams_file(bad)
+    bad = tmp_path / "period.csv"
+    bad.write_text("".join(h.replace("0 h 1 min 0 s", "0 h 7 min 0 s") for h in head) + "".join(body))
+    with pytest.raises(InputError, match=r"period\.csv: line 27: unknown summarization period"):
+        read_cams_file(bad)
+    bad = tmp_path / "cols.csv"
+    bad.write_text("".join(h.replace(";Clear sky BNI;", ";Clear sky XYZ;") for h in head) + "".join(body))
+    with pytest.raises(InputError, match=r"cols\.csv: line \d+: column header lacks Clear sky BNI"):
+        read_cams_file(bad)
+    bad = tmp_path / "fields.csv"
+    bad.write_text("".join(head) + body[0].replace(";", ";1;", 1))
+    with pytest.raises(InputError, match=r"fields\.csv: line \d+: 36 fields"):
+        read_cams_file(bad)
+
+
+def test_gap_and_negative_are_flagged(cams, tmp_path):
+    src = cams / "cams_mcclear_1min_verbose_60rows_pvlib-527fa1c.csv"
+    head, body = _data_rows(src)
+    body = list(body)
+    del body[10]                                      # 12:10 missing
+    fields = body[20].split(";")                      # 12:21 gets a negative clear-sky GHI
+    fields[2] = "-3.0"
+    body[20] = ";".join(fields)
+    f = tmp_path / "gappy.csv"
+    f.write_text("".join(head) + "".join(body))
+    frame, meta = read_cams_file(f)
+    assert meta["gaps"] == 1 and meta["negative"] == 1
+    assert len(frame) == 60
+    report = ingest_cams([f], tmp_path / "data")
+    table = pd.read_parquet(tmp_path / "data" / "radiation" / "radiation.parquet")
+    assert len(table) == 60
+    t = pd.to_datetime(table["t_utc"], unit="s", utc=True)
+    flags = dict(zip(t.dt.strftime("%H:%M"), table["flag"]))
+    assert flags["12:10"] & FLAG_GAP and flags["12:21"] & FLAG_NEGATIVE
+    assert flags["12:05"] & ~FLAG_NO_ALLSKY == 0
+    # filled values lie between their neighbours and are physical
+    v = table["ghi_clear"].to_numpy()
+    assert (v >= 0).all()
+    assert min(v[9], v[11]) - 1e-3 <= v[10] <= max(v[9], v[11]) + 1e-3
+    assert report["files"][0]["negative"] == 1 and report["files"][0]["gaps"] == 1
+    saved = json.loads((tmp_path / "data" / "radiation" / "ingest_report.json").read_text())
+    assert saved["locations"][0]["all_sky_from_clear_sky"] is True
+
+
+def test_true_solar_time_file(cams, tmp_path):
+    """12:00 true solar time is the sun's transit: the UTC stamp must match pvlib's transit."""
+    head, body = _data_rows(cams / "cams_mcclear_1min_verbose_60rows_pvlib-527fa1c.csv")
+    f = tmp_path / "tst.csv"
+    f.write_text("".join(h.replace("Universal time (UT)", "True solar time (TST)") for h in head)
+                 + "".join(body))
+    frame, meta = read_cams_file(f)
+    assert meta["time_reference"] == "TST"
+    noon_utc = frame["t_start"].iloc[0]
+    day = pd.DatetimeIndex([pd.Timestamp("2020-06-01", tz="UTC")])
+    transit = pvlib.solarposition.sun_rise_set_transit_spa(day, 55.7906, 12.5251)["transit"].iloc[0]
+    assert abs((noon_utc - transit).total_seconds()) < 20
+
+
+def test_table_lookup_and_sun_position(cams, tmp_path):
+    src = cams / "cams_mcclear_1min_verbose_60rows_pvlib-527fa1c.csv"
+    ingest_cams([src], tmp_path)
+    table = RadiationTable.load(tmp_path, 2020)
+    raw = pd.read_csv(src, sep=";", comment="#", header=None)
+    t0 = pd.Timestamp("2020-06-01 12:00:30", tz="UTC").timestamp()
+    t = t0 + np.array([0.0, 60.0, 90.0, 600.0])
+    out = table.lookup(t)
+    ghi = raw[2].to_numpy() * 60
+    assert out["ghi_clear"][0] == pytest.approx(ghi[0], rel=1e-5)
+    assert out["ghi_clear"][1] == pytest.approx(ghi[1], rel=1e-5)
+    assert out["ghi_clear"][2] == pytest.approx((ghi[1] + ghi[2]) / 2, rel=1e-5)
+    assert out["ghi"][3] == pytest.approx(ghi[10], rel=1e-5)     # McClear: all-sky = clear
+    # CAMS gives the solar zenith angle at each period's middle (column 7, 'sza')
+    sza = raw[6].to_numpy()
+    assert np.abs(out["zenith"] - sza[[0, 1, 1, 10]] + [0, 0, (sza[1] - sza[2]) / 2, 0]).max() < 0.05
+    assert np.isnan(table.lookup([t0 - 7200])["ghi"][0])
+    with pytest.raises(InputError, match="2019"):
+        RadiationTable.load(tmp_path, 2019)
+
+
+def test_several_locations_nearest(cams, tmp_path):
+    src = cams / "cams_radiation_1min_verbose.csv"
+    head, body = _data_rows(src)
+    other = tmp_path / "south.csv"
+    other.write_text("".join(h.replace("55.7906", "49.6116").replace("12.5251", "6.1319") for h in head)
+                     + "".join(body))
+    ingest_cams([src, other], tmp_path / "d")
+    table = RadiationTable.load(tmp_path / "d", 2020)
+    assert len(table.lat) == 2
+    loc = table.nearest_location([49.5, 56.0], [6.0, 12.0])
+    assert table.lat[loc[0]] == pytest.approx(49.6116) and table.lat[loc[1]] == pytest.approx(55.7906)
+    t = pd.Timestamp("2020-06-01 12:01:30", tz="UTC").timestamp()
+    a, b = table.lookup([t, t], location=loc)["zenith"]
+    assert a < b        # the same minute, the sun higher in Luxembourg than in Denmark
