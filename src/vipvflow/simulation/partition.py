@@ -41,6 +41,7 @@ class RunContext:
     wind_speed_mps: float
     timezone: str
     bvh_cache_size: int = 8
+    ground_albedo: float = 0.2
     route_of_trip: dict = field(default_factory=dict, compare=False, hash=False)
 
 
@@ -116,7 +117,8 @@ def run_partition(ctx: RunContext, tile: str, month: str, geometry: pd.DataFrame
     if n:
         t1 = time.perf_counter()
         irr = evaluate_passes(passes, seg, geometry, _radiation(ctx.data_dir, ctx.year),
-                              _scene(ctx, tile), IrradianceCfg(**ctx.irradiance))
+                              _scene(ctx, tile), IrradianceCfg(**ctx.irradiance),
+                              ground_albedo=ctx.ground_albedo)
         timings["irradiance_s"] = time.perf_counter() - t1
     else:
         irr = pd.DataFrame({c: np.zeros(0, np.float32) for c in COMPONENTS})
@@ -181,4 +183,4 @@ def worker_bvh_builds() -> dict:
     """BVH builds per tile in this process (collected from every worker after a run)."""
     from .. import shading
 
-    return dict(getattr(shading, "BVH_BUILDS", {}))
+    return {tile: n for (_, tile), n in shading.BVH_BUILDS.items()}

@@ -47,7 +47,7 @@ def trip_consumption(cfg: Config, data_dir: Path, year: int) -> pd.DataFrame:
 def reduce_run(cfg: Config, year: int, run_dir: Path, say=print) -> dict:
     """Write trip_energy, segments, segment_month, route_month, block_day, monthly, hourly
     outputs, ``summary.json`` and ``report.html``; return the summary."""
-    from ..economics import fleet_economics
+    from .. import economics
     from .report import write_report
 
     data_dir = Path(cfg.data_dir)
@@ -113,19 +113,26 @@ def reduce_run(cfg: Config, year: int, run_dir: Path, say=print) -> dict:
     pv = cfg.pv_system()
     vehicle = cfg.vehicle_params()
     n_buses = int(trip.groupby("service_date")["block_id"].nunique().max())
-    eco = fleet_economics(
-        pv_kwh=float(trip["pv_kwh"].sum()), demand_kwh=float(trip["consumption_kwh"].sum()),
-        n_buses=n_buses, kwp=pv.kwp, battery_kwh=vehicle.battery_kwh,
-        soc_window=cfg.economics.soc_window, cost_eur_per_wp=cfg.economics.cost_eur_per_wp,
-        tariff_eur_per_kwh=cfg.economics.tariff_eur_per_kwh)
+    pv_year, demand_year = float(trip["pv_kwh"].sum()), float(trip["consumption_kwh"].sum())
+    window = cfg.economics.soc_window
+    eco = {
+        "fleet_demand_mwh": demand_year / 1000.0,
+        "coverage": float(economics.coverage(pv_year, demand_year)),
+        "avoided_charging_cycles_fleet": float(economics.avoided_cycles(pv_year, vehicle.battery_kwh, window)),
+        "avoided_charging_cycles_per_bus": float(
+            economics.avoided_cycles(pv_year / n_buses, vehicle.battery_kwh, window)),
+        "system_cost_eur_per_bus": float(economics.system_cost_eur(pv.kwp, cfg.economics.cost_eur_per_wp)),
+        "payback_years": float(economics.simple_payback_years(
+            pv.kwp, pv_year / n_buses, cfg.economics.cost_eur_per_wp, cfg.economics.tariff_eur_per_kwh)),
+    }
     tot = sm[[c for c in sm.columns if c.startswith("h_")]].sum()
     monthly = (trip.groupby("month", sort=True)
                .agg(trips=("trip_id", "size"), pv_kwh=("pv_kwh", "sum"), pv_kwh_clear=("pv_kwh_clear", "sum"),
                     pv_kwh_unshaded=("pv_kwh_unshaded", "sum"),
                     pv_kwh_clear_unshaded=("pv_kwh_clear_unshaded", "sum"),
                     consumption_kwh=("consumption_kwh", "sum")).reset_index())
-    usable = vehicle.battery_kwh * (cfg.economics.soc_window[1] - cfg.economics.soc_window[0])
-    monthly["avoided_charging_cycles"] = monthly["pv_kwh"] / usable
+    monthly["avoided_charging_cycles"] = economics.avoided_cycles(
+        monthly["pv_kwh"].to_numpy(), vehicle.battery_kwh, window)
     monthly["kwh_per_kwp_allsky"] = monthly["pv_kwh"] / (pv.kwp * n_buses)
     monthly["kwh_per_kwp_clearsky"] = monthly["pv_kwh_clear"] / (pv.kwp * n_buses)
     write_parquet(monthly, run_dir / "monthly.parquet")

@@ -111,7 +111,7 @@ def run_simulation(cfg: Config, year: int, scheduler: str | None = None,
         irradiance=cfg.irradiance.model_dump(), pv_system=cfg.pv_system().model_dump(),
         pv_mode=cfg.pv.mode, monthly_temperature_c=tuple(cfg.climate.monthly_mean_temperature_c),
         wind_speed_mps=cfg.climate.wind_speed_mps, timezone=feed["timezone"],
-        bvh_cache_size=cfg.dask.bvh_cache_size,
+        bvh_cache_size=cfg.dask.bvh_cache_size, ground_albedo=cfg.city.albedo.ground,
         route_of_trip=dict(zip(trips["trip_id"], trips["route_id"].astype(str))))
 
     todo = [(t, m) for t in tiles for m in _months(cfg, year) if not partition_done(run_dir, t, m)]
