@@ -1,0 +1,43 @@
+"""``vipvflow ingest gtfs FEED --data-dir DIR``: a GTFS feed to hyper-segments and patterns."""
+from __future__ import annotations
+
+from pathlib import Path
+
+
+def register(sub):
+    p = sub.add_parser("gtfs", help="GTFS feed -> gtfs/segments.parquet, trips, patterns",
+                       description="Read a GTFS zip or folder (gtfs-kit), cut every shape into "
+                       "hyper-segments and write the trajectory stage files under "
+                       "DATA_DIR/gtfs/.")
+    p.add_argument("feed", help="GTFS zip file or folder")
+    p.add_argument("--data-dir", required=True, help="scenario data directory")
+    p.add_argument("--crs", default=None,
+                   help="projected CRS when the city is not ingested, e.g. EPSG:2169 "
+                        "(default: city/tiles.json, else the local UTM zone)")
+    p.add_argument("--config", default=None, help="scenario YAML (trajectory settings)")
+    p.add_argument("--dist-units", default=None, choices=["m", "km", "mi", "ft"],
+                   help="units of shape_dist_traveled (default: inferred and checked)")
+    p.set_defaults(func=run)
+
+
+def run(args) -> int:
+    from ..config import load_config
+    from ..trajectory import ingest_gtfs
+
+    cfg = load_config(args.config)
+    report = ingest_gtfs(Path(args.feed), Path(args.data_dir), cfg.trajectory, crs=args.crs,
+                         dist_units=args.dist_units)
+    c = report["counts"]
+    print(f"GTFS {args.feed} -> {Path(args.data_dir) / 'gtfs'}  ({report['seconds']} s)")
+    print(f"  CRS {report['crs']} ({report['crs_source']}), timezone {report['timezone']}, "
+          f"timing {report['timing']}")
+    print(f"  shapes {c['shapes']}  segments {c['segments']}  tiles {c['tiles']}  "
+          f"trips {c['trips']}  patterns {c['patterns']}  routes {c['routes']}  "
+          f"({report['total_shape_length_km']} km of shapes)")
+    if report["problems"]:
+        print(f"  problems ({len(report['problems'])}):")
+        for line in report["problems"]:
+            print(f"    - {line}")
+    else:
+        print("  problems: none")
+    return 0

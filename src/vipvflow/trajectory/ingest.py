@@ -1,0 +1,400 @@
+"""``ingest_gtfs``: a GTFS feed to the trajectory stage files under ``<data_dir>/gtfs/``.
+
+Files written (see docs/contracts.md, "Trajectories"):
+
+- ``segments.parquet``  GeoParquet LineString Z, one row per hyper-segment.
+- ``trips.parquet``     one row per trip (frequencies expanded), with its pattern and start.
+- ``patterns.parquet``  per pattern and segment: ``t_offset_s``, ``dt_s``, ``speed_mps``.
+- ``pattern_stops.parquet``  per pattern and stop: ``stop_index, stop_id, dist_m, arr_s,
+  dep_s`` (s after the first departure): the input of the driving-cycle generator.
+- ``calendar.parquet``, ``calendar_dates.parquet``  the feed's service calendars.
+- ``feed.json``         timezone, CRS, tile size, counts and problems.
+"""
+from __future__ import annotations
+
+import json
+import logging
+import os
+import time
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from ..errors import InputError
+from .feed import read_feed
+from .schedule import pattern_segment_times, project_stops_monotone
+from .segments import build_segments, cumulative_distance, project_shapes
+
+log = logging.getLogger(__name__)
+
+_UNIT_M = {"m": 1.0, "km": 1000.0, "mi": 1609.344, "ft": 0.3048}
+
+
+def _atomic(path: Path, write) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    write(tmp)
+    os.replace(tmp, path)
+
+
+def _city_grid(data_dir: Path):
+    """(crs, tile_size_m) from ``city/tiles.json`` or (None, None)."""
+    path = data_dir / "city" / "tiles.json"
+    if not path.exists():
+        return None, None
+    try:
+        meta = json.loads(path.read_text())
+    except json.JSONDecodeError as exc:
+        raise InputError(f"{path}: not valid JSON: {exc}") from None
+    return meta.get("crs"), meta.get("tile_size_m")
+
+
+def _terrain(data_dir: Path, problems: list[str]):
+    """The city's terrain model, or None (module not available or no terrain.npz)."""
+    if not (data_dir / "city" / "terrain.npz").exists():
+        return None
+    try:
+        from ..city import TerrainModel
+    except ImportError:
+        problems.append("city/terrain.npz present but vipvflow.city.TerrainModel is not "
+                        "available; default elevation used")
+        return None
+    try:
+        return TerrainModel.load(data_dir)
+    except Exception as exc:  # a broken terrain must not stop the timetable
+        problems.append(f"city/terrain.npz could not be loaded ({exc}); default elevation used")
+        return None
+
+
+def _choose_crs(feed, data_dir: Path, crs):
+    import geopandas as gpd
+    from pyproj import CRS
+
+    city_crs, tile_size = _city_grid(data_dir)
+    if city_crs:
+        return CRS.from_user_input(city_crs), tile_size, "city/tiles.json"
+    if crs:
+        return CRS.from_user_input(crs), None, "argument"
+    pts = gpd.GeoSeries(gpd.points_from_xy(feed.stops["stop_lon"], feed.stops["stop_lat"]),
+                        crs="EPSG:4326")
+    return pts.estimate_utm_crs(), None, "local UTM zone"
+
+
+def _dist_factor(st: pd.DataFrame, shape_len: dict, feed_units: str | None, problems):
+    """Metres per unit of the feed's ``shape_dist_traveled``, checked against the geometry.
+
+    gtfs-kit infers units from magnitudes and can be wrong (a 5 km line in metres looks
+    like km); the ratio of each shape's projected length to the largest stop distance of
+    its trips decides, among m, km, mi and ft. Returns None when no unit fits.
+    """
+    if "shape_dist_traveled" not in st or st["shape_dist_traveled"].isna().all():
+        return None
+    last = st.groupby("trip_id", sort=False).agg(shape_id=("shape_id", "first"),
+                                                  dmax=("shape_dist_traveled", "max"))
+    last = last[last["dmax"] > 0]
+    ratio = last["shape_id"].map(shape_len).astype(float) / last["dmax"].astype(float)
+    ratio = ratio[np.isfinite(ratio)]
+    if ratio.empty:
+        return None
+    r = float(np.median(ratio))
+    name, factor = min(_UNIT_M.items(), key=lambda kv: abs(np.log(r / kv[1])))
+    if abs(np.log(r / factor)) > np.log(1.15):
+        problems.append(f"shape_dist_traveled fits no unit (shape length / distance = {r:.3g}); "
+                        "stops projected onto shapes instead")
+        return None
+    if feed_units and name != feed_units:
+        problems.append(f"shape_dist_traveled is in {name}, not {feed_units} as inferred; "
+                        f"read as {name}")
+    return factor
+
+
+def _fill_times(dist, t):
+    """Missing stop times interpolated along distance between timepoints (s)."""
+    bad = np.isnan(t)
+    if bad.any() and (~bad).sum() >= 2:
+        t = t.copy()
+        t[bad] = np.interp(dist[bad], dist[~bad], t[~bad])
+    return t
+
+
+def spread_repeated_times(d, arr, dep):
+    """Stop times truncated to the minute, spread along distance (s).
+
+    Timetables often give several consecutive stops the same time; taken literally the bus
+    would cover the distance between them in no time. Stops whose time repeats the previous
+    stop's departure are re-timed by linear interpolation along distance between the
+    surrounding stops whose times do change (the first departure and last arrival are kept).
+
+    Returns
+    -------
+    arr, dep : ndarray
+        New times (s); dwell kept at the stops still used as time points.
+    changed : int
+        Number of stops re-timed.
+    """
+    m = len(d)
+    anchors = [0] + [i for i in range(1, m - 1) if arr[i] > dep[i - 1]] + [m - 1]
+    changed = True
+    while changed and len(anchors) > 2:
+        changed = False
+        for n in range(len(anchors) - 1):
+            i, j = anchors[n], anchors[n + 1]
+            if dep[i] >= arr[j] and d[j] > d[i]:
+                if i != 0:
+                    anchors.pop(n)
+                elif j != m - 1:
+                    anchors.pop(n + 1)
+                else:
+                    continue
+                changed = True
+                break
+    a_idx = np.asarray(anchors)
+    inner = np.setdiff1d(np.arange(m), a_idx)
+    if len(inner) == 0:
+        return arr, dep, 0
+    prev = np.searchsorted(a_idx, inner) - 1              # anchor before each re-timed stop
+    i0, i1 = a_idx[prev], a_idx[prev + 1]
+    span = d[i1] - d[i0]
+    f = np.where(span > 0, (d[inner] - d[i0]) / np.where(span > 0, span, 1.0), 0.0)
+    t = dep[i0] + (arr[i1] - dep[i0]) * f
+    arr, dep = arr.copy(), dep.copy()
+    arr[inner] = t
+    dep[inner] = t
+    return arr, dep, len(inner)
+
+
+def ingest_gtfs(feed_path, data_dir, traj_cfg, crs=None, dist_units: str | None = None) -> dict:
+    """Read a GTFS feed and write the trajectory stage files under ``data_dir/gtfs/``.
+
+    Parameters
+    ----------
+    feed_path : str or Path
+        GTFS zip or folder.
+    data_dir : str or Path
+        Scenario data directory; ``city/tiles.json`` there, when present, fixes the CRS and
+        tile size, and ``city/terrain.npz`` the ground height.
+    traj_cfg : vipvflow.config.TrajectoryCfg
+        Segment length (m), roof height (m), default elevation (m), timing mode, cycle.
+    crs : str, optional
+        Projected CRS when the city has not been ingested (e.g. ``EPSG:2169``); else the
+        local UTM zone.
+    dist_units : str, optional
+        Units of ``shape_dist_traveled`` when known (checked against the geometry anyway).
+
+    Returns
+    -------
+    dict
+        The content of ``feed.json``: timezone, crs, tile_size_m, counts, problems, seconds.
+    """
+    from pyproj import Transformer
+
+    t_start = time.perf_counter()
+    data_dir = Path(data_dir)
+    out = data_dir / "gtfs"
+    feed = read_feed(feed_path, dist_units=dist_units)
+    problems = list(feed.problems)
+    crs_obj, tile_size, crs_source = _choose_crs(feed, data_dir, crs)
+    if not crs_obj.is_projected:
+        raise InputError(f"{crs_obj.to_string()}: the trajectory CRS must be projected (metres)")
+    tile_size = float(tile_size or 500.0)
+    to_xy = Transformer.from_crs("EPSG:4326", crs_obj, always_xy=True)
+
+    trips = feed.trips.copy()
+    used = set(trips["shape_id"].astype(str))
+    shape_xy = project_shapes(feed.shapes[feed.shapes["shape_id"].astype(str).isin(used)], to_xy)
+    degenerate = [s for s, p in shape_xy.items() if len(p) < 2]
+    if degenerate:
+        problems.append(f"{len(degenerate)} shapes have fewer than two distinct points; their "
+                        "trips are dropped")
+        for s in degenerate:
+            shape_xy.pop(s)
+    shape_len = {s: float(cumulative_distance(p)[-1]) for s, p in shape_xy.items()}
+    terrain = _terrain(data_dir, problems)
+    segs, geom = build_segments(shape_xy, traj_cfg.segment_length_m, traj_cfg.roof_height_m,
+                                tile_size, terrain, traj_cfg.default_elevation_m)
+
+    # ---- stop distances along shapes, per trip --------------------------------------------
+    trips["shape_id"] = trips["shape_id"].astype(str)
+    trips = trips[trips["shape_id"].isin(shape_xy.keys())]
+    st = feed.stop_times.merge(trips[["trip_id", "shape_id"]], on="trip_id")
+    st = st.sort_values(["trip_id", "stop_sequence"], kind="stable").reset_index(drop=True)
+    sx, sy = to_xy.transform(feed.stops["stop_lon"].to_numpy(float),
+                             feed.stops["stop_lat"].to_numpy(float))
+    stop_pos = pd.DataFrame({"x": sx, "y": sy}, index=feed.stops["stop_id"].astype(str))
+    st_xy = stop_pos.loc[st["stop_id"].astype(str)].to_numpy()
+    factor = _dist_factor(st, shape_len, feed.dist_units, problems)
+    feed_d = (st["shape_dist_traveled"].to_numpy(float) * factor
+              if factor is not None else np.full(len(st), np.nan))
+
+    tid = st["trip_id"].astype(str).to_numpy()
+    bounds = np.flatnonzero(np.r_[True, tid[1:] != tid[:-1], True])
+    shape_of = st["shape_id"].to_numpy()
+    stop_ids = st["stop_id"].astype(str).to_numpy()
+    arr_all, dep_all = st["arr_s"].to_numpy(float), st["dep_s"].to_numpy(float)
+    projected: dict = {}
+    n_projected = n_feed = n_nonmono = n_short = n_untimed = n_spread = 0
+    keys, rows = {}, []
+    trip_pattern, trip_start = {}, {}
+    pattern_stops, pattern_shape = [], []
+    for a, b in zip(bounds[:-1], bounds[1:]):
+        trip, shape = tid[a], shape_of[a]
+        if b - a < 2:
+            n_short += 1
+            continue
+        length = shape_len[shape]
+        d = feed_d[a:b]
+        if np.isnan(d).any() or np.any(np.diff(d) < 0) or d[-1] > 1.05 * length:
+            if not np.isnan(d).all():
+                n_nonmono += 1
+            key = (shape, tuple(stop_ids[a:b]))
+            if key not in projected:
+                projected[key] = project_stops_monotone(shape_xy[shape], st_xy[a:b])
+            d = projected[key]
+            n_projected += 1
+        else:
+            d = np.clip(d, 0.0, length)
+            n_feed += 1
+        arr, dep = _fill_times(d, arr_all[a:b]), _fill_times(d, dep_all[a:b])
+        if np.isnan(arr).any() or np.isnan(dep).any():
+            n_untimed += 1
+            continue
+        start = dep[0]
+        arr, dep = arr - start, dep - start
+        arr[0] = 0.0                      # the trip begins at its first departure
+        if np.any(np.diff(np.column_stack([arr, dep]).ravel()) < 0):
+            # times going backwards: keep the trip, make times non-decreasing, report
+            seq = np.maximum.accumulate(np.column_stack([arr, dep]).ravel())
+            arr, dep = seq[0::2], seq[1::2]
+            problems.append(f"trip {trip}: stop times decrease along the trip; made monotone")
+        arr2, dep2, _ = spread_repeated_times(d, arr, dep)
+        if not (np.array_equal(arr2, arr) and np.array_equal(dep2, dep)):
+            n_spread += 1
+            arr, dep = arr2, dep2
+        key = (shape, tuple(stop_ids[a:b]), tuple(np.round(d, 1)), tuple(arr), tuple(dep))
+        pid = keys.get(key)
+        if pid is None:
+            pid = keys[key] = len(keys)
+            pattern_shape.append(shape)
+            pattern_stops.append(pd.DataFrame({
+                "pattern_id": np.int64(pid), "stop_index": np.arange(b - a, dtype=np.int32),
+                "stop_id": stop_ids[a:b], "dist_m": d, "arr_s": arr, "dep_s": dep}))
+        trip_pattern[trip] = pid
+        trip_start[trip] = start
+    if n_short:
+        problems.append(f"{n_short} trips have fewer than two stop times; dropped")
+    if n_untimed:
+        problems.append(f"{n_untimed} trips have too few timed stops; dropped")
+    if n_spread:
+        problems.append(f"{n_spread} trips give consecutive stops the same time; those stops "
+                        "were re-timed along distance between the stops whose times change")
+    if n_nonmono:
+        problems.append(f"{n_nonmono} trips have shape_dist_traveled missing, decreasing or "
+                        "beyond the shape; their stops were projected onto the shape")
+
+    # ---- per-pattern segment timing -------------------------------------------------------
+    seg_by_shape = {s: g for s, g in segs.groupby("shape_id", sort=False)}
+    pstops = pd.concat(pattern_stops, ignore_index=True) if pattern_stops else pd.DataFrame(
+        columns=["pattern_id", "stop_index", "stop_id", "dist_m", "arr_s", "dep_s"])
+    timing = getattr(traj_cfg, "timing", "stop_times")
+    frames, n_zero, cycle_delays = [], 0, []
+    for pid, g in pstops.groupby("pattern_id", sort=True):
+        sg = seg_by_shape[pattern_shape[pid]]
+        d, arr, dep = g["dist_m"].to_numpy(), g["arr_s"].to_numpy(), g["dep_s"].to_numpy()
+        seg_start, seg_len = sg["cum_dist_m"].to_numpy(), sg["length_m"].to_numpy()
+        if timing == "driving_cycle":
+            from .cycle import cycle_reach_times
+            idx, t0, dtt, cov, rep = cycle_reach_times(d, arr, dep, seg_start, seg_len,
+                                                       traj_cfg.cycle)
+            if rep["max_delay_s"] > 0:
+                cycle_delays.append(rep["max_delay_s"])
+        else:
+            idx, t0, dtt, cov = pattern_segment_times(d, arr, dep, seg_start, seg_len)
+        moving = cov > 0
+        n_zero += int(np.sum(moving & (dtt <= 0)))
+        frames.append(pd.DataFrame({
+            "pattern_id": np.int64(pid),
+            "segment_id": sg["segment_id"].to_numpy(np.int64)[idx],
+            "t_offset_s": t0.astype(np.float64),
+            "dt_s": dtt.astype(np.float32),
+            "speed_mps": np.where(dtt > 0, cov / np.where(dtt > 0, dtt, 1), 0).astype(np.float32),
+        }))
+    patterns = pd.concat(frames, ignore_index=True) if frames else pd.DataFrame(
+        columns=["pattern_id", "segment_id", "t_offset_s", "dt_s", "speed_mps"])
+    if n_zero:
+        problems.append(f"{n_zero} pattern segments are scheduled with zero running time "
+                        "(stop times repeat between distinct stops); their dt_s is 0")
+    if cycle_delays:
+        problems.append(f"driving cycles: {len(cycle_delays)} patterns cannot keep their "
+                        f"schedule within the limits (max delay {max(cycle_delays):.0f} s)")
+
+    # ---- trips table ----------------------------------------------------------------------
+    trips = trips[trips["trip_id"].astype(str).isin(trip_pattern.keys())].copy()
+    trips["trip_id"] = trips["trip_id"].astype(str)
+    routes = feed.routes[["route_id", "route_short_name"]] if "route_short_name" in \
+        feed.routes else feed.routes[["route_id"]].assign(route_short_name=pd.NA)
+    trips = trips.merge(routes, on="route_id", how="left")
+    for col in ("direction_id", "block_id"):
+        if col not in trips:
+            trips[col] = pd.NA
+    trips["pattern_id"] = trips["trip_id"].map(trip_pattern).astype(np.int64)
+    trips["start_s"] = trips["trip_id"].map(trip_start).astype(np.float64)
+    trips_out = pd.DataFrame({
+        "trip_id": trips["trip_id"].astype(str),
+        "route_id": trips["route_id"].astype(str),
+        "route_short_name": trips["route_short_name"].astype("string"),
+        "direction_id": trips["direction_id"].astype("Int32"),
+        "shape_id": trips["shape_id"].astype(str),
+        "service_id": trips["service_id"].astype(str),
+        "block_id": trips["block_id"].astype("string"),
+        "pattern_id": trips["pattern_id"],
+        "start_s": trips["start_s"],
+    }).sort_values(["route_id", "start_s", "trip_id"], kind="stable", ignore_index=True)
+
+    # ---- write ----------------------------------------------------------------------------
+    import geopandas as gpd
+
+    gseg = gpd.GeoDataFrame(segs, geometry=geom, crs=crs_obj)
+    _atomic(out / "segments.parquet", lambda p: gseg.to_parquet(p, index=False))
+    _atomic(out / "trips.parquet", lambda p: trips_out.to_parquet(p, index=False))
+    _atomic(out / "patterns.parquet", lambda p: patterns.to_parquet(p, index=False))
+    _atomic(out / "pattern_stops.parquet", lambda p: pstops.to_parquet(p, index=False))
+    cal_cols = ["service_id", "monday", "tuesday", "wednesday", "thursday", "friday",
+                "saturday", "sunday", "start_date", "end_date"]
+    cal = (feed.calendar[cal_cols] if feed.calendar is not None
+           else pd.DataFrame(columns=cal_cols)).astype({"service_id": str, "start_date": str,
+                                                        "end_date": str})
+    cd_cols = ["service_id", "date", "exception_type"]
+    cd = (feed.calendar_dates[cd_cols] if feed.calendar_dates is not None
+          else pd.DataFrame(columns=cd_cols)).astype({"service_id": str, "date": str})
+    _atomic(out / "calendar.parquet", lambda p: cal.to_parquet(p, index=False))
+    _atomic(out / "calendar_dates.parquet", lambda p: cd.to_parquet(p, index=False))
+
+    report = {
+        "feed": str(Path(feed_path)),
+        "timezone": feed.timezone,
+        "crs": crs_obj.to_string(),
+        "crs_source": crs_source,
+        "tile_size_m": tile_size,
+        "segment_length_m": float(traj_cfg.segment_length_m),
+        "timing": timing,
+        "terrain": terrain is not None,
+        "counts": {
+            "routes": int(trips_out["route_id"].nunique()),
+            "shapes": int(len(shape_xy)),
+            "segments": int(len(segs)),
+            "tiles": int(segs["tile"].nunique()) if len(segs) else 0,
+            "trips": int(len(trips_out)),
+            "patterns": int(len(keys)),
+            "stops": int(st["stop_id"].nunique()),
+            "frequency_trips": int(feed.frequency_trips),
+            "shapes_built_from_stops": int(feed.shapes_built_from_stops),
+            "trips_with_feed_distances": n_feed,
+            "trips_with_projected_stops": n_projected,
+        },
+        "total_shape_length_km": round(sum(shape_len.values()) / 1000.0, 3),
+        "problems": problems,
+        "seconds": round(time.perf_counter() - t_start, 2),
+    }
+    _atomic(out / "feed.json", lambda p: p.write_text(json.dumps(report, indent=2)))
+    return report

@@ -1,0 +1,381 @@
+"""Service dates, trip patterns and passes.
+
+Timing along a shape
+--------------------
+A trip's stop times are placed on its shape at the stops' distances (metres in the projected
+CRS). The time at which the bus *reaches* distance ``s`` is piecewise linear: between the
+departure from stop i and the arrival at stop i+1 it grows linearly with distance; at a stop
+it jumps from the arrival to the departure (the bus dwells there). Before the first stop the
+time is the first departure, past the last stop the last arrival. A segment's time
+``dt_s`` is the reach time at its end minus the reach time at its start, so a dwell falls on
+the segment in which the stop lies (on the following one when the stop is exactly on a
+boundary). Only the segments overlapping [first stop, last stop] belong to a pattern.
+
+Trips that share a shape, stops, stop distances and stop-time offsets from the first
+departure share a *pattern*; the per-segment times are stored once per pattern
+(``patterns.parquet``) and a pass (trip, service date) adds its start time.
+
+Local time to UTC
+-----------------
+GTFS times count from "noon minus 12 h" of the service date in the agency's timezone: local
+midnight, except on the days the clocks change, when it is 23:00 or 01:00. The UTC time of a
+stop time t on service date D is therefore ``UTC(D 12:00 local) - 12 h + t``, computed exactly
+so here.
+
+Months
+------
+A pass belongs to the month of its *service date*: a trip of 31 May leaving at 24:30 is in
+May although it runs on 1 June. Every pass is thus in exactly one (tile, month) partition.
+"""
+from __future__ import annotations
+
+import datetime as dt
+import functools
+import json
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pyarrow.parquet as pq
+
+WEEKDAYS = ["monday", "tuesday", "wednesday", "thursday", "friday", "saturday", "sunday"]
+
+
+# ---------------------------------------------------------------------------------------------
+# stops on shapes
+
+def project_stops_monotone(pts: np.ndarray, stop_xy: np.ndarray) -> np.ndarray:
+    """Distances along a polyline of stops visited in order, never decreasing (m).
+
+    Each stop may project onto any piece of the polyline; the set of projections with
+    non-decreasing distance that minimises the sum of stop-to-shape distances is chosen
+    (dynamic programming over the pieces, O(stops x pieces)), so a shape that passes the
+    same place twice (loops, out-and-back) gets each stop on the right pass.
+
+    Parameters
+    ----------
+    pts : ndarray (n, 2)
+        Shape vertices (m), n >= 2.
+    stop_xy : ndarray (m, 2)
+        Stops in visiting order (m).
+    """
+    a, b = pts[:-1], pts[1:]
+    d = b - a
+    seg_len2 = np.einsum("ij,ij->i", d, d)
+    cum = np.r_[0.0, np.cumsum(np.sqrt(seg_len2))]
+    rel = stop_xy[:, None, :] - a[None, :, :]                       # (m, k, 2)
+    u = np.where(seg_len2 > 0, np.einsum("mkj,kj->mk", rel, d) / np.where(seg_len2 > 0,
+                                                                          seg_len2, 1), 0)
+    u = np.clip(u, 0.0, 1.0)
+    foot = a[None] + u[..., None] * d[None]
+    dist = np.hypot(*(stop_xy[:, None, :] - foot).transpose(2, 0, 1))  # (m, k)
+    pos = cum[:-1][None] + u * np.sqrt(seg_len2)[None]               # (m, k), rows sorted
+    m, k = dist.shape
+    cost = dist[0].copy()
+    back = np.zeros((m, k), dtype=np.int64)
+    for i in range(1, m):
+        order_min = np.minimum.accumulate(cost)
+        arg = _prefix_argmin(cost)
+        j = np.searchsorted(pos[i - 1], pos[i], side="right") - 1
+        ok = j >= 0
+        new = np.full(k, np.inf)
+        new[ok] = dist[i, ok] + order_min[j[ok]]
+        back[i, ok] = arg[j[ok]]
+        cost = new
+    out = np.empty(m)
+    jj = int(np.argmin(cost))
+    for i in range(m - 1, -1, -1):
+        out[i] = pos[i, jj]
+        jj = back[i, jj]
+    return np.maximum.accumulate(out)
+
+
+def _prefix_argmin(v: np.ndarray) -> np.ndarray:
+    """Index of the minimum of v[:j+1] for every j."""
+    idx = np.arange(len(v))
+    running = np.minimum.accumulate(v)
+    is_new = v <= running
+    return np.maximum.accumulate(np.where(is_new, idx, 0))
+
+
+def reach_time(s, stop_d, arr, dep) -> np.ndarray:
+    """Time the bus reaches distance *s* (s after the first departure; see module doc).
+
+    Parameters
+    ----------
+    s : array of float
+        Distances along the shape (m).
+    stop_d, arr, dep : array of float
+        Stop distances (m, non-decreasing), arrival and departure times (s).
+    """
+    s = np.asarray(s, float)
+    stop_d, arr, dep = (np.asarray(v, float) for v in (stop_d, arr, dep))
+    i = np.searchsorted(stop_d, s, side="left")          # stop_d[i-1] < s <= stop_d[i]
+    i_c = np.clip(i, 1, len(stop_d) - 1)
+    d0, d1 = stop_d[i_c - 1], stop_d[i_c]
+    gap = d1 - d0
+    frac = np.where(gap > 0, (s - d0) / np.where(gap > 0, gap, 1.0), 1.0)
+    t = dep[i_c - 1] + (arr[i_c] - dep[i_c - 1]) * np.clip(frac, 0.0, 1.0)
+    t = np.where(s <= stop_d[0], dep[0], t)
+    return np.where(s >= stop_d[-1], arr[-1], t)
+
+
+def pattern_segment_times(stop_d, arr, dep, seg_start, seg_len):
+    """Per-segment timing of one pattern.
+
+    Returns
+    -------
+    index : ndarray of int
+        Positions (into seg_start) of the segments the pattern covers.
+    t_offset : ndarray
+        Reach time of each segment's start (s after the first departure).
+    dt : ndarray
+        Time on the segment (s), dwell included.
+    covered : ndarray
+        Length of the segment the trip actually drives (m; less than the segment's length
+        only where the first or last stop lies inside it).
+    """
+    stop_d = np.asarray(stop_d, float)
+    seg_end = seg_start + seg_len
+    first, last = stop_d[0], stop_d[-1]
+    if last > first:
+        idx = np.flatnonzero((seg_end > first) & (seg_start < last))
+    else:  # degenerate trip standing still: the segment holding the stop
+        idx = np.flatnonzero((seg_start <= first) & (seg_end >= first))[:1]
+    a = np.maximum(seg_start[idx], first)
+    b = np.minimum(seg_end[idx], last)
+    t0 = reach_time(a, stop_d, arr, dep)
+    t1 = reach_time(b, stop_d, arr, dep)
+    return idx, t0, t1 - t0, b - a
+
+
+# ---------------------------------------------------------------------------------------------
+# service dates
+
+def _read(data_dir, name: str, **kw) -> pd.DataFrame:
+    path = Path(data_dir) / "gtfs" / name
+    return pq.read_table(path, **kw).to_pandas()
+
+
+def service_dates_from_tables(calendar: pd.DataFrame | None, calendar_dates: pd.DataFrame | None,
+                              year: int) -> pd.DataFrame:
+    """Active (service_id, date) pairs of *year* from calendar + calendar_dates tables."""
+    start, end = pd.Timestamp(year, 1, 1), pd.Timestamp(year, 12, 31)
+    days = pd.date_range(start, end, freq="D")
+    parts = []
+    if calendar is not None and len(calendar):
+        cal = calendar.reset_index(drop=True)
+        c0 = pd.to_datetime(cal["start_date"].astype(str), format="%Y%m%d").to_numpy()
+        c1 = pd.to_datetime(cal["end_date"].astype(str), format="%Y%m%d").to_numpy()
+        flags = cal[WEEKDAYS].fillna(0).astype(int).to_numpy()             # (s, 7)
+        dv = days.to_numpy()
+        wd = days.day_of_week.to_numpy()
+        active = ((dv[None, :] >= c0[:, None]) & (dv[None, :] <= c1[:, None])
+                  & (flags[:, wd] == 1))
+        si, di = np.nonzero(active)
+        parts.append(pd.DataFrame({"service_id": cal["service_id"].to_numpy()[si],
+                                   "date": days[di]}))
+    base = pd.concat(parts, ignore_index=True) if parts else pd.DataFrame(
+        {"service_id": pd.Series(dtype=object), "date": pd.Series(dtype="datetime64[ns]")})
+    if calendar_dates is not None and len(calendar_dates):
+        cd = calendar_dates.copy()
+        cd["date"] = pd.to_datetime(cd["date"].astype(str), format="%Y%m%d")
+        cd = cd[(cd["date"] >= start) & (cd["date"] <= end)]
+        removed = cd[cd["exception_type"].astype(int) == 2][["service_id", "date"]]
+        added = cd[cd["exception_type"].astype(int) == 1][["service_id", "date"]]
+        if len(removed):
+            key = pd.MultiIndex.from_frame(base[["service_id", "date"]].astype(
+                {"service_id": str}))
+            rkey = pd.MultiIndex.from_frame(removed.astype({"service_id": str}))
+            base = base[~key.isin(rkey)]
+        base = pd.concat([base, added], ignore_index=True)
+    out = base.astype({"service_id": str}).drop_duplicates()
+    out["date"] = pd.to_datetime(out["date"]).astype("datetime64[ns]")
+    return out.sort_values(["date", "service_id"]).reset_index(drop=True)
+
+
+@functools.lru_cache(maxsize=16)
+def _service_dates_cached(gdir: str, year: int, stamp: tuple) -> pd.DataFrame:
+    gdir = Path(gdir)
+    cal = (pq.read_table(gdir / "calendar.parquet").to_pandas()
+           if (gdir / "calendar.parquet").exists() else None)
+    cd = (pq.read_table(gdir / "calendar_dates.parquet").to_pandas()
+          if (gdir / "calendar_dates.parquet").exists() else None)
+    return service_dates_from_tables(cal, cd, year)
+
+
+def _stamp(gdir: Path, names) -> tuple:
+    """Modification times of files, so caches see a re-ingest."""
+    return tuple((gdir / n).stat().st_mtime_ns if (gdir / n).exists() else 0 for n in names)
+
+
+def service_dates(data_dir, year: int) -> pd.DataFrame:
+    """Every (service_id, date) on which a service runs in *year* (dates as local days).
+
+    Parameters
+    ----------
+    data_dir : path
+        Scenario data directory holding ``gtfs/`` (from :func:`ingest_gtfs`).
+    year : int
+
+    Returns
+    -------
+    DataFrame[service_id (str), date (datetime64[ns], midnight)]
+    """
+    gdir = (Path(data_dir) / "gtfs").resolve()
+    stamp = _stamp(gdir, ("calendar.parquet", "calendar_dates.parquet"))
+    return _service_dates_cached(str(gdir), int(year), stamp).copy()
+
+
+def service_day_origin_utc(dates, timezone: str) -> np.ndarray:
+    """Unix seconds of the GTFS time origin ("noon minus 12 h", local) of each service date.
+
+    Parameters
+    ----------
+    dates : array-like of datetime64 (days)
+    timezone : str
+        IANA zone of the agency, e.g. ``Europe/Luxembourg``.
+    """
+    d = pd.DatetimeIndex(pd.to_datetime(dates)).normalize()
+    noon = (d + pd.Timedelta(hours=12)).tz_localize(timezone, ambiguous=False,
+                                                    nonexistent="shift_forward")
+    origin = noon.tz_convert("UTC") - pd.Timedelta(hours=12)
+    return ((origin - pd.Timestamp(0, tz="UTC")) / pd.Timedelta(seconds=1)).to_numpy(float)
+
+
+# ---------------------------------------------------------------------------------------------
+# passes
+
+def _feed_info(data_dir) -> dict:
+    return json.loads((Path(data_dir) / "gtfs" / "feed.json").read_text())
+
+
+def _parse_month(month, year):
+    if isinstance(month, str):
+        period = pd.Period(month, freq="M")
+        if year is not None and int(year) != period.year:
+            raise ValueError(f"month {month!r} is not in year {year}")
+    else:
+        if year is None:
+            raise ValueError("an integer month needs a year")
+        period = pd.Period(year=int(year), month=int(month), freq="M")
+    return period
+
+
+_PASS_COLUMNS = ["segment_id", "trip_id", "service_date", "t_utc", "dt_s", "speed_mps"]
+
+
+def _expand(runs: pd.DataFrame, pat: pd.DataFrame) -> pd.DataFrame:
+    """Outer product of runs (trip, date, origin + start) with their pattern's segments."""
+    if runs.empty or pat.empty:
+        return _empty_passes()
+    pat = pat.sort_values(["pattern_id", "t_offset_s"], kind="stable").reset_index(drop=True)
+    pids = pat["pattern_id"].to_numpy()
+    uniq, first = np.unique(pids, return_index=True)
+    count = np.diff(np.r_[first, len(pids)])
+    runs = runs[runs["pattern_id"].isin(uniq)]
+    loc = np.searchsorted(uniq, runs["pattern_id"].to_numpy())
+    n = count[loc]
+    run_idx = np.repeat(np.arange(len(runs)), n)
+    within = np.arange(n.sum()) - np.repeat(np.cumsum(n) - n, n)
+    row = first[loc][run_idx] + within
+    t0 = runs["t0_utc"].to_numpy(float)[run_idx]
+    trip_code, trip_names = pd.factorize(runs["trip_id"].astype(str), sort=True)
+    return pd.DataFrame({
+        "segment_id": pat["segment_id"].to_numpy(np.int64)[row],
+        "trip_id": pd.Categorical.from_codes(trip_code[run_idx], trip_names),
+        "service_date": runs["service_date"].to_numpy()[run_idx],
+        "t_utc": t0 + pat["t_offset_s"].to_numpy(float)[row],
+        "dt_s": pat["dt_s"].to_numpy(np.float32)[row],
+        "speed_mps": pat["speed_mps"].to_numpy(np.float32)[row],
+    })
+
+
+def _empty_passes() -> pd.DataFrame:
+    return pd.DataFrame({
+        "segment_id": pd.Series(dtype=np.int64), "trip_id": pd.Series(dtype="category"),
+        "service_date": pd.Series(dtype="datetime64[ns]"), "t_utc": pd.Series(dtype=float),
+        "dt_s": pd.Series(dtype=np.float32), "speed_mps": pd.Series(dtype=np.float32)})
+
+
+def iter_passes(data_dir, tile: str, month, year: int | None = None) -> pd.DataFrame:
+    """Every pass of every trip through the segments of *tile* in *month*.
+
+    Parameters
+    ----------
+    data_dir : path
+        Scenario data directory (``gtfs/`` from :func:`ingest_gtfs`).
+    tile : str
+        Tile name (:mod:`vipvflow.tiles`).
+    month : str or int
+        ``"2024-06"``, or 6 together with *year*.
+    year : int, optional
+        Checked against *month* when both are given.
+
+    Returns
+    -------
+    DataFrame
+        ``segment_id`` int64, ``trip_id`` (categorical: millions of rows share a few
+        thousand names), ``service_date`` (datetime64[ns], the local
+        service day), ``t_utc`` float64 (Unix s at segment start), ``dt_s`` float32 (s on
+        the segment), ``speed_mps`` float32 (mean speed on the segment, dwell included),
+        sorted by service date, trip and time. A pass belongs to the month of its service
+        date (see module doc). Only this month and this tile are ever held in memory.
+    """
+    period = _parse_month(month, year)
+    segs = _read(data_dir, "segments.parquet", columns=["segment_id", "tile"],
+                 filters=[("tile", "==", tile)])
+    if segs.empty:
+        return _empty_passes()
+    pat = _read(data_dir, "patterns.parquet",
+                filters=[("segment_id", "in", segs["segment_id"].to_numpy().tolist())])
+    if pat.empty:
+        return _empty_passes()
+    trips = _read(data_dir, "trips.parquet",
+                  columns=["trip_id", "service_id", "pattern_id", "start_s"])
+    trips = trips[trips["pattern_id"].isin(np.unique(pat["pattern_id"]))]
+    sd = service_dates(data_dir, period.year)
+    sd = sd[(sd["date"] >= period.start_time) & (sd["date"] <= period.end_time)]
+    return _passes(data_dir, trips, sd, pat)
+
+
+def _passes(data_dir, trips, sd, pat) -> pd.DataFrame:
+    runs = trips.merge(sd, on="service_id")
+    if runs.empty:
+        return _empty_passes()
+    tz = _feed_info(data_dir)["timezone"]
+    udates = np.unique(runs["date"].to_numpy())
+    origin = service_day_origin_utc(udates, tz)
+    runs = runs.assign(
+        t0_utc=origin[np.searchsorted(udates, runs["date"].to_numpy())] + runs["start_s"],
+        service_date=runs["date"])
+    runs = runs.sort_values(["service_date", "trip_id"], kind="stable").reset_index(drop=True)
+    # runs are in (date, trip) order and each pattern's segments in time order, so the
+    # passes come out sorted by service date, trip and time
+    return _expand(runs, pat)
+
+
+def passes_for_trip(data_dir, trip_id: str, service_date) -> pd.DataFrame:
+    """All segment passes of one trip on one service date (columns as :func:`iter_passes`).
+
+    The date need not be a day the trip's service runs (the app may ask "what if"); the
+    timing is the trip's pattern placed on that date.
+    """
+    trips = _read(data_dir, "trips.parquet", columns=["trip_id", "service_id", "pattern_id",
+                                                      "start_s"])
+    trips = trips[trips["trip_id"] == str(trip_id)]
+    if trips.empty:
+        raise KeyError(f"trip {trip_id!r} not in {Path(data_dir) / 'gtfs' / 'trips.parquet'}")
+    pid = int(trips["pattern_id"].iloc[0])
+    pat = _read(data_dir, "patterns.parquet", filters=[("pattern_id", "==", pid)])
+    date = pd.Timestamp(service_date).normalize()
+    sd = pd.DataFrame({"service_id": trips["service_id"].astype(str).to_numpy(),
+                       "date": pd.DatetimeIndex([date]).astype("datetime64[ns]")})
+    return _passes(data_dir, trips.astype({"service_id": str}), sd, pat)
+
+
+def date_of(value) -> dt.date:
+    """A service date given as ``YYYYMMDD``, ``YYYY-MM-DD``, date or Timestamp."""
+    if isinstance(value, str) and len(value) == 8 and value.isdigit():
+        return dt.datetime.strptime(value, "%Y%m%d").date()
+    return pd.Timestamp(value).date()
