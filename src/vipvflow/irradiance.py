@@ -77,17 +77,32 @@ def _basis(n: np.ndarray):
     return t1, np.cross(n, t1)
 
 
-def cosine_directions(normals: np.ndarray, n_rays: int, rng: np.random.Generator) -> np.ndarray:
+def segment_uniforms(seed: int, stream: int, keys: np.ndarray, n: int) -> np.ndarray:
+    """Uniform random numbers (m, n) drawn from a generator of its own per key (segment id),
+    so a segment's rays do not depend on which other segments share its batch, tile or worker."""
+    keys = np.asarray(keys, dtype=np.int64)
+    out = np.empty((len(keys), n))
+    for i, key in enumerate(keys):
+        out[i] = np.random.default_rng([seed, stream, int(key)]).random(n)
+    return out
+
+
+def cosine_directions(normals: np.ndarray, n_rays: int, rng) -> np.ndarray:
     """Cosine-weighted hemisphere directions about each normal, shape (m, n_rays, 3).
 
     Stratified: a golden-angle spiral of equal-area rings on the unit disk (Malley's method,
-    cosine-weighted), randomly rotated and jittered per normal.
+    cosine-weighted), randomly rotated and jittered per normal.  *rng* is a numpy Generator
+    or an (m, n_rays + 1) array of uniforms (see :func:`segment_uniforms`).
     """
     m = len(normals)
     k = np.arange(n_rays)
-    jitter = rng.random((m, n_rays))
+    if isinstance(rng, np.random.Generator):
+        uni = rng.random((m, n_rays + 1))
+    else:
+        uni = np.asarray(rng, dtype=np.float64).reshape(m, n_rays + 1)
+    jitter = uni[:, :n_rays]
     u = (k[None] + jitter) / n_rays                            # radial strata
-    phi = 2 * np.pi * ((k[None] * _GOLDEN + rng.random((m, 1))) % 1.0)
+    phi = 2 * np.pi * ((k[None] * _GOLDEN + uni[:, n_rays:]) % 1.0)
     r = np.sqrt(u)
     lx, ly, lz = r * np.cos(phi), r * np.sin(phi), np.sqrt(np.clip(1 - u, 0, 1))
     t1, t2 = _basis(np.asarray(normals, np.float64))
@@ -138,8 +153,9 @@ def segment_geometry(scene, segments: pd.DataFrame, cfg: IrradianceCfg | None = 
         weight 0.
     """
     cfg = cfg or IrradianceCfg()
-    rng = np.random.default_rng(cfg.seed)
     n_seg = len(segments)
+    seg_ids = (segments["segment_id"].to_numpy(np.int64) if "segment_id" in segments
+               else np.arange(n_seg, dtype=np.int64))
     tilt, azim = roof_plane(segments["heading_deg"].to_numpy(float),
                             segments["gradient"].to_numpy(float))
     normal = plane_normal(tilt, azim)
@@ -159,7 +175,9 @@ def segment_geometry(scene, segments: pd.DataFrame, cfg: IrradianceCfg | None = 
         m = sl.stop - sl.start
         o, nrm = origin[sl], normal[sl]
         # sky view factor
-        d = cosine_directions(nrm, cfg.svf_rays, rng).reshape(-1, 3)
+        keys = seg_ids[sl]
+        d = cosine_directions(nrm, cfg.svf_rays,
+                              segment_uniforms(cfg.seed, 0, keys, cfg.svf_rays + 1)).reshape(-1, 3)
         oo = np.repeat(o, cfg.svf_rays, axis=0)
         blocked = scene.occluded(oo, d, cfg.ray_length_m)
         sky = (~blocked) & (d[:, 2] > 0)
@@ -167,7 +185,7 @@ def segment_geometry(scene, segments: pd.DataFrame, cfg: IrradianceCfg | None = 
         if not (cfg.reflection and cfg.reflection_rays > 0 and G > 0):
             continue
         N = cfg.reflection_rays
-        d = cosine_directions(nrm, N, rng).reshape(-1, 3)
+        d = cosine_directions(nrm, N, segment_uniforms(cfg.seed, 1, keys, N + 1)).reshape(-1, 3)
         oo = np.repeat(o, N, axis=0)
         tri, dist = scene.first_hit(oo, d, cfg.ray_length_m)
         hit = tri >= 0
@@ -373,8 +391,8 @@ def evaluate_passes(passes: pd.DataFrame, segments: pd.DataFrame, geometry: pd.D
     Returns
     -------
     DataFrame indexed like *passes*: ``direct, diffuse, reflected, total`` and the
-    ``_clear`` variants, ``total_unshaded``, ``total_clear_unshaded`` (float32, W/m2),
-    ``sun_visible`` (bool).
+    ``_clear`` variants, ``total_unshaded``, ``total_clear_unshaded``, and the horizontal
+    ``ghi``, ``ghi_clear`` at the pass (float32, W/m2), ``sun_visible`` (bool).
     """
     cfg = cfg or IrradianceCfg()
     del segments
@@ -391,7 +409,8 @@ def evaluate_passes(passes: pd.DataFrame, segments: pd.DataFrame, geometry: pd.D
     geo = pack_geometry(geometry, cfg, ground_albedo)
     loc_col = geometry["rad_location"].to_numpy(np.int64) if "rad_location" in geometry else None
     n = len(passes)
-    block = np.empty((n, len(COMPONENTS)), np.float32)
+    columns = list(COMPONENTS) + ["ghi", "ghi_clear"]
+    block = np.empty((n, len(columns)), np.float32)
     visible = np.empty(n, bool)
     for a in range(0, n, _CHUNK):
         sl = slice(a, min(n, a + _CHUNK))
@@ -402,7 +421,9 @@ def evaluate_passes(passes: pd.DataFrame, segments: pd.DataFrame, geometry: pd.D
         out = roof_irradiance(geo, r, sun, rad, scene, cfg, ground_albedo)
         for j, k in enumerate(COMPONENTS):
             block[sl, j] = out[k]
+        block[sl, -2] = np.nan_to_num(rad["ghi"])
+        block[sl, -1] = np.nan_to_num(rad["ghi_clear"])
         visible[sl] = out["sun_visible"]
-    df = pd.DataFrame(block, index=passes.index, columns=list(COMPONENTS), copy=False)
+    df = pd.DataFrame(block, index=passes.index, columns=columns, copy=False)
     df["sun_visible"] = visible
     return df

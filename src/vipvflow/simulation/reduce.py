@@ -29,14 +29,16 @@ def _read_parts(run_dir: Path, kind: str) -> pd.DataFrame:
 def trip_consumption(cfg: Config, data_dir: Path, year: int) -> pd.DataFrame:
     """Battery energy per trip pattern and month (kWh) from the vehicle model run over each
     pattern's 2 s driving cycle at the month's mean ambient temperature."""
-    from ..trajectory import pattern_cycles
+    from ..trajectory import pattern_cycle
     from ..vehicle import simulate_cycle
 
     params = cfg.vehicle_params()
     temps = cfg.climate.monthly_mean_temperature_c
+    patterns = pd.read_parquet(data_dir / "gtfs" / "trips.parquet", columns=["pattern_id"])["pattern_id"]
     rows = []
-    for pattern_id, cycle in pattern_cycles(data_dir, cfg.trajectory).items():
-        for m in range(1, 13):
+    for pattern_id in sorted(patterns.unique()):
+        cycle = pattern_cycle(data_dir, pattern_id, cfg.trajectory.cycle)
+        for m in cfg.run.months:
             e = simulate_cycle(cycle, params, ambient_c=temps[m - 1])
             rows.append({"pattern_id": pattern_id, "month": f"{year}-{m:02d}",
                          "consumption_kwh": e["battery_kwh"], "traction_kwh": e["traction_kwh"],
