@@ -26,6 +26,12 @@ def _read_parts(run_dir: Path, kind: str) -> pd.DataFrame:
     return pd.concat([pd.read_parquet(f) for f in files], ignore_index=True)
 
 
+def shading_loss(shaded, unshaded):
+    """1 - shaded / unshaded irradiation (or energy); NaN where nothing was received unshaded."""
+    unshaded = unshaded.where(unshaded > 0) if hasattr(unshaded, "where") else (unshaded if unshaded > 0 else np.nan)
+    return 1.0 - shaded / unshaded
+
+
 def trip_consumption(cfg: Config, data_dir: Path, year: int) -> pd.DataFrame:
     """Battery energy per trip pattern and month (kWh) from the vehicle model run over each
     pattern's 2 s driving cycle at the month's mean ambient temperature."""
@@ -79,9 +85,12 @@ def reduce_run(cfg: Config, year: int, run_dir: Path, say=print) -> dict:
 
     # --- segment-month (GeoParquet for maps)
     sm = _read_parts(run_dir, "segment_month")
-    sm["shading_loss"] = 1.0 - sm["h_total"] / sm["h_total_unshaded"].where(sm["h_total_unshaded"] > 0)
-    sm["shading_loss_clear"] = 1.0 - sm["h_total_clear"] / sm["h_total_clear_unshaded"].where(
-        sm["h_total_clear_unshaded"] > 0)
+    # shading loss: sky and sun light the buildings take away (1 - (direct + diffuse) / unshaded);
+    # the reflected light they add is reported apart as reflection gain
+    sm["shading_loss"] = shading_loss(sm["h_direct"] + sm["h_diffuse"], sm["h_total_unshaded"])
+    sm["shading_loss_clear"] = shading_loss(sm["h_direct_clear"] + sm["h_diffuse_clear"],
+                                            sm["h_total_clear_unshaded"])
+    sm["reflection_gain"] = sm["h_reflected"] / sm["h_total_unshaded"].where(sm["h_total_unshaded"] > 0)
     shape_route = (trips_meta.drop_duplicates("shape_id")[["shape_id", "route_short_name", "direction_id"]])
     smg = segments[["segment_id", "shape_id", "geometry"]].merge(sm, on="segment_id", how="inner")
     smg = gpd.GeoDataFrame(smg.merge(shape_route, on="shape_id", how="left"),
@@ -93,7 +102,7 @@ def reduce_run(cfg: Config, year: int, run_dir: Path, say=print) -> dict:
     rm = (trip.groupby(["route_id", "route_short_name", "direction_id", "month"], sort=True)
           .agg(trips=("trip_id", "size"), **{c: (c, "sum") for c in agg}).reset_index())
     rm["coverage"] = rm["pv_kwh"] / rm["consumption_kwh"]
-    rm["shading_loss"] = 1 - rm["pv_kwh"] / rm["pv_kwh_unshaded"].where(rm["pv_kwh_unshaded"] > 0)
+    rm["shading_loss"] = shading_loss(rm["pv_kwh_direct"] + rm["pv_kwh_diffuse"], rm["pv_kwh_unshaded"])
     write_parquet(rm, run_dir / "route_month.parquet")
 
     # --- vehicle block per day
@@ -115,7 +124,10 @@ def reduce_run(cfg: Config, year: int, run_dir: Path, say=print) -> dict:
     pv = cfg.pv_system()
     vehicle = cfg.vehicle_params()
     n_buses = int(trip.groupby("service_date")["block_id"].nunique().max())
-    pv_year, demand_year = float(trip["pv_kwh"].sum()), float(trip["consumption_kwh"].sum())
+    # a run over some months states annual figures scaled by 12 / months (flagged in the summary)
+    annualise = 12.0 / len(cfg.run.months)
+    pv_year = float(trip["pv_kwh"].sum()) * annualise
+    demand_year = float(trip["consumption_kwh"].sum()) * annualise
     window = cfg.economics.soc_window
     eco = {
         "fleet_demand_mwh": demand_year / 1000.0,
@@ -148,11 +160,15 @@ def reduce_run(cfg: Config, year: int, run_dir: Path, say=print) -> dict:
         "pv_kwh_allsky": float(trip["pv_kwh"].sum()),
         "pv_kwh_clearsky": float(trip["pv_kwh_clear"].sum()),
         "pv_kwh_allsky_unshaded": float(trip["pv_kwh_unshaded"].sum()),
-        "kwh_per_kwp_allsky": float(trip["pv_kwh"].sum() / (pv.kwp * n_buses)),
-        "kwh_per_kwp_clearsky": float(trip["pv_kwh_clear"].sum() / (pv.kwp * n_buses)),
+        "annualised_from_months": annualise != 1.0,
+        "kwh_per_kwp_allsky": float(trip["pv_kwh"].sum() * annualise / (pv.kwp * n_buses)),
+        "kwh_per_kwp_clearsky": float(trip["pv_kwh_clear"].sum() * annualise / (pv.kwp * n_buses)),
         "irradiation_kwh_m2": {k[2:]: float(v) / 1000.0 for k, v in tot.items()},
-        "shading_loss_allsky": float(1 - tot["h_total"] / tot["h_total_unshaded"]),
-        "shading_loss_clearsky": float(1 - tot["h_total_clear"] / tot["h_total_clear_unshaded"]),
+        "shading_loss_allsky": float(shading_loss(tot["h_direct"] + tot["h_diffuse"], tot["h_total_unshaded"])),
+        "shading_loss_clearsky": float(shading_loss(tot["h_direct_clear"] + tot["h_diffuse_clear"],
+                                                    tot["h_total_clear_unshaded"])),
+        "reflection_gain_allsky": float(tot["h_reflected"] / tot["h_total_unshaded"]),
+        "net_building_effect_allsky": float(tot["h_total"] / tot["h_total_unshaded"] - 1),
         "unshaded_to_ghi_allsky": float(tot["h_total_unshaded"] / tot["h_ghi"]),
         "unshaded_to_ghi_clearsky": float(tot["h_total_clear_unshaded"] / tot["h_ghi_clear"]),
         "reflected_share": float(tot["h_reflected"] / tot["h_total"]),

@@ -45,9 +45,11 @@ def fig_monthly(monthly: pd.DataFrame, summary: dict):
 def fig_map(smg, column: str, label: str, cmap: str):
     annual = smg.groupby("segment_id").agg(
         geometry=("geometry", "first"), h_total=("h_total", "sum"),
+        h_direct=("h_direct", "sum"), h_diffuse=("h_diffuse", "sum"),
         h_total_unshaded=("h_total_unshaded", "sum"), n_passes=("n_passes", "sum"),
         pv_kwh=("pv_kwh", "sum"))
-    annual["shading_loss"] = 1 - annual["h_total"] / annual["h_total_unshaded"].where(annual["h_total_unshaded"] > 0)
+    annual["shading_loss"] = 1 - (annual["h_direct"] + annual["h_diffuse"]) / annual["h_total_unshaded"].where(
+        annual["h_total_unshaded"] > 0)
     annual["yield_wh_per_pass"] = 1000 * annual["pv_kwh"] / annual["n_passes"].where(annual["n_passes"] > 0)
     lines = [np.asarray(g.coords)[:, :2] for g in annual["geometry"]]
     fig, ax = plt.subplots(figsize=(7, 6))
@@ -86,12 +88,14 @@ def fig_hourly(hp: pd.DataFrame):
 def fig_routes(rm: pd.DataFrame):
     r = rm.groupby(["route_short_name", "direction_id"]).agg(
         trips=("trips", "sum"), pv_kwh=("pv_kwh", "sum"), consumption_kwh=("consumption_kwh", "sum"),
-        pv_kwh_unshaded=("pv_kwh_unshaded", "sum")).reset_index()
+        pv_kwh_unshaded=("pv_kwh_unshaded", "sum"), pv_kwh_direct=("pv_kwh_direct", "sum"),
+        pv_kwh_diffuse=("pv_kwh_diffuse", "sum")).reset_index()
     labels = [f"{a} / dir {b}" for a, b in zip(r["route_short_name"], r["direction_id"])]
     fig, ax = plt.subplots(1, 2, figsize=(10, 3.8))
     ax[0].bar(labels, 100 * r["pv_kwh"] / r["consumption_kwh"], color="#4285f4")
     ax[0].set_ylabel("PV share of consumption (%)")
-    ax[1].bar(labels, 100 * (1 - r["pv_kwh"] / r["pv_kwh_unshaded"]), color="#db4437")
+    ax[1].bar(labels, 100 * (1 - (r["pv_kwh_direct"] + r["pv_kwh_diffuse"]) / r["pv_kwh_unshaded"]),
+              color="#db4437")
     ax[1].set_ylabel("shading loss (%)")
     for a in ax:
         a.tick_params(axis="x", rotation=30)

@@ -41,6 +41,10 @@ def make_client(cfg: Config, scheduler: str | None, n_workers: int | None):
     from distributed import Client, LocalCluster
 
     scheduler = scheduler or cfg.dask.scheduler
+    if not log.isEnabledFor(logging.INFO):
+        for name in ("distributed", "distributed.scheduler", "distributed.nanny", "distributed.core",
+                     "distributed.worker", "distributed.http.proxy"):
+            logging.getLogger(name).setLevel(logging.WARNING)
     if scheduler:
         return Client(scheduler), None
     n = n_workers or cfg.dask.n_workers or os.cpu_count() or 1

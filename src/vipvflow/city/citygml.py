@@ -1,0 +1,394 @@
+"""Streaming CityGML 1.0 / 2.0 / 3.0 reader.
+
+``lxml.etree.iterparse`` delivers one ``cityObjectMember`` at a time; the member is turned
+into a :class:`Feature` (raw rings as numpy arrays, no per-vertex Python objects) and then
+cleared together with everything parsed before it, so memory stays bounded for files of
+gigabytes.  Elements are matched by local name, so the same code reads every CityGML
+version and both GML 3.1.1 (``http://www.opengis.net/gml``) and GML 3.2
+(``http://www.opengis.net/gml/3.2``).
+
+What is read
+------------
+- ``Building`` and its ``BuildingPart`` s (any depth; building id = the top Building's
+  ``gml:id``): thematic boundary surfaces (``boundedBy`` in 1.0/2.0, ``boundary`` in 3.0)
+  with their lod2 (else lod3/lod4/lod1) multi-surfaces; without thematic surfaces the
+  object's lod2Solid / lod2MultiSurface / lod1Solid / lod1MultiSurface, typed later
+  from the normal. ``xlink:href`` surface members are resolved within the feature.
+- ``ReliefFeature`` / ``TINRelief``: triangles and polygons (``gml:Triangle`` in
+  ``trianglePatches`` / ``patches``) as terrain.
+- ``SolitaryVegetationObject`` / ``PlantCover``: explicit polygons as vegetation.
+"""
+from __future__ import annotations
+
+import gzip
+import re
+import zipfile
+from collections import Counter
+from contextlib import contextmanager
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Iterator
+
+import numpy as np
+from lxml import etree
+
+from ..errors import InputError
+
+XLINK_HREF = "{http://www.w3.org/1999/xlink}href"
+GML_IDS = ("{http://www.opengis.net/gml}id", "{http://www.opengis.net/gml/3.2}id")
+
+#: thematic surface class -> surface type of the contract
+THEMATIC = {
+    "RoofSurface": "roof",
+    "WallSurface": "wall",
+    "GroundSurface": "ground",
+    "ClosureSurface": "closure",
+    "OuterFloorSurface": "roof",     # up-facing, open to the sky (terraces)
+    "OuterCeilingSurface": "other",  # down-facing overhangs
+}
+#: interior (LoD4) surfaces: not part of the outer shell
+INTERIOR = {"InteriorWallSurface", "CeilingSurface", "FloorSurface"}
+
+_MEMBERS = ("{*}cityObjectMember", "{*}featureMember", "{*}Envelope")
+_LOD_SURF = re.compile(r"^lod([0-4])(MultiSurface|Solid|Geometry|CompositeSurface|MultiSolid)$")
+_POLYGONAL = {"Polygon", "Triangle", "PolygonPatch", "Rectangle"}
+
+
+def local(el) -> str:
+    tag = el.tag
+    if not isinstance(tag, str):
+        return ""
+    return tag.rpartition("}")[2]
+
+
+def gml_id(el) -> str | None:
+    for key in GML_IDS:
+        v = el.get(key)
+        if v is not None:
+            return v
+    return None
+
+
+@dataclass
+class RawSurface:
+    """One polygon as read: rings (n, 3) in the file's CRS, exterior first."""
+
+    rings: list
+    surface_type: str | None      # None: classify from the normal
+    citygml_class: str
+    surface_id: str | None        # None: generate
+    reversed: bool = False
+
+
+@dataclass
+class Feature:
+    """A city object: its id, kind (building, terrain, vegetation) and polygons."""
+
+    kind: str
+    feature_id: str
+    surfaces: list = field(default_factory=list)
+    n_parts: int = 0
+    thematic: Counter = field(default_factory=Counter)   # thematic surfaces per type
+    problems: Counter = field(default_factory=Counter)   # unreadable bits, per reason
+
+
+class CityGMLReader:
+    """Iterate the features of one CityGML file (or file object).
+
+    Parameters
+    ----------
+    source : path or binary file object
+    label : str
+        Name used in error messages (file path, ``zip!member``).
+
+    Attributes (after iteration has started)
+    ----------------------------------------
+    srs_name : str or None -- first ``srsName`` met (envelope or geometry)
+    version : str or None -- ``"1.0"``, ``"2.0"`` or ``"3.0"``
+    ignored : Counter -- features not read, per class name
+    """
+
+    def __init__(self, source, label: str):
+        self.source = source
+        self.label = label
+        self.srs_name: str | None = None
+        self.version: str | None = None
+        self.gml: str | None = None
+        self.ignored: Counter = Counter()
+        self._anon = 0
+
+    def __iter__(self) -> Iterator[Feature]:
+        ctx = etree.iterparse(self.source, events=("end",), tag=_MEMBERS, huge_tree=True,
+                              remove_comments=True, remove_pis=True)
+        try:
+            for _, elem in ctx:
+                name = local(elem)
+                if name == "Envelope":
+                    if self.srs_name is None and elem.get("srsName"):
+                        self.srs_name = elem.get("srsName")
+                    continue
+                if self.version is None:
+                    m = re.search(r"citygml/(\d\.\d)", etree.QName(elem).namespace or "")
+                    self.version = m.group(1) if m else None
+                for child in elem:
+                    if not isinstance(child.tag, str):
+                        continue
+                    feature = self._feature(child)
+                    if feature is not None:
+                        yield feature
+                # free what has been read: the member and all earlier siblings
+                elem.clear()
+                parent = elem.getparent()
+                if parent is not None:
+                    while elem.getprevious() is not None:
+                        del parent[0]
+        except etree.XMLSyntaxError as exc:
+            line = exc.lineno if exc.lineno else "?"
+            raise InputError(f"{self.label}: line {line}: not well-formed XML: {exc.msg}") from None
+        finally:
+            del ctx
+
+    # -- features -----------------------------------------------------------------
+    def _feature(self, el) -> Feature | None:
+        name = local(el)
+        if self.gml is None:
+            self.gml = "3.2" if el.get(GML_IDS[1]) is not None else (
+                "3.1.1" if el.get(GML_IDS[0]) is not None else None)
+        if self.srs_name is None:
+            found = el.xpath(".//@srsName")
+            if found:
+                self.srs_name = str(found[0])
+        if name == "Building":
+            return self._building(el)
+        if name == "ReliefFeature":
+            return self._generic(el, "terrain", "terrain", "ReliefFeature")
+        if name in ("SolitaryVegetationObject", "PlantCover"):
+            return self._generic(el, "vegetation", "vegetation", name)
+        self.ignored[name] += 1
+        return None
+
+    def _new_id(self, kind: str) -> str:
+        self._anon += 1
+        return f"{Path(self.label).stem}_{kind}_{self._anon}"
+
+    def _building(self, el) -> Feature:
+        bid = gml_id(el) or self._new_id("building")
+        feature = Feature("building", bid)
+        index = _LazyIndex(el)
+        objects = [el] + [p for p in el.iter("{*}BuildingPart")]
+        feature.n_parts = len(objects) - 1
+        for obj in objects:
+            n_thematic = 0
+            for holder in obj:
+                if local(holder) not in ("boundedBy", "boundary"):
+                    continue
+                for surf in holder:
+                    cls = local(surf)
+                    if cls in INTERIOR:
+                        feature.problems["interior_surface_ignored"] += 1
+                        continue
+                    stype = THEMATIC.get(cls)
+                    if stype is None:
+                        continue
+                    n_thematic += 1
+                    feature.thematic[stype] += 1
+                    geom = _best_lod(surf)
+                    if geom is None:
+                        feature.problems["surface_without_geometry"] += 1
+                        continue
+                    sid = gml_id(surf)
+                    polys = list(_polygons(geom, index, feature.problems))
+                    for k, (poly, rev) in enumerate(polys):
+                        rings = _rings(poly, feature.problems)
+                        if rings is None:
+                            continue
+                        this_id = None if sid is None else (sid if len(polys) == 1 else f"{sid}_{k}")
+                        feature.surfaces.append(RawSurface(rings, stype, cls, this_id, rev))
+            if n_thematic == 0:
+                geom = _fallback_geometry(obj)
+                if geom is not None:
+                    for poly, rev in _polygons(geom, index, feature.problems):
+                        rings = _rings(poly, feature.problems)
+                        if rings is not None:
+                            feature.surfaces.append(
+                                RawSurface(rings, None, local(geom), gml_id(poly), rev))
+        return feature
+
+    def _generic(self, el, kind: str, stype: str, cls: str) -> Feature:
+        fid = gml_id(el) or self._new_id(kind)
+        feature = Feature(kind, fid)
+        index = _LazyIndex(el)
+        for poly, rev in _polygons(el, index, feature.problems, skip_implicit=True):
+            rings = _rings(poly, feature.problems)
+            if rings is not None:
+                feature.surfaces.append(RawSurface(rings, stype, cls, None, rev))
+        return feature
+
+
+class _LazyIndex:
+    """``gml:id`` -> element within one feature, built on the first xlink."""
+
+    def __init__(self, root):
+        self.root = root
+        self._map = None
+
+    def get(self, ref: str):
+        if self._map is None:
+            self._map = {}
+            for e in self.root.iter():
+                i = gml_id(e) if isinstance(e.tag, str) else None
+                if i is not None:
+                    self._map[i] = e
+        return self._map.get(ref.lstrip("#"))
+
+
+def _best_lod(surf):
+    """The geometry property of a thematic surface: lod2 first, else the lowest other LoD."""
+    found = {}
+    for child in surf:
+        m = _LOD_SURF.match(local(child))
+        if m:
+            found.setdefault(int(m.group(1)), child)
+    for lod in (2, 3, 4, 1, 0):
+        if lod in found:
+            return found[lod]
+    return None
+
+
+def _fallback_geometry(obj):
+    """Solid / multi-surface of a building object without thematic surfaces."""
+    by_name = {}
+    for child in obj:
+        by_name.setdefault(local(child), child)
+    for name in ("lod2Solid", "lod2MultiSurface", "lod3Solid", "lod3MultiSurface",
+                 "lod1Solid", "lod1MultiSurface"):
+        if name in by_name:
+            return by_name[name]
+    return None
+
+
+def _polygons(el, index: _LazyIndex, problems: Counter, skip_implicit: bool = False,
+              reverse: bool = False, depth: int = 0):
+    """Yield (polygon element, reversed) under *el*, following xlinks within the feature."""
+    if depth > 50:
+        problems["xlink_cycle"] += 1
+        return
+    for child in el:
+        if not isinstance(child.tag, str):
+            continue
+        name = local(child)
+        if name in _POLYGONAL:
+            yield child, reverse
+            continue
+        if skip_implicit and "ImplicitRepresentation" in name:
+            problems["implicit_geometry_ignored"] += 1
+            continue
+        if name == "Envelope":
+            continue
+        href = child.get(XLINK_HREF)
+        if href is not None and len(child) == 0:
+            target = index.get(href)
+            if target is None:
+                problems["unresolved_xlink"] += 1
+                continue
+            if local(target) in _POLYGONAL:
+                yield target, reverse
+            else:
+                yield from _polygons(target, index, problems, skip_implicit, reverse, depth + 1)
+            continue
+        flip = reverse
+        if name == "OrientableSurface" and child.get("orientation") == "-":
+            flip = not reverse
+        yield from _polygons(child, index, problems, skip_implicit, flip, depth + 1)
+
+
+def _srs_dimension(el) -> int | None:
+    for _ in range(8):
+        if el is None:
+            return None
+        d = el.get("srsDimension")
+        if d is not None:
+            return int(d)
+        el = el.getparent()
+    return None
+
+
+def _ring_coords(ring) -> np.ndarray | None:
+    """(n, 3) coordinates of a LinearRing (posList, pos sequence or GML 2 coordinates)."""
+    values = None
+    dim = None
+    pos_texts = []
+    for child in ring:
+        name = local(child)
+        if name == "posList":
+            values = child.text.split() if child.text else []
+            dim = _srs_dimension(child)
+        elif name == "pos":
+            parts = child.text.split() if child.text else []
+            pos_texts.append(parts)
+            if dim is None:
+                dim = _srs_dimension(child) or len(parts)
+        elif name == "coordinates":
+            values = (child.text or "").replace(",", " ").split()
+            dim = 3
+    if pos_texts:
+        if any(len(p) != len(pos_texts[0]) for p in pos_texts):
+            return None
+        values = [v for p in pos_texts for v in p]
+    if not values:
+        return None
+    arr = np.array(values, dtype=np.float64)
+    if dim is None:
+        dim = 3 if len(arr) % 3 == 0 else 2
+    if dim not in (2, 3) or len(arr) % dim:
+        return None
+    arr = arr.reshape(-1, dim)
+    if dim == 2:
+        arr = np.column_stack([arr, np.zeros(len(arr))])
+    return arr
+
+
+def _rings(poly, problems: Counter) -> list | None:
+    """Exterior and interior rings of a polygon element as (n, 3) arrays."""
+    rings = []
+    for child in poly:
+        name = local(child)
+        if name in ("exterior", "outerBoundaryIs", "interior", "innerBoundaryIs"):
+            ring_el = next((r for r in child if local(r) == "LinearRing"), None)
+            if ring_el is None:
+                problems["unsupported_ring"] += 1
+                return None
+            try:
+                coords = _ring_coords(ring_el)
+            except ValueError:
+                coords = None
+            if coords is None:
+                problems["unreadable_coordinates"] += 1
+                return None
+            if name in ("exterior", "outerBoundaryIs"):
+                rings.insert(0, coords)
+            else:
+                rings.append(coords)
+    if not rings:
+        problems["polygon_without_exterior"] += 1
+        return None
+    return rings
+
+
+@contextmanager
+def open_sources(path: Path):
+    """Yield (label, binary file object) for a .gml/.xml, .gml.gz or every GML in a .zip."""
+    path = Path(path)
+    if not path.exists():
+        raise InputError(f"{path}: file not found")
+    if path.suffix.lower() == ".zip":
+        with zipfile.ZipFile(path) as zf:
+            names = [n for n in zf.namelist()
+                     if n.lower().endswith((".gml", ".xml", ".citygml")) and not n.endswith("/")]
+            if not names:
+                raise InputError(f"{path}: zip holds no .gml or .xml file")
+            yield [(f"{path}!{n}", (lambda n=n: zf.open(n))) for n in names]
+    elif path.suffix.lower() == ".gz":
+        yield [(str(path), lambda: gzip.open(path, "rb"))]
+    else:
+        yield [(str(path), lambda: open(path, "rb"))]

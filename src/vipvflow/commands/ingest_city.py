@@ -1,0 +1,38 @@
+"""``vipvflow ingest city FILE... --data-dir DIR``: CityGML -> tiled surfaces and meshes."""
+from __future__ import annotations
+
+from pathlib import Path
+
+from ..config import load_config
+from ..errors import InputError
+
+
+def register(sub):
+    p = sub.add_parser(
+        "city", help="read CityGML LoD2 files into tiled surfaces, tile meshes and terrain",
+        description="Stream-read CityGML 1.0/2.0/3.0 files (.gml, .xml, .gml.gz or .zip) and "
+                    "write <data-dir>/city/: surfaces per tile (GeoParquet), tile meshes, "
+                    "tiles.json, terrain.npz and ingest_report.json.")
+    p.add_argument("files", nargs="*", type=Path,
+                   help="CityGML files (default: inputs.citygml of the config)")
+    p.add_argument("--data-dir", type=Path, default=None,
+                   help="scenario data dir (default: data_dir of the config)")
+    p.add_argument("--crs", default=None,
+                   help="output CRS, also assumed for files without srsName (e.g. EPSG:2169)")
+    p.add_argument("--config", "-c", default=None, help="scenario YAML (tile size, buffer, albedo)")
+    p.set_defaults(func=run)
+
+
+def run(args):
+    from ..city import ingest_city
+
+    cfg = load_config(args.config)
+    files = list(args.files) or list(cfg.inputs.citygml)
+    if not files:
+        raise InputError("no CityGML file given (pass FILE... or set inputs.citygml in --config)")
+    data_dir = args.data_dir or cfg.data_dir
+    crs = args.crs or cfg.inputs.citygml_crs
+    report = ingest_city(files, data_dir, cfg.city, crs=crs)
+    print(report.summary())
+    print(f"report: {report.report_path}")
+    return 0
