@@ -39,3 +39,36 @@ def demo_small(tmp_path_factory) -> Path:
     out = tmp_path_factory.mktemp("demo_small")
     generate_demo(out, year=2024, seed=42, size="small")
     return out
+
+
+def write_small_config(root: Path, inputs: Path, months=(6,), name: str = "small") -> Path:
+    """A scenario YAML over the small demo inputs in *inputs*, data and outputs under *root*."""
+    import yaml
+
+    conf = {
+        "scenario": name, "data_dir": str(root / "data"), "out_dir": str(root / "out"),
+        "demo": {"enabled": True, "seed": 42, "size": "small"},
+        "inputs": {"citygml": [str(inputs / "demo_city.gml")], "gtfs": str(inputs / "demo_gtfs.zip"),
+                   "cams": [str(inputs / "cams_radiation_demo.csv")]},
+        "run": {"months": list(months)},
+    }
+    path = root / f"{name}.yaml"
+    path.write_text(yaml.safe_dump(conf))
+    return path
+
+
+@pytest.fixture(scope="session")
+def small_config(tmp_path_factory, demo_small) -> Path:
+    """Scenario YAML of the small demo for June 2024 (ingested once per session)."""
+    root = tmp_path_factory.mktemp("small_scenario")
+    return write_small_config(root, demo_small)
+
+
+@pytest.fixture(scope="session")
+def small_run(small_config) -> Path:
+    """A finished simulation of the small demo (June 2024) on a real 2-worker LocalCluster."""
+    from vipvflow.config import load_config
+    from vipvflow.simulation import run_simulation
+
+    cfg = load_config(small_config, overrides={"dask": {"n_workers": 2}})
+    return run_simulation(cfg, 2024, say=lambda *a: None)

@@ -87,6 +87,8 @@ class IrradianceCfg(_Model):
     ray_length_m: float = Field(300.0, gt=0)
     ray_offset_m: float = Field(0.05, ge=0)
     max_reflector_groups: int = Field(3, ge=0)
+    reflector_points: int = Field(4, ge=1)
+    reflector_sky_rays: int = Field(32, ge=1)
     seed: int = 7
 
 
@@ -148,9 +150,10 @@ class DaskCfg(_Model):
 
 
 class RunCfg(_Model):
-    """What part of the year to simulate (all months by default)."""
+    """What part of the year and network to simulate (all months and routes by default)."""
 
     months: list[int] = Field(default_factory=lambda: list(range(1, 13)), min_length=1)
+    routes: list[str] | None = None
 
     @model_validator(mode="after")
     def _months(self):
@@ -200,8 +203,10 @@ class Config(_Model):
                               VehicleParams, CONF_DIR / "vehicles.yaml", "vehicle.model")
 
     def digest(self) -> str:
-        """A stable hash of the validated configuration (for run manifests)."""
-        text = json.dumps(self.model_dump(mode="json"), sort_keys=True)
+        """A stable hash of what decides a run's results (for run manifests and resuming):
+        the validated configuration without where it runs (``dask``), where it writes
+        (``out_dir``) and where it mirrors (``db``)."""
+        text = json.dumps(self.model_dump(mode="json", exclude={"dask", "db", "out_dir"}), sort_keys=True)
         return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 

@@ -42,6 +42,8 @@ class RunContext:
     timezone: str
     bvh_cache_size: int = 8
     ground_albedo: float = 0.2
+    routes: tuple | None = None
+    shapes: tuple | None = None
     route_of_trip: dict = field(default_factory=dict, compare=False, hash=False)
 
 
@@ -76,6 +78,8 @@ def tile_geometry(ctx: RunContext, tile: str) -> pd.DataFrame:
         return pd.read_parquet(path)
     seg = _segments(ctx.data_dir)
     seg = seg[seg["tile"] == tile]
+    if ctx.shapes is not None:
+        seg = seg[seg["shape_id"].isin(ctx.shapes)]
     geom = segment_geometry(_scene(ctx, tile), seg, IrradianceCfg(**ctx.irradiance))
     write_parquet(geom, path)
     return geom
@@ -110,7 +114,7 @@ def run_partition(ctx: RunContext, tile: str, month: str, geometry: pd.DataFrame
     run_dir = Path(ctx.run_dir)
     if geometry is None:
         geometry = tile_geometry(ctx, tile)
-    passes = iter_passes(ctx.data_dir, tile, month, ctx.year)
+    passes = iter_passes(ctx.data_dir, tile, month, ctx.year, routes=ctx.routes)
     timings = {"passes_s": time.perf_counter() - t0}
     n = len(passes)
     seg = _segments(ctx.data_dir)

@@ -32,7 +32,7 @@ def shading_loss(shaded, unshaded):
     return 1.0 - shaded / unshaded
 
 
-def trip_consumption(cfg: Config, data_dir: Path, year: int) -> pd.DataFrame:
+def trip_consumption(cfg: Config, data_dir: Path, year: int, pattern_ids) -> pd.DataFrame:
     """Battery energy per trip pattern and month (kWh) from the vehicle model run over each
     pattern's 2 s driving cycle at the month's mean ambient temperature."""
     from ..trajectory import pattern_cycle
@@ -40,9 +40,8 @@ def trip_consumption(cfg: Config, data_dir: Path, year: int) -> pd.DataFrame:
 
     params = cfg.vehicle_params()
     temps = cfg.climate.monthly_mean_temperature_c
-    patterns = pd.read_parquet(data_dir / "gtfs" / "trips.parquet", columns=["pattern_id"])["pattern_id"]
     rows = []
-    for pattern_id in sorted(patterns.unique()):
+    for pattern_id in sorted(set(pattern_ids)):
         cycle = pattern_cycle(data_dir, pattern_id, cfg.trajectory.cycle)
         for m in cfg.run.months:
             e = simulate_cycle(cycle, params, ambient_c=temps[m - 1])
@@ -69,13 +68,14 @@ def reduce_run(cfg: Config, year: int, run_dir: Path, say=print) -> dict:
                                   "shape_id", "service_id", "block_id", "pattern_id", "start_s"]],
                       on="trip_id", how="left", validate="many_to_one")
     trip["month"] = pd.to_datetime(trip["service_date"]).dt.strftime("%Y-%m")
-    cons = trip_consumption(cfg, data_dir, year)
+    cons = trip_consumption(cfg, data_dir, year, trip["pattern_id"].unique())
     trip = trip.merge(cons, on=["pattern_id", "month"], how="left", validate="many_to_one")
     trip["coverage"] = trip["pv_kwh"] / trip["consumption_kwh"]
     write_parquet(trip, run_dir / "trip_energy.parquet")
 
     # --- segments with their geometry factors
     segments = gpd.read_parquet(data_dir / "gtfs" / "segments.parquet")
+    segments = segments[segments["shape_id"].isin(trip["shape_id"].unique())]
     geom_files = sorted((run_dir / "parts" / "geometry").glob("tile=*.parquet"))
     if geom_files:
         geo = pd.concat([pd.read_parquet(f) for f in geom_files], ignore_index=True)

@@ -11,6 +11,7 @@ from pathlib import Path
 import pandas as pd
 
 from ..config import Config
+from ..errors import InputError
 from .partition import RunContext, partition_done, run_partition, tile_geometry, worker_bvh_builds
 from .storage import write_json
 
@@ -106,16 +107,27 @@ def run_simulation(cfg: Config, year: int, scheduler: str | None = None,
     run_dir = run_dir_of(cfg, year)
     run_dir.mkdir(parents=True, exist_ok=True)
     _reset_if_config_changed(run_dir, cfg.digest())
-    seg_tiles = pd.read_parquet(data_dir / "gtfs" / "segments.parquet", columns=["tile"])["tile"]
-    tiles = sorted(seg_tiles.unique())
     feed = json.loads((data_dir / "gtfs" / "feed.json").read_text())
-    trips = pd.read_parquet(data_dir / "gtfs" / "trips.parquet", columns=["trip_id", "route_id"])
+    trips = pd.read_parquet(data_dir / "gtfs" / "trips.parquet", columns=["trip_id", "route_id", "shape_id"])
+    routes = cfg.run.routes
+    shapes = None
+    if routes is not None:
+        unknown = sorted(set(routes) - set(trips["route_id"].astype(str)))
+        if unknown:
+            raise InputError(f"{cfg._source}: run.routes: route_id(s) not in the feed: {', '.join(unknown)}")
+        trips = trips[trips["route_id"].astype(str).isin(routes)]
+        shapes = tuple(sorted(trips["shape_id"].unique()))
+    seg = pd.read_parquet(data_dir / "gtfs" / "segments.parquet", columns=["tile", "shape_id"])
+    if shapes is not None:
+        seg = seg[seg["shape_id"].isin(shapes)]
+    tiles = sorted(seg["tile"].unique())
     ctx = RunContext(
         data_dir=str(data_dir.resolve()), run_dir=str(run_dir.resolve()), year=year,
         irradiance=cfg.irradiance.model_dump(), pv_system=cfg.pv_system().model_dump(),
         pv_mode=cfg.pv.mode, monthly_temperature_c=tuple(cfg.climate.monthly_mean_temperature_c),
         wind_speed_mps=cfg.climate.wind_speed_mps, timezone=feed["timezone"],
         bvh_cache_size=cfg.dask.bvh_cache_size, ground_albedo=cfg.city.albedo.ground,
+        routes=tuple(routes) if routes is not None else None, shapes=shapes,
         route_of_trip=dict(zip(trips["trip_id"], trips["route_id"].astype(str))))
 
     todo = [(t, m) for t in tiles for m in _months(cfg, year) if not partition_done(run_dir, t, m)]

@@ -298,7 +298,8 @@ def _empty_passes() -> pd.DataFrame:
         "dt_s": pd.Series(dtype=np.float32), "speed_mps": pd.Series(dtype=np.float32)})
 
 
-def iter_passes(data_dir, tile: str, month, year: int | None = None) -> pd.DataFrame:
+def iter_passes(data_dir, tile: str, month, year: int | None = None,
+                routes=None) -> pd.DataFrame:
     """Every pass of every trip through the segments of *tile* in *month*.
 
     Parameters
@@ -311,6 +312,8 @@ def iter_passes(data_dir, tile: str, month, year: int | None = None) -> pd.DataF
         ``"2024-06"``, or 6 together with *year*.
     year : int, optional
         Checked against *month* when both are given.
+    routes : list of str, optional
+        Only trips of these ``route_id``\ s (default: all).
 
     Returns
     -------
@@ -332,8 +335,11 @@ def iter_passes(data_dir, tile: str, month, year: int | None = None) -> pd.DataF
     if pat.empty:
         return _empty_passes()
     trips = _read(data_dir, "trips.parquet",
-                  columns=["trip_id", "service_id", "pattern_id", "start_s"])
+                  columns=["trip_id", "route_id", "service_id", "pattern_id", "start_s"])
     trips = trips[trips["pattern_id"].isin(np.unique(pat["pattern_id"]))]
+    if routes is not None:
+        trips = trips[trips["route_id"].astype(str).isin([str(r) for r in routes])]
+    trips = trips.drop(columns="route_id")
     sd = service_dates(data_dir, period.year)
     sd = sd[(sd["date"] >= period.start_time) & (sd["date"] <= period.end_time)]
     return _passes(data_dir, trips, sd, pat)

@@ -1,0 +1,173 @@
+"""The simulation on a real Dask LocalCluster: worker count, interruption, worker loss, BVH
+reuse, and physics sanity of the demo's results."""
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import geopandas as gpd
+import numpy as np
+import pandas as pd
+import pytest
+from shapely.geometry import LineString, Point
+
+from vipvflow.config import load_config
+from vipvflow.simulation import run_simulation
+
+OUTPUTS = ["trip_energy.parquet", "segment_month.parquet", "route_month.parquet",
+           "block_day.parquet", "monthly.parquet", "hourly_pattern.parquet"]
+KEYS = {"trip_energy.parquet": ["trip_id", "service_date"],
+        "segment_month.parquet": ["segment_id", "month"],
+        "route_month.parquet": ["route_id", "direction_id", "month"],
+        "block_day.parquet": ["block_id", "service_date"],
+        "monthly.parquet": ["month"], "hourly_pattern.parquet": ["month", "hour"]}
+
+
+def _cfg(small_config, out: Path, **dask):
+    return load_config(small_config, overrides={"out_dir": str(out), "dask": dask})
+
+
+def assert_same_results(a: Path, b: Path):
+    for name in OUTPUTS:
+        x = pd.read_parquet(a / name).sort_values(KEYS[name]).reset_index(drop=True)
+        y = pd.read_parquet(b / name).sort_values(KEYS[name]).reset_index(drop=True)
+        x = x.drop(columns=[c for c in ("geometry",) if c in x])
+        y = y.drop(columns=[c for c in ("geometry",) if c in y])
+        pd.testing.assert_frame_equal(x, y, check_exact=False, rtol=1e-12, atol=0, obj=name)
+    sa, sb = (json.loads((p / "summary.json").read_text()) for p in (a, b))
+    assert sa == sb
+
+
+def test_outputs_written(small_run):
+    for name in OUTPUTS + ["segments.parquet", "summary.json", "manifest.json", "report.html"]:
+        assert (small_run / name).exists(), name
+    smg = gpd.read_parquet(small_run / "segment_month.parquet")
+    assert smg.crs.to_epsg() == 2169 and smg.geometry.has_z.all()
+    trips = pd.read_parquet(small_run / "trip_energy.parquet")
+    # every trip of June 2024 of the small demo: the calendar implies 20 weekdays (no holiday
+    # in June... except none), 5 Saturdays, 5 Sundays
+    layout = json.loads((small_run.parents[2].parent / "demo_small_inputs.json").read_text()) \
+        if (small_run.parents[2].parent / "demo_small_inputs.json").exists() else None
+    assert trips["consumption_kwh"].gt(0).all() and trips["pv_kwh"].ge(0).all()
+    html = (small_run / "report.html").read_text()
+    assert html.count("data:image/png;base64") == 6
+    del layout
+
+
+def test_trip_count_matches_calendar(small_run, demo_small):
+    from vipvflow.demo.gtfs import service_day_counts  # noqa: F401  (the demo's own calendar)
+    import gtfs_kit as gk
+
+    feed = gk.read_feed(demo_small / "demo_gtfs.zip", dist_units="m")
+    dates = [d.strftime("%Y%m%d") for d in pd.date_range("2024-06-01", "2024-06-30")]
+    expected = int(feed.compute_trip_activity(dates)[dates].to_numpy().sum())
+    trips = pd.read_parquet(small_run / "trip_energy.parquet")
+    assert len(trips) == expected
+
+
+def test_one_and_two_workers_give_equal_results(small_run, small_config, tmp_path):
+    one = run_simulation(_cfg(small_config, tmp_path / "one", n_workers=1), 2024, say=lambda *a: None)
+    assert_same_results(small_run, one)
+
+
+def test_bvh_built_at_most_once_per_worker(small_run):
+    manifest = json.loads((small_run / "manifest.json").read_text())
+    builds = manifest["bvh_builds_per_worker"]
+    assert len(builds) == 2
+    counts = [n for per_worker in builds.values() for n in per_worker.values()]
+    assert counts and max(counts) == 1
+
+
+def test_interrupted_run_resumes_to_the_same_result(small_run, small_config, tmp_path):
+    out = tmp_path / "resumed"
+    cfg = _cfg(small_config, out, n_workers=2)
+    run_dir = out / cfg.scenario / "2024"
+    cmd = [sys.executable, "-m", "vipvflow.cli", "simulate", "--config", str(small_config),
+           "--year", "2024", "--workers", "2"]
+    env = dict(os.environ, PYTHONUNBUFFERED="1")
+    yaml_override = tmp_path / "conf.yaml"
+    import yaml
+
+    conf = yaml.safe_load(Path(small_config).read_text())
+    conf["out_dir"] = str(out)
+    yaml_override.write_text(yaml.safe_dump(conf))
+    cmd[cmd.index(str(small_config))] = str(yaml_override)
+    proc = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                            start_new_session=True)
+    deadline = time.time() + 120
+    parts = run_dir / "parts" / "segment_month"
+    while time.time() < deadline and proc.poll() is None:
+        if len(list(parts.glob("tile=*/month=*.parquet"))) >= 2:
+            os.killpg(proc.pid, signal.SIGKILL)
+            break
+        time.sleep(0.05)
+    proc.wait(timeout=60)
+    done = len(list(parts.glob("tile=*/month=*.parquet")))
+    assert 2 <= done < 6, f"the run was not interrupted mid-way ({done} partitions)"
+    assert not (run_dir / "summary.json").exists()
+    resumed = run_simulation(cfg, 2024, say=lambda *a: None)
+    manifest = json.loads((resumed / "manifest.json").read_text())
+    assert manifest["partitions_computed"] == 6 - done
+    assert_same_results(small_run, resumed)
+
+
+def test_killed_worker_gives_the_same_result(small_run, small_config, tmp_path):
+    from distributed import Client, LocalCluster
+
+    out = tmp_path / "killed"
+    cfg = _cfg(small_config, out)
+    run_dir = out / cfg.scenario / "2024"
+    killed = {}
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0") as cluster, \
+            Client(cluster) as client:
+        pids = client.run(os.getpid)
+
+        def killer():
+            deadline = time.time() + 120
+            while time.time() < deadline:
+                if list((run_dir / "parts" / "geometry").glob("*.parquet")):
+                    victim = sorted(pids.values())[0]
+                    os.kill(victim, signal.SIGKILL)
+                    killed["pid"] = victim
+                    killed["done"] = len(list((run_dir / "parts" / "segment_month").glob("*/*.parquet")))
+                    return
+                time.sleep(0.01)
+
+        t = threading.Thread(target=killer)
+        t.start()
+        result = run_simulation(cfg, 2024, scheduler=cluster.scheduler_address, say=lambda *a: None)
+        t.join()
+    assert killed and killed["done"] < 6
+    assert_same_results(small_run, result)
+
+
+def _stretch_kind(segments: gpd.GeoDataFrame, layout: dict) -> np.ndarray:
+    lines = [(s["kind"], LineString(s["centerline"])) for s in layout["stretches"]]
+    mids = [Point(g.interpolate(0.5, normalized=True).coords[0][:2]) for g in segments.geometry]
+    kinds = []
+    for p in mids:
+        kinds.append(min(lines, key=lambda kl: kl[1].distance(p))[0])
+    return np.array(kinds)
+
+
+def test_physics_sanity(small_run, demo_small):
+    s = json.loads((small_run / "summary.json").read_text())
+    # without buildings the roof sees the CAMS horizontal irradiation, up to the roof tilt
+    # of the road gradients (at most a few degrees): within 1 %
+    assert abs(s["unshaded_to_ghi_allsky"] - 1) < 0.01
+    assert abs(s["unshaded_to_ghi_clearsky"] - 1) < 0.01
+    assert 0 < s["shading_loss_allsky"] < 1 and 0 < s["shading_loss_clearsky"] < 1
+    layout = json.loads((demo_small / "demo_layout.json").read_text())
+    sm = gpd.read_parquet(small_run / "segment_month.parquet")
+    kinds = _stretch_kind(sm, layout)
+    loss = 1 - (sm["h_direct"] + sm["h_diffuse"]) / sm["h_total_unshaded"]
+    canyon, open_ = loss[kinds == "canyon"], loss[kinds == "open"]
+    assert len(canyon) and len(open_)
+    assert canyon.mean() > 0.05 > open_.mean() + 0.02
+    assert (loss > -1e-9).all() and (loss < 1).all()
