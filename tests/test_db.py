@@ -1,8 +1,8 @@
 """The PostGIS mirror against a real PostgreSQL 15 + PostGIS started by the test session.
 
-The run directory comes from ``tests/db_run.py`` (files with the columns the reduce step
-writes), or from ``$VIPVFLOW_TEST_RUN_DIR`` (a real ``out/<scenario>/<year>``): the tests only
-read its files and compare the database with them.
+The run directory is the session's real small-demo simulation (``small_run`` in conftest),
+or ``$VIPVFLOW_TEST_RUN_DIR`` (any ``out/<scenario>/<year>``): the tests only read its files
+and compare the database with them.
 """
 from __future__ import annotations
 
@@ -22,7 +22,7 @@ import pandas as pd
 import pyarrow.parquet as pq
 import pytest
 
-from db_run import checksums, clone_run, write_run
+from db_run import checksums, clone_run
 from vipvflow.db import DatabaseError, citus_statements, ddl, mirror_run, run_id_of, schema
 from vipvflow.db import server as pgserver
 
@@ -74,12 +74,13 @@ def dsn(pg):
 
 
 @pytest.fixture(scope="session")
-def run_dir(tmp_path_factory) -> Path:
-    """The run directory under test (only read by the tests)."""
+def run_dir(request) -> Path:
+    """The run directory under test (only read by the tests): the session's real small-demo
+    simulation, or ``$VIPVFLOW_TEST_RUN_DIR``."""
     real = os.environ.get("VIPVFLOW_TEST_RUN_DIR")
     if real:
         return Path(real)
-    return write_run(tmp_path_factory.mktemp("run") / "dbtest" / "2024")
+    return request.getfixturevalue("small_run")
 
 
 @pytest.fixture

@@ -139,7 +139,10 @@ def test_reflection_from_large_wall_matches_view_factor():
     """Horizontal roof at distance D from a wall of height H above it, albedo rho.
 
     View factor roof -> wall (2D, infinite length): F = (1 - D / sqrt(D^2 + H^2)) / 2.
-    Reflected = rho F E_wall, E_wall = DNI cos(theta) + DHI / 2 + GHI rho_g / 2.
+    Reflected = rho F E_wall, E_wall = DNI cos(theta) + DHI F_sky + GHI rho_g F_ground.  The
+    wall stands alone on open ground (no ground in the mesh, nothing in front of it), so its
+    own view factors are those of a vertical plane: F_sky = F_ground = 1/2, and it is lit
+    over its whole height or not at all.
     """
     D, H, zr, rho, rho_g = 6.0, 25.0, 3.0, 0.4, 0.2
     scene = Scene(box_mesh([[D, -LONG, 0.0, D + 2, LONG, zr + H]], albedo_wall=rho))
@@ -151,6 +154,13 @@ def test_reflection_from_large_wall_matches_view_factor():
     assert geometry["r0_w"].iloc[0] == pytest.approx(rho * F, rel=0.03)
     assert geometry["r0_nx"].iloc[0] == pytest.approx(-1.0, abs=1e-6)
     assert geometry["r1_w"].iloc[0] == 0
+    assert geometry["r0_sky"].iloc[0] == pytest.approx(0.5, abs=0.03)
+    assert geometry["r0_open"].iloc[0] == pytest.approx(1 - geometry["r0_sky"].iloc[0], abs=1e-6)
+    assert geometry["r0_gnd"].iloc[0] == 0
+    pz = geometry[[f"r0_p{k}_z" for k in range(cfg.reflector_points)]].to_numpy()
+    px = geometry[[f"r0_p{k}_x" for k in range(cfg.reflector_points)]].to_numpy()
+    assert (np.diff(pz) >= 0).all() and (pz > zr).all() and (pz < zr + H).all()
+    np.testing.assert_allclose(px, D - 0.02, atol=1e-9)      # on the face, lifted 2 cm
     # sun in the west at 30 deg elevation lights the wall face (normal -x) at cos = 0.866
     zen, az = np.array([60.0]), np.array([270.0])
     dni, dhi = 700.0, 120.0
@@ -180,3 +190,83 @@ def test_sky_view_factor_diffuse_mode():
     assert a["diffuse"][0] == pytest.approx(300.0)
     assert b["diffuse"][0] == pytest.approx(300.0 * geometry["svf"].iloc[0])
     assert b["total_unshaded"][0] == a["total_unshaded"][0]
+
+
+def _canyon(H, W, rho_wall=0.35, rho_road=0.15):
+    """Infinite canyon (walls along y) with its road as ground triangles in the mesh."""
+    from vipvflow.mesh import SURFACE_CODE, TileMesh
+
+    walls = box_mesh([[-W / 2 - 20, -LONG, 0, -W / 2, LONG, H],
+                      [W / 2, -LONG, 0, W / 2 + 20, LONG, H]], albedo_wall=rho_wall)
+    g = 4 * LONG
+    road = np.array([[[-g, -g, 0], [g, -g, 0], [g, g, 0]], [[-g, -g, 0], [g, g, 0], [-g, g, 0]]])
+    tris = np.concatenate([walls.vertices[walls.triangles], road])
+    mesh = TileMesh.from_triangles(tris, albedo=np.r_[walls.albedo, [rho_road] * 2])
+    mesh.surface_type[:] = np.r_[walls.surface_type, [SURFACE_CODE["ground"]] * 2]
+    return mesh
+
+
+@pytest.mark.parametrize("P", [4, 16])
+def test_partly_lit_facade_lit_fraction(P):
+    """Sun across a canyon at elevation e: the facade facing it is lit above
+    z_s = H - W tan e only.  From a horizontal roof at height z_r on the centreline (distance
+    D = W/2), a strip of the facade between heights h1 < h2 above the roof has the view factor
+    (sin a1 - sin a2) / 2 with sin a = D / sqrt(D^2 + h^2).  Beam reflected once:
+    rho DNI cos(theta) F_lit; the P sample points resolve F_lit to within half a point's share
+    of the group's weight, F / (2 P)."""
+    H, W, zr, rho, el, dni = 16.0, 18.0, 3.2, 0.35, 20.0, 800.0
+    scene = Scene(_canyon(H, W, rho))
+    cfg = IrradianceCfg(svf_rays=64, reflection_rays=8192, ray_length_m=10_000.0,
+                        reflector_points=P, reflector_sky_rays=8)
+    geometry = segment_geometry(scene, _segments([0.0], 0.0, zr), cfg)
+    s_ = lambda h: (W / 2) / np.hypot(W / 2, h)
+    z_s = H - W * np.tan(np.radians(el))
+    r0 = cfg.ray_offset_m
+    F = (s_(0.0) - s_(H - zr - r0)) / 2
+    F_lit = (s_(z_s - zr - r0) - s_(H - zr - r0)) / 2
+    rad = {"dni": [0.0], "dhi": [0.0], "ghi": [0.0], "dni_clear": [dni], "dhi_clear": [0.0],
+           "ghi_clear": [0.0]}
+    out = _kernel(scene, geometry, np.array([0]), np.array([90.0 - el]), np.array([90.0]), rad, cfg)
+    e_full = rho * dni * np.cos(np.radians(el))
+    assert not out["sun_visible"][0] and out["reflected"][0] == 0
+    assert abs(out["reflected_clear"][0] - e_full * F_lit) <= e_full * F * (0.5 / P + 0.03)
+    assert out["reflected_clear"][0] < 0.8 * e_full * F        # not lit all-or-nothing
+
+
+def test_canyon_facade_sees_its_own_sky_and_road():
+    """A point at height z on a canyon wall (height H, width W) sees the sky above the
+    opposite roof edge, F_sky = (1 - (H - z) / sqrt((H - z)^2 + W^2)) / 2, and the road below,
+    F_road = (1 - z / sqrt(z^2 + W^2)) / 2 (2D, infinite canyon); the group's factors are
+    the means over its sample points, the road's weighted by its albedo."""
+    H, W, zr, rho_road = 16.0, 18.0, 3.2, 0.15
+    scene = Scene(_canyon(H, W, rho_road=rho_road))
+    cfg = IrradianceCfg(svf_rays=64, reflection_rays=2048, ray_length_m=10_000.0,
+                        reflector_points=4, reflector_sky_rays=2048)
+    geometry = segment_geometry(scene, _segments([0.0], 0.0, zr), cfg)
+    row = geometry.iloc[0]
+    groups = [g for g in range(cfg.max_reflector_groups) if row[f"r{g}_w"] > 0]
+    assert len(groups) == 2                                    # the two facades
+    for g in groups:
+        z = np.array([row[f"r{g}_p{k}_z"] for k in range(cfg.reflector_points)])
+        f_sky = (1 - (H - z) / np.hypot(H - z, W)) / 2
+        f_road = (1 - z / np.hypot(z, W)) / 2
+        assert row[f"r{g}_sky"] == pytest.approx(f_sky.mean(), abs=0.015)
+        assert row[f"r{g}_gnd"] == pytest.approx(rho_road * f_road.mean(), abs=0.015 * rho_road)
+        assert row[f"r{g}_open"] == 0                           # the road covers the ground
+
+
+def test_geometry_is_per_segment_and_plain_numeric():
+    """A segment's rays come from its own random stream: the same geometry whether it is
+    computed with others in one batch or alone; every column is a plain number (parquet)."""
+    scene = Scene(box_mesh([[8, -50, 0, 12, 50, 15], [-14, -20, 0, -9, 30, 22]]))
+    cfg = IrradianceCfg(svf_rays=32, reflection_rays=64, reflector_points=3, reflector_sky_rays=8)
+    segs = _segments(np.linspace(-5, 5, 7), np.linspace(-30, 30, 7), 3.2, 10.0, 0.02)
+    segs["segment_id"] = [40, 3, 17, 8, 99, 5, 61]
+    together = segment_geometry(scene, segs, cfg)
+    alone = pd.concat([segment_geometry(scene, segs.iloc[[i]], cfg) for i in (4, 0, 6, 1, 2, 5, 3)])
+    alone = alone.set_index("segment_id").loc[segs["segment_id"]].reset_index()
+    pd.testing.assert_frame_equal(together, alone[together.columns])
+    pd.testing.assert_frame_equal(together, segment_geometry(scene, segs, cfg, chunk=2))
+    assert all(np.issubdtype(t, np.number) for t in together.dtypes)
+    assert (together["r0_w"] > 0).all()
+    assert {f"r2_p2_{c}" for c in "xyz"} | {"r2_sky", "r2_gnd", "r2_open"} <= set(together.columns)

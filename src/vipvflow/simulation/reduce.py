@@ -144,7 +144,11 @@ def reduce_run(cfg: Config, year: int, run_dir: Path, say=print) -> dict:
                .agg(trips=("trip_id", "size"), pv_kwh=("pv_kwh", "sum"), pv_kwh_clear=("pv_kwh_clear", "sum"),
                     pv_kwh_unshaded=("pv_kwh_unshaded", "sum"),
                     pv_kwh_clear_unshaded=("pv_kwh_clear_unshaded", "sum"),
+                    pv_kwh_direct=("pv_kwh_direct", "sum"), pv_kwh_diffuse=("pv_kwh_diffuse", "sum"),
+                    pv_kwh_reflected=("pv_kwh_reflected", "sum"),
                     consumption_kwh=("consumption_kwh", "sum")).reset_index())
+    monthly["shading_loss"] = shading_loss(monthly["pv_kwh_direct"] + monthly["pv_kwh_diffuse"],
+                                           monthly["pv_kwh_unshaded"])
     monthly["avoided_charging_cycles"] = economics.avoided_cycles(
         monthly["pv_kwh"].to_numpy(), vehicle.battery_kwh, window)
     monthly["kwh_per_kwp_allsky"] = monthly["pv_kwh"] / (pv.kwp * n_buses)
