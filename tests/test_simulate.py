@@ -170,4 +170,5 @@ def test_physics_sanity(small_run, demo_small):
     canyon, open_ = loss[kinds == "canyon"], loss[kinds == "open"]
     assert len(canyon) and len(open_)
     assert canyon.mean() > 0.05 > open_.mean() + 0.02
-    assert (loss > -1e-9).all() and (loss < 1).all()
+    # open segments lose nothing: zero up to float32 rounding of the per-pass sums
+    assert (loss > -1e-6).all() and (loss < 1).all()

@@ -21,7 +21,7 @@ SCHEMA = "vipvflow"
 #: arrow type for a PostgreSQL column type (the loader casts file columns to it)
 ARROW_OF_SQL = {
     "text": "string", "bigint": "int64", "integer": "int32", "smallint": "int16",
-    "double precision": "float64", "real": "float32", "boolean": "bool", "date": "date32",
+    "double precision": "float64", "real": "float32", "boolean": "bool_", "date": "date32",
     "timestamptz": "timestamp_utc", "jsonb": "string",
 }
 
@@ -106,7 +106,7 @@ TRIP_ENERGY = Table(
     "trip_energy", "trip_energy.parquet", ("route_id", "trip_id", "service_date"), [
         ("route_id", "text"), ("trip_id", "text"), ("service_date", "date"), ("month", "text"),
         ("route_short_name", "text"), ("direction_id", "integer"), ("shape_id", "text"),
-        ("service_id", "text"), ("block_id", "text"), ("pattern_id", "text"), ("start_s", _F),
+        ("service_id", "text"), ("block_id", "text"), ("pattern_id", "bigint"), ("start_s", _F),
         ("seconds", _F), *_cols(_PV, _F),
         *_cols(["consumption_kwh", "traction_kwh", "recuperated_kwh", "aux_kwh", "coverage"], _F),
     ], partition_by="month", distribute_by="route_id",

@@ -70,18 +70,28 @@ def _scene(ctx: RunContext, tile: str):
 
 def tile_geometry(ctx: RunContext, tile: str) -> pd.DataFrame:
     """Per-segment geometry factors of a tile (sky view factor, reflector groups), computed
-    once per run and stored in ``parts/geometry/tile=<TILE>.parquet``."""
+    once per run and stored in ``parts/geometry/tile=<TILE>.parquet``, and the segments'
+    horizon profiles (:func:`vipvflow.horizon.horizon_profile` from the roof ray origins)
+    in ``parts/horizon/tile=<TILE>.parquet``, so a trip can be recomputed without rays."""
+    from ..horizon import horizon_frame, horizon_path, horizon_profile
     from ..irradiance import segment_geometry
 
     path = geometry_path(Path(ctx.run_dir), tile)
     if path.exists():
-        return pd.read_parquet(path)
-    seg = _segments(ctx.data_dir)
-    seg = seg[seg["tile"] == tile]
-    if ctx.shapes is not None:
-        seg = seg[seg["shape_id"].isin(ctx.shapes)]
-    geom = segment_geometry(_scene(ctx, tile), seg, IrradianceCfg(**ctx.irradiance))
-    write_parquet(geom, path)
+        geom = pd.read_parquet(path)
+    else:
+        seg = _segments(ctx.data_dir)
+        seg = seg[seg["tile"] == tile]
+        if ctx.shapes is not None:
+            seg = seg[seg["shape_id"].isin(ctx.shapes)]
+        geom = segment_geometry(_scene(ctx, tile), seg, IrradianceCfg(**ctx.irradiance))
+        write_parquet(geom, path)
+    hpath = horizon_path(ctx.run_dir, tile)
+    if not hpath.exists():
+        origins = geom[["px", "py", "pz"]].to_numpy(np.float64)
+        profile = horizon_profile(_scene(ctx, tile), origins,
+                                  max_distance_m=IrradianceCfg(**ctx.irradiance).ray_length_m)
+        write_parquet(horizon_frame(geom["segment_id"].to_numpy(), profile), hpath)
     return geom
 
 
