@@ -108,6 +108,70 @@ def pv_energy_kwh(poa_wm2: np.ndarray, dt_s: np.ndarray, speed_mps: np.ndarray, 
                            wind_speed_mps=ctx.wind_speed_mps + speed_mps)
 
 
+def _local_hours(t_utc: np.ndarray, timezone: str) -> np.ndarray:
+    """Local clock hour (0..23) of Unix times, converting each distinct UTC hour once."""
+    if not len(t_utc):
+        return np.zeros(0, np.int8)
+    utc_hour = np.floor(t_utc / 3600.0).astype(np.int64)
+    uniq, inverse = np.unique(utc_hour, return_inverse=True)
+    start = pd.to_datetime(uniq * 3600, unit="s", utc=True).tz_convert(timezone)
+    # UTC offset of each distinct UTC hour (daylight-saving changes fall on UTC hour starts)
+    offset = np.asarray([o.total_seconds() for o in start.map(lambda t: t.utcoffset())])
+    return (np.floor((t_utc + offset[inverse]) / 3600.0).astype(np.int64) % 24).astype(np.int8)
+
+
+def aggregate_partition(passes: pd.DataFrame, irr: pd.DataFrame, month: int, ctx: RunContext):
+    """Sum a partition's passes per trip and service date, per segment and per local hour.
+
+    Vectorised with numpy (``reduceat`` over the passes, which come sorted by service date,
+    trip and time; ``bincount`` per segment and hour), so the reduce costs a small part of
+    the irradiance evaluation.
+    """
+    n = len(passes)
+    dt = passes["dt_s"].to_numpy(np.float64)
+    speed = passes["speed_mps"].to_numpy(np.float64)
+    kwh = {f"pv_kwh{suffix}": pv_energy_kwh(irr[col].to_numpy(np.float64), dt, speed, month, ctx)
+           for suffix, col in VARIANTS.items()}
+    for comp in ("direct", "diffuse", "reflected"):
+        kwh[f"pv_kwh_{comp}"] = pv_energy_kwh(irr[comp].to_numpy(np.float64), dt, speed, month, ctx)
+    kwh["seconds"] = dt
+    # irradiation (Wh/m2) received during each pass
+    h = {f"h_{c}": irr[c].to_numpy(np.float64) * dt / 3600.0 for c in COMPONENTS}
+
+    # per trip and service date: runs of equal (date, trip) in the sorted passes
+    trip_code = np.asarray(passes["trip_id"].cat.codes if hasattr(passes["trip_id"], "cat")
+                           else pd.factorize(passes["trip_id"])[0], dtype=np.int64)
+    day = passes["service_date"].to_numpy().astype("datetime64[D]").astype(np.int64)
+    if n:
+        change = np.flatnonzero((np.diff(trip_code) != 0) | (np.diff(day) != 0)) + 1
+        starts = np.concatenate([[0], change])
+    else:
+        starts = np.zeros(0, np.int64)
+    kwh_block = np.column_stack(list(kwh.values())) if n else np.zeros((0, len(kwh)))
+    sums = np.add.reduceat(kwh_block, starts, axis=0) if n else kwh_block
+    trip = pd.DataFrame(sums, columns=list(kwh))
+    trip.insert(0, "service_date", passes["service_date"].to_numpy()[starts])
+    trip.insert(0, "trip_id", np.asarray(passes["trip_id"].to_numpy()[starts]).astype(str))
+    trip = trip.groupby(["trip_id", "service_date"], sort=True).sum().reset_index()
+
+    # per segment
+    seg_ids, seg_pos = np.unique(passes["segment_id"].to_numpy(np.int64), return_inverse=True)
+    cols = {**kwh, **h}
+    segm = pd.DataFrame({"segment_id": seg_ids,
+                         "n_passes": np.bincount(seg_pos, minlength=len(seg_ids)).astype(np.int64)})
+    for name in [c for c in kwh if c != "seconds"] + list(h) + ["seconds"]:
+        segm[name] = np.bincount(seg_pos, weights=cols[name], minlength=len(seg_ids))
+
+    # per local hour
+    hour = _local_hours(passes["t_utc"].to_numpy(np.float64), ctx.timezone)
+    hours = np.unique(hour)
+    pos = np.searchsorted(hours, hour)
+    hourly = pd.DataFrame({"hour": hours.astype(np.int8)})
+    for name in list(h) + ["seconds"]:
+        hourly[name] = np.bincount(pos, weights=cols[name], minlength=len(hours))
+    return trip, segm, hourly
+
+
 def run_partition(ctx: RunContext, tile: str, month: str, geometry: pd.DataFrame | None = None) -> dict:
     """Evaluate every pass of *tile* in *month* and write the partition's files.
 
@@ -137,38 +201,11 @@ def run_partition(ctx: RunContext, tile: str, month: str, geometry: pd.DataFrame
     else:
         irr = pd.DataFrame({c: np.zeros(0, np.float32) for c in COMPONENTS})
     t2 = time.perf_counter()
-    dt = passes["dt_s"].to_numpy(np.float64)
-    speed = passes["speed_mps"].to_numpy(np.float64)
-    mnum = int(month[5:7])
-    energy = {f"pv_kwh{suffix}": pv_energy_kwh(irr[col].to_numpy(np.float64), dt, speed, mnum, ctx)
-              for suffix, col in VARIANTS.items()}
-    for comp in ("direct", "diffuse", "reflected"):
-        energy[f"pv_kwh_{comp}"] = pv_energy_kwh(irr[comp].to_numpy(np.float64), dt, speed, mnum, ctx)
-    work = pd.DataFrame(energy)
-    work["trip_id"] = passes["trip_id"].to_numpy()
-    work["service_date"] = passes["service_date"].to_numpy()
-    work["segment_id"] = passes["segment_id"].to_numpy()
-    work["seconds"] = dt
-    for comp in COMPONENTS:
-        # irradiation (Wh/m2) received during the pass
-        work[f"h_{comp}"] = irr[comp].to_numpy(np.float64) * dt / 3600.0
-
-    kwh_cols = [c for c in work.columns if c.startswith("pv_kwh")]
-    h_cols = [f"h_{c}" for c in COMPONENTS]
-    trip = (work.groupby(["trip_id", "service_date"], sort=True, observed=True)[kwh_cols + ["seconds"]]
-            .sum().reset_index())
-    trip["tile"] = tile
-    segm = work.groupby("segment_id", sort=True)[kwh_cols + h_cols + ["seconds"]].sum()
-    segm.insert(0, "n_passes", work.groupby("segment_id", sort=True).size().astype(np.int64))
-    segm = segm.reset_index()
+    trip, segm, hourly = aggregate_partition(passes, irr, int(month[5:7]), ctx)
+    for df in (trip, segm, hourly):
+        df["tile"] = tile
     segm["month"] = month
-    segm["tile"] = tile
-
-    local = pd.to_datetime(passes["t_utc"].to_numpy(np.float64), unit="s", utc=True).tz_convert(ctx.timezone)
-    work["hour"] = np.asarray(local.hour, dtype=np.int8)
-    hourly = work.groupby("hour", sort=True)[h_cols + ["seconds"]].sum().reset_index()
     hourly["month"] = month
-    hourly["tile"] = tile
     timings["reduce_s"] = time.perf_counter() - t2
 
     t3 = time.perf_counter()
