@@ -18,6 +18,7 @@ import pytest
 from shapely.geometry import LineString, Point
 
 from vipvflow.config import load_config
+from vipvflow.errors import InputError
 from vipvflow.simulation import run_simulation
 
 OUTPUTS = ["trip_energy.parquet", "segment_month.parquet", "route_month.parquet",
@@ -172,3 +173,45 @@ def test_physics_sanity(small_run, demo_small):
     assert canyon.mean() > 0.05 > open_.mean() + 0.02
     # open segments lose nothing: zero up to float32 rounding of the per-pass sums
     assert (loss > -1e-6).all() and (loss < 1).all()
+
+
+def test_vecto_cycles_written_and_vmod_replaces_consumption(small_run, small_config, tmp_path, test_data):
+    import shutil
+
+    from vipvflow import vecto
+    from vipvflow.simulation.reduce import trip_consumption
+
+    cfg = load_config(small_config)
+    trips = pd.read_parquet(small_run / "trip_energy.parquet")
+    segs = pd.read_parquet(Path(cfg.data_dir) / "gtfs" / "segments.parquet")
+    length = segs.groupby("shape_id")["length_m"].sum()
+    files = sorted((small_run / "vecto").glob("pattern_*.vdri"))
+    patterns = trips.drop_duplicates("pattern_id").set_index("pattern_id")["shape_id"]
+    assert len(files) == len(patterns) and list((small_run / "vecto").glob("*.vecto"))
+    for f in files:
+        vdri = vecto.read_vdri(f)
+        shape = patterns[int(f.stem.split("_")[1])]
+        # the cycle's distance is the shape's length (within 1 %)
+        assert vdri["s_m"].iloc[-1] == pytest.approx(length[shape], rel=0.01)
+    # a battery-electric VECTO modal result for pattern 0 replaces its built-in consumption
+    vmod_dir = tmp_path / "vmod"
+    vmod_dir.mkdir()
+    vmod = vmod_dir / "pattern_0.vmod"
+    vmod.write_text("time [s],dt [s],dist [m],P_wheel_in [kW],P_brake_loss [kW],P_aux_el [kW],"
+                    "P_REESS_T [kW],P_REESS_int [kW],P_REESS_loss [kW]\n"
+                    "0.5,1,0,0,0,12,12,12.4,0.4\n1.5,1,5,80,0,12,95,98,3\n2.5,1,12,-30,-5,12,-15,-14,1\n",
+                    encoding="utf-8-sig")
+    cfg = load_config(small_config, overrides={"vehicle": {"vmod_dir": str(vmod_dir)}})
+    cons = trip_consumption(cfg, Path(cfg.data_dir), 2024, patterns.index, say=lambda *a: None)
+    want = (12.4 + 98 - 14) / 3600  # battery energy integrated by hand (kWh)
+    assert vecto.vmod_energy(vmod)["battery_kwh"] == pytest.approx(want)
+    want = vecto.vmod_energy(vmod)["battery_kwh"]
+    got = cons.set_index("pattern_id")
+    assert np.all(got.loc[[0], "consumption_kwh"] == want)
+    assert np.all(got.loc[[0], "consumption_source"] == "vecto")
+    others = got.drop(index=0)
+    assert (others["consumption_source"] == "built-in").all()
+    # the modal result of a conventional vehicle (no battery) is refused with the file named
+    shutil.copy(next((test_data / "vecto").glob("*.vmod")), vmod_dir / "pattern_0.vmod")
+    with pytest.raises(InputError, match="pattern_0.vmod.*battery"):
+        trip_consumption(cfg, Path(cfg.data_dir), 2024, patterns.index, say=lambda *a: None)

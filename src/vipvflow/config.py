@@ -116,6 +116,9 @@ class PVCfg(_Model):
 class VehicleCfg(_Model):
     model: str = "ecitaro_12m"
     overrides: dict[str, Any] = Field(default_factory=dict)
+    # folder of VECTO modal results named pattern_<id>.vmod (from running VECTO on the
+    # run's vecto/ cycles): they replace the built-in consumption of those patterns
+    vmod_dir: Path | None = None
 
 
 class EconomicsCfg(_Model):

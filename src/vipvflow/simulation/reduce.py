@@ -14,6 +14,7 @@ import numpy as np
 import pandas as pd
 
 from ..config import Config
+from ..errors import InputError
 from .storage import write_json, write_parquet
 
 log = logging.getLogger(__name__)
@@ -32,22 +33,48 @@ def shading_loss(shaded, unshaded):
     return 1.0 - shaded / unshaded
 
 
-def trip_consumption(cfg: Config, data_dir: Path, year: int, pattern_ids) -> pd.DataFrame:
+def trip_consumption(cfg: Config, data_dir: Path, year: int, pattern_ids, vecto_dir: Path | None = None,
+                     say=print) -> pd.DataFrame:
     """Battery energy per trip pattern and month (kWh) from the vehicle model run over each
-    pattern's 2 s driving cycle at the month's mean ambient temperature."""
+    pattern's 2 s driving cycle at the month's mean ambient temperature.
+
+    With *vecto_dir* each pattern's cycle is also written as a VECTO driving cycle
+    (``pattern_<id>.vdri``) with a VECTO job of the vehicle, so a VECTO user can run them;
+    with ``vehicle.vmod_dir`` the VECTO modal results ``pattern_<id>.vmod`` found there
+    replace the built-in consumption of those patterns (for every month).
+    """
+    from .. import vecto
     from ..trajectory import pattern_cycle
     from ..vehicle import simulate_cycle
 
     params = cfg.vehicle_params()
     temps = cfg.climate.monthly_mean_temperature_c
-    rows = []
+    vmod = {}
+    if cfg.vehicle.vmod_dir is not None:
+        files = {int(p.stem.split("_", 1)[1]): p for p in Path(cfg.vehicle.vmod_dir).glob("pattern_*.vmod")}
+        if files:
+            vmod = vecto.vmod_trip_energies(files)["consumption_kwh"].to_dict()
+            bad = [str(files[k]) for k, v in vmod.items() if not np.isfinite(v)]
+            if bad:
+                raise InputError(f"{bad[0]}: no battery power columns (P_REESS_*): not the modal "
+                                 "result of a battery-electric VECTO run")
+            say(f"consumption of {len(vmod)} pattern(s) from VECTO results in {cfg.vehicle.vmod_dir}")
+    rows, cycles = [], []
+    if vecto_dir is not None:
+        vecto_dir.mkdir(parents=True, exist_ok=True)
     for pattern_id in sorted(set(pattern_ids)):
         cycle = pattern_cycle(data_dir, pattern_id, cfg.trajectory.cycle)
+        if vecto_dir is not None:
+            cycles.append(vecto.write_vdri(cycle, vecto_dir / f"pattern_{pattern_id}.vdri"))
         for m in cfg.run.months:
             e = simulate_cycle(cycle, params, ambient_c=temps[m - 1])
             rows.append({"pattern_id": pattern_id, "month": f"{year}-{m:02d}",
-                         "consumption_kwh": e["battery_kwh"], "traction_kwh": e["traction_kwh"],
-                         "recuperated_kwh": e["recuperated_kwh"], "aux_kwh": e["aux_kwh"]})
+                         "consumption_kwh": vmod.get(int(pattern_id), e["battery_kwh"]),
+                         "consumption_source": "vecto" if int(pattern_id) in vmod else "built-in",
+                         "traction_kwh": e["traction_kwh"], "recuperated_kwh": e["recuperated_kwh"],
+                         "aux_kwh": e["aux_kwh"]})
+    if vecto_dir is not None and cycles:
+        vecto.write_vecto_job(vecto_dir, params, cycles=[Path(c).name for c in cycles])
     return pd.DataFrame(rows)
 
 
@@ -68,7 +95,8 @@ def reduce_run(cfg: Config, year: int, run_dir: Path, say=print) -> dict:
                                   "shape_id", "service_id", "block_id", "pattern_id", "start_s"]],
                       on="trip_id", how="left", validate="many_to_one")
     trip["month"] = pd.to_datetime(trip["service_date"]).dt.strftime("%Y-%m")
-    cons = trip_consumption(cfg, data_dir, year, trip["pattern_id"].unique())
+    cons = trip_consumption(cfg, data_dir, year, trip["pattern_id"].unique(),
+                            vecto_dir=run_dir / "vecto", say=say)
     trip = trip.merge(cons, on=["pattern_id", "month"], how="left", validate="many_to_one")
     trip["coverage"] = trip["pv_kwh"] / trip["consumption_kwh"]
     write_parquet(trip, run_dir / "trip_energy.parquet")
