@@ -311,6 +311,9 @@ def test_bad_dsn_is_one_clear_line_and_leaves_the_run_untouched(pg, run_dir):
 def test_doc_sql_examples_run_as_written(dsn, run_dir):
     mirror_run(dsn, run_dir, log=lambda m: None)
     blocks = sql_blocks(DOC)
+    readme = sql_blocks(ROOT / "README.md")
+    # the README shows the same examples as the doc, so they run as written there too
+    assert readme and all(b in blocks for b in readme)
     assert len(blocks) >= 3
     routes = set(pd.read_parquet(run_dir / "route_month.parquet")["route_short_name"].astype(str))
     for sql in blocks:
