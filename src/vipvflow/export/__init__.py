@@ -1,0 +1,4 @@
+"""Exports of a finished run to other formats (CityGML 3.0 Dynamizers, see ``docs/dynamizer.md``)."""
+from .dynamizer import load_run, read_dynamizers, reflector_contributions, write_dynamizers
+
+__all__ = ["load_run", "read_dynamizers", "reflector_contributions", "write_dynamizers"]
