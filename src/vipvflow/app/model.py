@@ -1,0 +1,447 @@
+"""What the web app shows, as a library: one trip recomputed for any settings, and the run's
+monthly yields rescaled to another PV system.
+
+:class:`TripModel` loads a finished run (``out/<scenario>/<year>/``) once: the segments,
+their stored geometry factors (``parts/geometry``) and horizon profiles
+(``parts/horizon``), the radiation table of the run's data directory, the timetable and the
+run's route-month outputs.  :meth:`TripModel.trip` then recomputes one trip without ray
+casting:
+
+* departure: the first scheduled trip of the route and direction leaving at or after the
+  requested time on the chosen date (the last one of the day when none leaves later; a
+  trip of another service day, placed on the date, when the route does not run that day);
+* per segment, at the middle of the time the bus spends on it (as the simulation does):
+  sun and CAMS radiation from :class:`vipvflow.radiation.RadiationTable`;
+  direct ``DNI max(cos AOI, 0)`` when the sun's elevation exceeds the segment's horizon
+  profile interpolated at the sun's azimuth (:mod:`vipvflow.horizon`); diffuse isotropic
+  ``DHI (1 + cos tilt) / 2`` or ``DHI x SVF`` as configured for the run; reflected from the
+  stored reflector groups (:func:`vipvflow.irradiance.pack_geometry`):
+  ``DHI sum w F_s + GHI sum w F_g + DNI sum max(s . w n, 0)`` — the beam part takes every
+  reflector group facing the sun as sunlit (the simulation casts a ray per sample point
+  instead, so the app's reflected light is an upper bound of the run's);
+  the unshaded reference ``DNI max(cos AOI, 0) + DHI (1 + cos tilt) / 2``;
+* PV: paper mode ``kWp x POA / 1000 x PR x dt / 3600`` or pvlib mode (PVWatts at a SAPM
+  cell temperature cooled by the bus's speed, :func:`vipvflow.pv.energy_pvlib`);
+* consumption: the pattern's 2 s driving cycle (:func:`vipvflow.trajectory.pattern_cycle`)
+  through :func:`vipvflow.vehicle.simulate_cycle` with the chosen auxiliary base load
+  (HVAC at the month's mean temperature on top), and the state of charge over the trip
+  with and without PV.
+"""
+from __future__ import annotations
+
+import json
+import time
+from dataclasses import dataclass, field, replace
+from functools import lru_cache
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from ..config import Config, PVSystem
+
+#: PV technologies offered: PVWatts temperature coefficient of power (1/K, typical datasheet
+#: values), module efficiency at STC (for sizing by area) and the pvlib SAPM mounting of the
+#: cell-temperature model (``pvlib.temperature.TEMPERATURE_MODEL_PARAMETERS['sapm']``).
+TECHNOLOGIES = {
+    "c-Si": {"gamma_pdc_per_k": -0.0037, "efficiency": 0.21,
+             "temperature_model": "sapm_open_rack_glass_polymer"},
+    "multi-Si": {"gamma_pdc_per_k": -0.0040, "efficiency": 0.18,
+                 "temperature_model": "sapm_open_rack_glass_polymer"},
+    "CdTe": {"gamma_pdc_per_k": -0.0028, "efficiency": 0.18,
+             "temperature_model": "sapm_open_rack_glass_glass"},
+    "CIGS": {"gamma_pdc_per_k": -0.0034, "efficiency": 0.16,
+             "temperature_model": "sapm_open_rack_glass_glass"},
+    "a-Si": {"gamma_pdc_per_k": -0.0020, "efficiency": 0.09,
+             "temperature_model": "sapm_open_rack_glass_glass"},
+}
+
+
+@dataclass(frozen=True)
+class PVChoice:
+    """The PV system the user explores.
+
+    ``kwp`` (kW at STC) or, when ``area_m2`` is given, ``area_m2 x efficiency`` of the
+    technology; ``performance_ratio`` is used in paper mode, ``losses_percent`` (DC system
+    losses) and ``inverter_efficiency`` in pvlib mode.
+    """
+
+    technology: str = "c-Si"
+    mode: str = "paper"
+    kwp: float = 3.5
+    area_m2: float | None = None
+    performance_ratio: float = 0.75
+    losses_percent: float = 14.0
+    inverter_efficiency: float = 0.96
+
+    @property
+    def peak_kw(self) -> float:
+        if self.area_m2 is not None:
+            return float(self.area_m2) * TECHNOLOGIES[self.technology]["efficiency"]
+        return float(self.kwp)
+
+    def system(self) -> PVSystem:
+        tech = TECHNOLOGIES[self.technology]
+        return PVSystem(name=f"app {self.technology}", technology=self.technology,
+                        kwp=self.peak_kw, roof_area_m2=30.0, area_share=0.8,
+                        performance_ratio=self.performance_ratio,
+                        gamma_pdc_per_k=tech["gamma_pdc_per_k"],
+                        inverter_efficiency=self.inverter_efficiency,
+                        system_losses_percent=self.losses_percent,
+                        temperature_model=tech["temperature_model"])
+
+    def linear_factor(self) -> float:
+        """kW per kW/m2 of POA, for rescaling stored energies (paper: kWp x PR; pvlib:
+        kWp x (1 - losses) x inverter efficiency, temperature effects not rescaled)."""
+        if self.mode == "paper":
+            return self.peak_kw * self.performance_ratio
+        return self.peak_kw * (1 - self.losses_percent / 100.0) * self.inverter_efficiency
+
+
+@dataclass
+class TripResult:
+    """One recomputed trip.
+
+    ``segments``: one row per segment pass (``segment_id, t_utc, time`` (local),
+    ``dt_s, speed_mps``, W/m2 ``direct, diffuse, reflected, total, unshaded``,
+    ``sun_visible``, ``power_kw``, ``energy_kwh``, ``x, y, x_end, y_end``);
+    ``cycle``: the 2 s driving cycle (``time`` local, ``t_s``, ``speed_kmh``, ``soc``,
+    ``soc_pv``, ``pv_kwh_cum``, ``battery_kwh_cum``); ``numbers``: ``pv_kwh``,
+    ``pv_kwh_unshaded``, ``consumption_kwh``, ``share``, ``shading_loss``, ``soc_end``,
+    ``soc_end_pv``, ``distance_km``, ``duration_min``, ``compute_s``.
+    """
+
+    trip_id: str
+    route_id: str
+    direction_id: int
+    date: pd.Timestamp
+    departure: pd.Timestamp
+    requested: str
+    note: str
+    segments: pd.DataFrame
+    cycle: pd.DataFrame
+    numbers: dict = field(default_factory=dict)
+
+
+def _minutes(value) -> float:
+    """Minutes after local midnight from ``'HH:MM'``, a number of minutes, or a time."""
+    if isinstance(value, str):
+        hh, mm = value.split(":")[:2]
+        return int(hh) * 60 + float(mm)
+    if hasattr(value, "hour"):
+        return value.hour * 60 + value.minute + getattr(value, "second", 0) / 60
+    return float(value)
+
+
+class TripModel:
+    """A finished run, loaded once, recomputing trips for the web app (no ray casting).
+
+    Parameters
+    ----------
+    run_dir : path of ``out/<scenario>/<year>/`` (with ``manifest.json``)
+    """
+
+    def __init__(self, run_dir):
+        from ..horizon import horizon_columns, load_horizons
+        from ..irradiance import pack_geometry
+        from ..radiation import RadiationTable
+        from ..trajectory import service_dates
+
+        self.run_dir = Path(run_dir)
+        manifest = json.loads((self.run_dir / "manifest.json").read_text())
+        self.manifest = manifest
+        self.year = int(manifest["year"])
+        self.cfg = Config.model_validate(manifest["config"])
+        self.data_dir = Path(self.cfg.data_dir)
+        gdir = self.data_dir / "gtfs"
+        self.timezone = json.loads((gdir / "feed.json").read_text())["timezone"]
+        self.vehicle = self.cfg.vehicle_params()
+        self.run_pv = self.cfg.pv_system()
+        self.run_pv_choice = PVChoice(
+            technology=self.run_pv.technology if self.run_pv.technology in TECHNOLOGIES else "c-Si",
+            mode=self.cfg.pv.mode, kwp=self.run_pv.kwp,
+            performance_ratio=self.run_pv.performance_ratio,
+            losses_percent=self.run_pv.system_losses_percent,
+            inverter_efficiency=self.run_pv.inverter_efficiency)
+
+        # segments with geometry factors and horizons, one row per segment id
+        geo = pd.concat([pd.read_parquet(f) for f in
+                         sorted((self.run_dir / "parts" / "geometry").glob("tile=*.parquet"))],
+                        ignore_index=True)
+        hor = load_horizons(self.run_dir)
+        if len(hor) == 0:
+            raise FileNotFoundError(f"{self.run_dir / 'parts' / 'horizon'}: no horizon profiles; "
+                                    "re-run the simulation with this version of vipvflow")
+        seg = pd.read_parquet(gdir / "segments.parquet",
+                              columns=["segment_id", "shape_id", "x", "y", "x_end", "y_end",
+                                       "length_m", "tile"])
+        geo = geo.merge(hor, on="segment_id", how="inner", validate="one_to_one")
+        geo = geo.merge(seg, on="segment_id", how="left", validate="one_to_one")
+        geo = geo.sort_values("segment_id").reset_index(drop=True)
+        self.geometry = geo
+        ids = geo["segment_id"].to_numpy(np.int64)
+        self._row = np.full(int(ids.max()) + 1, -1, np.int64)
+        self._row[ids] = np.arange(len(ids))
+        self._packed = pack_geometry(geo, self.cfg.irradiance, self.cfg.city.albedo.ground)
+        self._horizon = geo[horizon_columns(sum(c.startswith("h") and c[1:].isdigit()
+                                                for c in hor.columns))].to_numpy(np.float32)
+        self._loc = geo["rad_location"].to_numpy(np.int64) if "rad_location" in geo else None
+        self.radiation = RadiationTable.load(self.data_dir, self.year)
+
+        # timetable
+        self.trips = pd.read_parquet(gdir / "trips.parquet")
+        self.trips["route_id"] = self.trips["route_id"].astype(str)
+        self.trips["service_id"] = self.trips["service_id"].astype(str)
+        self.trips["direction_id"] = self.trips["direction_id"].fillna(0).astype(int)
+        pat = pd.read_parquet(gdir / "patterns.parquet")
+        pat = pat.sort_values(["pattern_id", "t_offset_s"], kind="stable")
+        self._patterns = {int(k): g for k, g in pat.groupby("pattern_id", sort=True)}
+        self.service_dates = service_dates(self.data_dir, self.year)
+        self.route_month = (pd.read_parquet(self.run_dir / "route_month.parquet")
+                            if (self.run_dir / "route_month.parquet").exists() else pd.DataFrame())
+        if len(self.route_month):
+            self.route_month["route_id"] = self.route_month["route_id"].astype(str)
+        # routes actually simulated (their segments have geometry)
+        have = set(geo["shape_id"].dropna())
+        self.trips = self.trips[self.trips["shape_id"].isin(have)].reset_index(drop=True)
+
+    # ------------------------------------------------------------------ choices
+    def routes(self) -> pd.DataFrame:
+        """Route-directions of the run: ``route_id, route_short_name, direction_id, trips``."""
+        return (self.trips.groupby(["route_id", "route_short_name", "direction_id"], sort=True)
+                .size().rename("trips").reset_index())
+
+    def departures(self, route_id, direction_id, date) -> pd.DataFrame:
+        """Scheduled trips of a route-direction on a service date (``trip_id, start_s``),
+        by departure time; empty when the route does not run that day."""
+        date = pd.Timestamp(date).normalize()
+        sids = set(self.service_dates.loc[self.service_dates["date"] == date, "service_id"].astype(str))
+        t = self.trips[(self.trips["route_id"] == str(route_id))
+                       & (self.trips["direction_id"] == int(direction_id))
+                       & self.trips["service_id"].isin(sids)]
+        return t.sort_values("start_s", kind="stable")
+
+    def pick_trip(self, route_id, direction_id, date, depart) -> tuple[pd.Series, str]:
+        """The trip leaving at or after *depart* (``'HH:MM'`` or minutes) on *date*; the
+        note says which rule chose it."""
+        want_s = _minutes(depart) * 60.0
+        deps = self.departures(route_id, direction_id, date)
+        note = "next scheduled departure at or after the chosen time"
+        if deps.empty:
+            deps = self.trips[(self.trips["route_id"] == str(route_id))
+                              & (self.trips["direction_id"] == int(direction_id))]
+            deps = deps.sort_values("start_s", kind="stable").drop_duplicates("start_s")
+            note = "the route does not run that day: a trip of another service day, placed on it"
+            if deps.empty:
+                raise KeyError(f"no trips for route {route_id!r} direction {direction_id}")
+        later = deps[deps["start_s"] >= want_s - 1e-6]
+        if later.empty:
+            return deps.iloc[-1], "no later departure that day: the day's last trip"
+        return later.iloc[0], note
+
+    # ------------------------------------------------------------------ compute
+    @lru_cache(maxsize=64)
+    def _cycle(self, pattern_id: int) -> pd.DataFrame:
+        from ..trajectory import pattern_cycle
+
+        return pattern_cycle(self.data_dir, pattern_id, self.cfg.trajectory.cycle)
+
+    def _origin_utc(self, date) -> float:
+        from ..trajectory import service_day_origin_utc
+
+        return float(service_day_origin_utc([pd.Timestamp(date)], self.timezone)[0])
+
+    def irradiance(self, segment_ids, t_utc) -> dict:
+        """Roof irradiance components (W/m2) of segments at times, from stored factors.
+
+        Parameters
+        ----------
+        segment_ids : (n,) int
+        t_utc : (n,) float, Unix s
+
+        Returns
+        -------
+        dict of (n,) arrays: ``direct, diffuse, reflected, total, unshaded`` (W/m2),
+        ``sun_visible`` (bool), ``elevation, azimuth`` (deg), ``ghi, dni, dhi`` (W/m2).
+        """
+        from ..horizon import sun_visible
+
+        rows = self._row[np.asarray(segment_ids, np.int64)]
+        if (rows < 0).any():
+            raise KeyError("segments without stored geometry")
+        loc = None if self._loc is None else self._loc[rows]
+        rad = self.radiation.lookup(np.asarray(t_utc, np.float64), location=loc, angles=True)
+        geo = self._packed
+        dni, dhi, ghi = (np.nan_to_num(rad[c]).astype(np.float64) for c in ("dni", "dhi", "ghi"))
+        sun = np.stack([rad["sun_x"], rad["sun_y"], rad["sun_z"]], 1).astype(np.float64)
+        sun = np.nan_to_num(sun)
+        elev = 90.0 - np.nan_to_num(rad["zenith"], nan=180.0).astype(np.float64)
+        nrm = geo["n"][rows].astype(np.float64)
+        cos_aoi = np.where(elev > 0, np.maximum((nrm * sun).sum(1), 0.0), 0.0)
+        visible = sun_visible(self._horizon[rows], elev, np.nan_to_num(rad["azimuth"]))
+        iso = (1.0 + nrm[:, 2]) / 2.0
+        sky = (geo["svf"][rows].astype(np.float64)
+               if self.cfg.irradiance.diffuse_model == "sky_view_factor" else iso)
+        direct = dni * cos_aoi * visible
+        diffuse = dhi * sky
+        reflected = np.zeros(len(rows))
+        if self.cfg.irradiance.reflection and geo["wn"].shape[1]:
+            facing = np.maximum(np.einsum("igj,ij->ig", geo["wn"][rows].astype(np.float64), sun), 0.0)
+            reflected = (dhi * geo["refl_sky"][rows] + ghi * geo["refl_gnd"][rows]
+                         + np.where(elev > 0, dni * facing.sum(1), 0.0))
+        return {"direct": direct, "diffuse": diffuse, "reflected": reflected,
+                "total": direct + diffuse + reflected, "unshaded": dni * cos_aoi + dhi * iso,
+                "sun_visible": visible, "elevation": elev, "azimuth": rad["azimuth"],
+                "ghi": ghi, "dni": dni, "dhi": dhi}
+
+    def pv_energy(self, poa, dt_s, speed_mps, month: int, pv: PVChoice) -> np.ndarray:
+        """PV energy (kWh) of each pass at POA irradiance *poa* (W/m2) for *dt_s* (s)."""
+        from .. import pv as pvmod
+
+        if pv.mode == "paper":
+            return pvmod.energy_paper(poa, dt_s, pv.peak_kw, pv.performance_ratio)
+        return pvmod.energy_pvlib(poa, dt_s, pv.system(),
+                                  temp_air_c=self.cfg.climate.monthly_mean_temperature_c[month - 1],
+                                  vehicle_speed_mps=speed_mps, wind_mps=self.cfg.climate.wind_speed_mps)
+
+    def trip(self, route_id, direction_id, date, depart="08:00", pv: PVChoice | None = None,
+             aux_kw: float | None = None, soc_start: float | None = None,
+             soc_min: float | None = None) -> TripResult:
+        """Recompute one trip (see the module doc for the rules and the model).
+
+        Parameters
+        ----------
+        route_id, direction_id : the route-direction
+        date : service date (str ``YYYY-MM-DD``, date or Timestamp; local day)
+        depart : ``'HH:MM'`` or minutes after local midnight (requested departure)
+        pv : PVChoice (default: the run's PV system)
+        aux_kw : auxiliary base load (kW), HVAC at the month's temperature on top
+            (default: the vehicle's)
+        soc_start, soc_min : SoC at the trip's start and the lower limit (0..1; defaults:
+            the vehicle's ``soc_max`` and ``soc_min``)
+        """
+        from ..vehicle import simulate_cycle, soc_trace
+
+        t0 = time.perf_counter()
+        pv = pv or self.run_pv_choice
+        date = pd.Timestamp(date).normalize()
+        row, note = self.pick_trip(route_id, direction_id, date, depart)
+        pid = int(row["pattern_id"])
+        pat = self._patterns[pid]
+        origin = self._origin_utc(date) + float(row["start_s"])
+        off = pat["t_offset_s"].to_numpy(np.float64)
+        dt = pat["dt_s"].to_numpy(np.float64)
+        speed = pat["speed_mps"].to_numpy(np.float64)
+        sid = pat["segment_id"].to_numpy(np.int64)
+        t_mid = origin + off + 0.5 * dt
+        irr = self.irradiance(sid, t_mid)
+        month = int(date.month)
+        energy = self.pv_energy(irr["total"], dt, speed, month, pv)
+        energy_uns = self.pv_energy(irr["unshaded"], dt, speed, month, pv)
+        energy_dd = self.pv_energy(irr["direct"] + irr["diffuse"], dt, speed, month, pv)
+        g = self.geometry.iloc[self._row[sid]]
+        tz = self.timezone
+        segs = pd.DataFrame({
+            "segment_id": sid, "t_utc": origin + off,
+            "time": pd.to_datetime(origin + off, unit="s", utc=True).tz_convert(tz).tz_localize(None),
+            "dt_s": dt, "speed_mps": speed,
+            **{k: np.asarray(irr[k], np.float64) for k in ("direct", "diffuse", "reflected", "total",
+                                                           "unshaded")},
+            "sun_visible": irr["sun_visible"],
+            "power_kw": np.divide(energy * 3600.0, dt, out=np.zeros_like(dt), where=dt > 0),
+            "energy_kwh": energy,
+            "x": g["x"].to_numpy(), "y": g["y"].to_numpy(),
+            "x_end": g["x_end"].to_numpy(), "y_end": g["y_end"].to_numpy()})
+
+        # vehicle
+        params = self.vehicle
+        upd = {}
+        if aux_kw is not None:
+            upd["aux_base_kw"] = float(aux_kw)
+        if soc_min is not None:
+            upd["soc_min"] = float(soc_min)
+        if soc_start is not None:
+            upd["soc_max"] = max(float(soc_start), params.soc_min if soc_min is None else float(soc_min) + 1e-6)
+        if upd:
+            params = params.model_copy(update=upd)
+        soc0 = params.soc_max if soc_start is None else float(soc_start)
+        cycle = self._cycle(pid)
+        cons = simulate_cycle(cycle, params, self.cfg.climate.monthly_mean_temperature_c[month - 1],
+                              detail=True)
+        iv = cons["intervals"]
+        t_s = cycle["t_s"].to_numpy(np.float64)
+        e_batt = np.r_[0.0, np.cumsum(iv["p_battery"] * iv["dt_s"]) / 3.6e6]      # kWh
+        seg_end = np.r_[0.0, off + dt]
+        e_pv = np.interp(t_s - t_s[0], seg_end, np.r_[0.0, np.cumsum(energy)])
+        cap = params.battery_kwh
+        soc = soc0 - e_batt / cap
+        # with PV: charging stops at soc_max (one-sided reflection of the running sum)
+        free = soc0 + (e_pv - e_batt) / cap
+        soc_pv = free - np.maximum(np.maximum.accumulate(free - params.soc_max), 0.0)
+        cyc = pd.DataFrame({
+            "t_s": t_s,
+            "time": pd.to_datetime(origin + t_s - t_s[0], unit="s", utc=True).tz_convert(tz).tz_localize(None),
+            "speed_kmh": cycle["speed_mps"].to_numpy(np.float64) * 3.6,
+            "soc": soc, "soc_pv": soc_pv, "pv_kwh_cum": e_pv, "battery_kwh_cum": e_batt})
+        pv_kwh = float(energy.sum())
+        use = float(cons["battery_kwh"])
+        end = soc_trace(pd.DataFrame({"battery_kwh": [use]}), [pv_kwh], params, soc_start=soc0)
+        uns = float(energy_uns.sum())
+        numbers = {
+            "pv_kwh": pv_kwh, "pv_kwh_unshaded": uns, "consumption_kwh": use,
+            "share": pv_kwh / use if use > 0 else float("nan"),
+            "shading_loss": 1.0 - float(energy_dd.sum()) / uns if uns > 0 else float("nan"),
+            "soc_end": float(end["soc_end"].iloc[0]), "soc_end_pv": float(end["soc_end_pv"].iloc[0]),
+            "soc_min": params.soc_min, "kwp": pv.peak_kw,
+            "distance_km": float(cons["distance_km"]), "duration_min": float(cons["duration_s"]) / 60.0,
+        }
+        departure = pd.Timestamp(origin, unit="s", tz="UTC").tz_convert(tz).tz_localize(None)
+        numbers["compute_s"] = time.perf_counter() - t0
+        return TripResult(trip_id=str(row["trip_id"]), route_id=str(route_id),
+                          direction_id=int(direction_id), date=date, departure=departure,
+                          requested=f"{int(_minutes(depart)) // 60:02d}:{int(_minutes(depart)) % 60:02d}",
+                          note=note, segments=segs, cycle=cyc, numbers=numbers)
+
+    # ------------------------------------------------------------------ fleet / months
+    def monthly(self, route_id=None, direction_id=None, pv: PVChoice | None = None) -> pd.DataFrame:
+        """The run's PV energy per month rescaled to *pv* (linear in kWp and PR or losses).
+
+        Parameters
+        ----------
+        route_id, direction_id : a route-direction, or ``None`` for the fleet
+
+        Returns
+        -------
+        DataFrame: ``month``, ``trips``, kWh ``allsky, clearsky, allsky_unshaded,
+        clearsky_unshaded, consumption``, ``shading_loss`` (all-sky, 1 - (direct + diffuse)
+        / unshaded), ``share`` (all-sky PV / consumption).
+        """
+        rm = self.route_month
+        cols = ["month", "trips", "allsky", "clearsky", "allsky_unshaded", "clearsky_unshaded",
+                "consumption", "shading_loss", "share"]
+        if rm.empty:
+            return pd.DataFrame(columns=cols)
+        if route_id is not None:
+            rm = rm[rm["route_id"] == str(route_id)]
+            if direction_id is not None:
+                rm = rm[rm["direction_id"].fillna(0).astype(int) == int(direction_id)]
+        f = (pv or self.run_pv_choice).linear_factor() / self.run_pv_choice.linear_factor()
+        agg = rm.groupby("month", sort=True)[["trips", "pv_kwh", "pv_kwh_clear", "pv_kwh_unshaded",
+                                              "pv_kwh_clear_unshaded", "pv_kwh_direct",
+                                              "pv_kwh_diffuse", "consumption_kwh"]].sum()
+        out = pd.DataFrame({"month": agg.index.astype(str), "trips": agg["trips"].to_numpy(),
+                            "allsky": agg["pv_kwh"].to_numpy() * f,
+                            "clearsky": agg["pv_kwh_clear"].to_numpy() * f,
+                            "allsky_unshaded": agg["pv_kwh_unshaded"].to_numpy() * f,
+                            "clearsky_unshaded": agg["pv_kwh_clear_unshaded"].to_numpy() * f,
+                            "consumption": agg["consumption_kwh"].to_numpy()})
+        uns = agg["pv_kwh_unshaded"].to_numpy()
+        dd = (agg["pv_kwh_direct"] + agg["pv_kwh_diffuse"]).to_numpy()
+        out["shading_loss"] = np.where(uns > 0, 1 - dd / np.where(uns > 0, uns, 1), np.nan)
+        out["share"] = out["allsky"] / out["consumption"].where(out["consumption"] > 0)
+        return out
+
+
+def with_pv(choice: PVChoice, **changes) -> PVChoice:
+    """A copy of *choice* with fields changed."""
+    return replace(choice, **changes)
