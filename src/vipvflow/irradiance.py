@@ -33,6 +33,9 @@ energy collectors, Solar Energy 7(2), 53-74.  pvlib: ``pvlib.irradiance.get_tota
 """
 from __future__ import annotations
 
+import threading
+import time
+
 import numpy as np
 import pandas as pd
 
@@ -43,6 +46,20 @@ _GOLDEN = (np.sqrt(5.0) - 1.0) / 2.0
 _CHUNK = 1 << 20        # passes per chunk in evaluate_passes
 _MIN_REFLECTOR_LIFT = 0.02   # m: a reflector's sun ray starts off its own surface
 _GROUND_CODES = [SURFACE_CODE["ground"], SURFACE_CODE["terrain"]]   # lit like open ground
+_STAGES = threading.local()
+
+
+def stage_seconds() -> dict:
+    """Seconds this thread has spent in the stages of the hot path (a running total, read
+    it before and after a call and subtract): ``lookup_s`` radiation and sun lookup,
+    ``ray_setup_s`` building the occlusion batch (direct and reflector rays), ``rays_s`` the
+    Embree occlusion query, ``components_s`` direct, diffuse and reflected arithmetic,
+    ``pack_s`` packing the geometry and filling the output (timed per chunk of passes)."""
+    s = getattr(_STAGES, "s", None)
+    if s is None:
+        s = _STAGES.s = dict.fromkeys(("lookup_s", "ray_setup_s", "rays_s", "components_s",
+                                       "pack_s"), 0.0)
+    return s
 
 
 # ---------------------------------------------------------------------------- roof plane
@@ -431,6 +448,8 @@ def roof_irradiance(geometry, rows, sun: np.ndarray, rad: dict, scene, cfg: Irra
     sun, all in one occlusion query; the same visibility serves all-sky and clear-sky.
     """
     f32 = np.float32
+    clock = stage_seconds()
+    t_start = time.perf_counter()
     geo = geometry if isinstance(geometry, dict) else pack_geometry(geometry, cfg, ground_albedo)
     rows = np.asarray(rows, np.int64)
     sun = np.asarray(sun, f32)
@@ -466,7 +485,12 @@ def roof_irradiance(geometry, rows, sun: np.ndarray, rad: dict, scene, cfg: Irra
         if len(pi):
             np.take(gp, rows[lit][pi] * G + gi, axis=0, out=o[nd:].reshape(-1, P, 3))
             d[nd:].reshape(-1, P, 3)[:] = sl[pi][:, None, :]
+        t_rays = time.perf_counter()
         occ = scene.occluded(o, d, cfg.ray_length_m)
+        t_done = time.perf_counter()
+        clock["ray_setup_s"] += t_rays - t_start
+        clock["rays_s"] += t_done - t_rays
+        t_start = t_done
         visible[cand] = ~occ[:nd]
     iso = (f32(1) + nz) * f32(0.5)
     sky = geo["svf"][rows] if cfg.diffuse_model == "sky_view_factor" else iso
@@ -484,6 +508,7 @@ def roof_irradiance(geometry, rows, sun: np.ndarray, rad: dict, scene, cfg: Irra
     else:
         refl = np.zeros(n, f32)
         refl_c = np.zeros(n, f32)
+    clock["components_s"] += time.perf_counter() - t_start
     return {"direct": direct, "diffuse": diffuse, "reflected": refl,
             "total": direct + diffuse + refl,
             "direct_clear": direct_c, "diffuse_clear": diffuse_c, "reflected_clear": refl_c,
@@ -521,6 +546,8 @@ def evaluate_passes(passes: pd.DataFrame, segments: pd.DataFrame, geometry: pd.D
     """
     cfg = cfg or IrradianceCfg()
     del segments
+    clock = stage_seconds()
+    t_pack = time.perf_counter()
     ids = geometry["segment_id"].to_numpy(np.int64)
     pos = np.full(int(ids.max()) + 1 if len(ids) else 1, -1, np.int64)
     pos[ids] = np.arange(len(ids))
@@ -537,18 +564,23 @@ def evaluate_passes(passes: pd.DataFrame, segments: pd.DataFrame, geometry: pd.D
     columns = list(COMPONENTS) + ["ghi", "ghi_clear"]
     block = np.empty((len(columns), n), np.float32).T      # column-major: one block per column
     visible = np.empty(n, bool)
+    clock["pack_s"] += time.perf_counter() - t_pack
     for a in range(0, n, _CHUNK):
         sl = slice(a, min(n, a + _CHUNK))
+        t_look = time.perf_counter()
         r = row[sl]
         loc = None if loc_col is None else loc_col[r]
         rad = radiation_table.lookup(t[sl], location=loc, angles=False)
         sun = np.stack([rad["sun_x"], rad["sun_y"], rad["sun_z"]], 1)
+        clock["lookup_s"] += time.perf_counter() - t_look
         out = roof_irradiance(geo, r, sun, rad, scene, cfg, ground_albedo)
+        t_pack = time.perf_counter()
         for j, k in enumerate(COMPONENTS):
             block[sl, j] = out[k]
         block[sl, -2] = np.nan_to_num(rad["ghi"])
         block[sl, -1] = np.nan_to_num(rad["ghi_clear"])
         visible[sl] = out["sun_visible"]
+        clock["pack_s"] += time.perf_counter() - t_pack
     df = pd.DataFrame(block, index=passes.index, columns=columns, copy=False)
     df["sun_visible"] = visible
     return df

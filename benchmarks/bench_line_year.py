@@ -1,0 +1,72 @@
+"""One bus line-year through the whole pipeline: the demo's 18 km line ``L1`` for 2024.
+
+``run_simulation`` with ``run.routes: [L1]`` on a LocalCluster of 2 worker processes, from a
+fresh output folder (nothing resumed); the demo's inputs are generated and ingested once
+into ``benchmarks/work/demo-full`` and reused (the first ingest's time is reported apart).
+
+Figures: wall time of the run (cluster start, per-tile geometry, 12 months x tiles of
+partitions, reduce, report, manifest), segment passes and passes per second, peak RSS of
+the whole process tree (this process + nanny + workers), BVH builds, and where the
+workers' time goes: the per-partition timings of the manifest, with the irradiance time
+split by :func:`vipvflow.irradiance.stage_seconds` (radiation lookup, ray setup, Embree
+rays, component arithmetic incl. reflection, packing) next to pass generation, the
+per-trip/segment/hour aggregation and the writing of the partition files.
+
+``tiny``: the small demo (3 km line), one month.
+"""
+from __future__ import annotations
+
+import json
+import sys
+
+from benchmarks.common import YEAR, demo_config, fresh_dir, prepare_demo, remove, run_pipeline, stage_split
+
+
+def run(tiny: bool = False) -> dict:
+    size = "small" if tiny else "full"
+    months = [6] if tiny else list(range(1, 13))
+    prep = prepare_demo(size)
+    out = fresh_dir("line_year")
+    try:
+        cfg = demo_config(size, out_dir=out, routes=["L1"], months=months, n_workers=2)
+        r = run_pipeline(cfg, YEAR, n_workers=2)
+    finally:
+        remove(out)
+    m = r["manifest"]
+    passes = m["passes_computed"]
+    builds = m["bvh_builds_per_worker"]
+    n_builds = sum(sum(v.values()) for v in builds.values())
+    tiles = len({t for v in builds.values() for t in v})
+    split = stage_split(m)
+    timings = m["timings_s"]
+    figures = {
+        "wall_s": round(r["wall_s"], 2),
+        "passes": passes,
+        "passes_per_s": round(passes / r["wall_s"]),
+        "map_s": timings.get("map_s"),
+        "reduce_s": timings.get("reduce_s"),
+        "peak_rss_gb": round(r["peak_rss_mb"] / 1024, 3),
+        "peak_rss_main_gb": round(r["peak_rss_main_mb"] / 1024, 3),
+        "partitions": m["partitions_computed"],
+        "bvh_builds": n_builds,
+        "bvh_builds_per_tile": round(n_builds / max(tiles, 1), 2),
+        "share_rays": split["rays_share"],
+        "share_lookup": split["lookup_share"],
+        "share_components": split["components_share"],
+        "share_ray_setup": split["ray_setup_share"],
+        "share_aggregate": split["aggregate_share"],
+        "share_passes": split["passes_share"],
+        "share_write": split["write_share"],
+        "share_pack": split["pack_share"],
+        "share_load_and_other": split["load_and_other_share"],
+        "ingest_s_first": prep["ingest_s"],
+    }
+    targets = {"wall_s": "< 60 (goal 10)", "peak_rss_gb": "< 4",
+               "bvh_builds_per_tile": "<= 2 (once per worker)"}
+    return {"figures": figures, "targets": targets, "stage_split_s": split,
+            "run_timings_s": timings, "bvh_builds_per_worker": builds, "prepare": prep,
+            "config": {"size": size, "routes": ["L1"], "months": months, "workers": 2}}
+
+
+if __name__ == "__main__":  # pragma: no cover
+    print(json.dumps(run(tiny="--tiny" in sys.argv), indent=2, default=str))

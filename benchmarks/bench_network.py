@@ -1,0 +1,232 @@
+"""A national-size network for one representative week, and the year extrapolated.
+
+A synthetic GTFS feed of 200 bus lines over the demo town's streets (the demo
+city, its terrain and its CAMS year are reused as ingested): each line is a stretch of one
+demo street (5-15 km), or runs along one street to the centre and out along the other; the
+lines overlap like the trunk corridors of a real network.  Stops every 400 m, 20 km/h with
+dwell, two directions, weekday headways of 10 to 120 min (05:00-23:00), Saturday at twice
+and Sunday at three times the weekday headway.  The calendar holds one week, Monday
+10 to Sunday 16 June 2024 (long days: more daytime passes, more rays than an average week).
+
+The feed is ingested (timed apart), then :func:`run_simulation` runs the week (run.months
+[6]) on a LocalCluster of 2 workers from a fresh output folder.  Figures: lines, segments,
+trips and passes of the week, wall time, passes per second, peak RSS, and the year
+**extrapolated** as the week x 52.2 (passes and wall time; not measured).
+
+``tiny``: the small demo's street, 4 lines, one weekday.
+"""
+from __future__ import annotations
+
+import datetime as dt
+import io
+import json
+import os
+import sys
+import time
+import zipfile
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from benchmarks.common import (WORK, YEAR, PeakRSS, demo_config, demo_paths, fresh_dir, prepare_demo,
+                               remove, run_pipeline)
+
+WEEKS_PER_YEAR = 365.25 / 7
+WEEK_START = dt.date(2024, 6, 10)         # a Monday
+HEADWAYS_MIN = (10, 15, 20, 30, 30, 60, 60, 120)
+SERVICES = {"WD": ((1, 1, 1, 1, 1, 0, 0), "05:00", "23:00", 1),
+            "SA": ((0, 0, 0, 0, 0, 1, 0), "06:00", "23:00", 2),
+            "SU": ((0, 0, 0, 0, 0, 0, 1), "07:00", "22:00", 3)}
+
+
+def sub_polyline(xy: np.ndarray, s0: float, s1: float) -> np.ndarray:
+    """The part of a polyline between distances *s0* and *s1* (m), reversed when s1 < s0."""
+    from vipvflow.demo.layout import cumulative_length, point_at
+
+    cum = cumulative_length(xy)
+    a, b = sorted((s0, s1))
+    inner = xy[(cum > a) & (cum < b)]
+    part = np.concatenate([point_at(xy, [a]), inner, point_at(xy, [b])])
+    return part if s0 <= s1 else part[::-1]
+
+
+def network_paths(layout, n_lines: int, seed: int = 11) -> list[np.ndarray]:
+    """*n_lines* polylines (EPSG:2169) over the streets of *layout*."""
+    from vipvflow.demo.layout import CENTRE_XY, cumulative_length
+
+    rng = np.random.default_rng(seed)
+    streets = [line.xy for line in layout.lines]
+    lengths = [float(cumulative_length(xy)[-1]) for xy in streets]
+    centre = []
+    for xy in streets:
+        fine = sub_polyline(xy, 0, cumulative_length(xy)[-1])
+        cum = cumulative_length(fine)
+        centre.append(float(cum[np.argmin(np.hypot(*(fine - CENTRE_XY).T))]))
+    paths = []
+    while len(paths) < n_lines:
+        if len(streets) > 1 and rng.random() < 0.4:        # along one street to the centre, out another
+            i, j = rng.choice(len(streets), 2, replace=False)
+            a = np.clip(centre[i] + rng.choice([-1, 1]) * rng.uniform(1500, 7000), 0, lengths[i])
+            b = np.clip(centre[j] + rng.choice([-1, 1]) * rng.uniform(1500, 7000), 0, lengths[j])
+            path = np.concatenate([sub_polyline(streets[i], a, centre[i]),
+                                   sub_polyline(streets[j], centre[j], b)[1:]])
+        else:
+            i = rng.integers(len(streets))
+            length = min(rng.uniform(5000, 15000), lengths[i] * 0.95)
+            s0 = rng.uniform(0, lengths[i] - length)
+            path = sub_polyline(streets[i], s0, s0 + length) if rng.random() < 0.5 else \
+                sub_polyline(streets[i], s0 + length, s0)
+        if cumulative_length(path)[-1] > 1000:
+            paths.append(path)
+    return paths
+
+
+def _hm(text: str) -> int:
+    h, m = text.split(":")
+    return int(h) * 3600 + int(m) * 60
+
+
+def write_network_gtfs(path: Path, paths: list[np.ndarray], days: list[dt.date], seed: int = 12) -> dict:
+    """A GTFS zip of one line per polyline, running on *days*; returns counts."""
+    from pyproj import Transformer
+
+    from vipvflow.demo.gtfs import _blocks, gtfs_time, stop_offsets, stop_positions
+    from vipvflow.demo.layout import cumulative_length, densify, point_at
+
+    rng = np.random.default_rng(seed)
+    to_wgs84 = Transformer.from_crs("EPSG:2169", "EPSG:4326", always_xy=True)
+    stops, shapes, trips, stop_times, routes = [], [], [], [], []
+    for k, xy in enumerate(paths):
+        rid = f"N{k:03d}"
+        length = float(cumulative_length(xy)[-1])
+        headway = int(rng.choice(HEADWAYS_MIN))
+        routes.append({"route_id": rid, "agency_id": "NET", "route_short_name": str(k + 100),
+                       "route_long_name": f"Network line {k + 100}", "route_type": 3})
+        pts = densify(xy, 20.0)
+        cum = cumulative_length(pts)
+        lon, lat = to_wgs84.transform(pts[:, 0], pts[:, 1])
+        stop_s = stop_positions(length)
+        slon, slat = to_wgs84.transform(*point_at(xy, stop_s).T)
+        arr, dep = stop_offsets(stop_s)
+        for d in (0, 1):
+            order = slice(None) if d == 0 else slice(None, None, -1)
+            shapes.append(pd.DataFrame({
+                "shape_id": f"{rid}_d{d}", "shape_pt_lat": np.round(lat[order], 7),
+                "shape_pt_lon": np.round(lon[order], 7), "shape_pt_sequence": np.arange(len(pts)),
+                "shape_dist_traveled": np.round(cum if d == 0 else (cum[-1] - cum)[::-1], 2)}))
+            stops.append(pd.DataFrame({
+                "stop_id": [f"{rid}_S{i:02d}_d{d}" for i in range(len(stop_s))],
+                "stop_name": [f"{rid} stop {i}" for i in range(len(stop_s))],
+                "stop_lat": np.round(slat, 7), "stop_lon": np.round(slon, 7)}))
+        for sid, (_, start, end, factor) in SERVICES.items():
+            t0 = np.arange(_hm(start), _hm(end), headway * 60 * factor, dtype=np.int64)
+            buses = _blocks(t0, t0, int(arr[-1]))
+            for d in (0, 1):
+                ids = [f"{rid}_{sid}_d{d}_{i:03d}" for i in range(len(t0))]
+                trips.append(pd.DataFrame({
+                    "route_id": rid, "service_id": sid, "trip_id": ids, "direction_id": d,
+                    "block_id": [f"{rid}_{sid}_B{b:02d}" for b in buses[d]],
+                    "shape_id": f"{rid}_d{d}"}))
+                idx = np.arange(len(stop_s)) if d == 0 else np.arange(len(stop_s))[::-1]
+                dist = stop_s if d == 0 else length - stop_s[::-1]
+                n = len(stop_s)
+                stop_times.append(pd.DataFrame({
+                    "trip_id": np.repeat(ids, n),
+                    "arrival_time": gtfs_time((t0[:, None] + arr[None, :]).ravel()),
+                    "departure_time": gtfs_time((t0[:, None] + dep[None, :]).ravel()),
+                    "stop_id": np.tile([f"{rid}_S{i:02d}_d{d}" for i in idx], len(t0)),
+                    "stop_sequence": np.tile(np.arange(1, n + 1), len(t0)),
+                    "shape_dist_traveled": np.tile(np.round(np.abs(dist), 2), len(t0)),
+                    "timepoint": 1}))
+    start, end = min(days).strftime("%Y%m%d"), max(days).strftime("%Y%m%d")
+    weekdays = {d.weekday() for d in days}
+    names = ["monday", "tuesday", "wednesday", "thursday", "friday", "saturday", "sunday"]
+    calendar = pd.DataFrame([{"service_id": sid, **{names[i]: int(mask[i] and i in weekdays) for i in range(7)},
+                              "start_date": start, "end_date": end}
+                             for sid, (mask, *_rest) in SERVICES.items()])
+    tables = {
+        "agency.txt": pd.DataFrame([{"agency_id": "NET", "agency_name": "vipvflow benchmark network",
+                                     "agency_url": "https://example.org/vipvflow-bench",
+                                     "agency_timezone": "Europe/Luxembourg"}]),
+        "routes.txt": pd.DataFrame(routes), "stops.txt": pd.concat(stops),
+        "trips.txt": pd.concat(trips), "stop_times.txt": pd.concat(stop_times),
+        "calendar.txt": calendar, "shapes.txt": pd.concat(shapes),
+    }
+    tmp = path.with_name(path.name + ".tmp")
+    with zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as zf:
+        for name, df in tables.items():
+            buf = io.StringIO()
+            df.to_csv(buf, index=False, lineterminator="\n")
+            zf.writestr(name, buf.getvalue())
+    os.replace(tmp, path)
+    return {"lines": len(paths), "trips": int(len(tables["trips.txt"])),
+            "stop_times": int(len(tables["stop_times.txt"])),
+            "network_km": round(sum(float(np.hypot(*np.diff(p, axis=0).T).sum()) for p in paths) / 1000, 1)}
+
+
+def run(tiny: bool = False) -> dict:
+    from vipvflow.demo.layout import build_layout
+    from vipvflow.simulation.prepare import ensure_ingested
+
+    size = "small" if tiny else "full"
+    n_lines = 4 if tiny else 200
+    days = [dt.date(2024, 6, 12)] if tiny else [WEEK_START + dt.timedelta(days=i) for i in range(7)]
+    prepare_demo(size)
+    demo = demo_paths(size)
+    root = WORK / f"network-{size}"
+    data_dir = root / "data"
+    data_dir.mkdir(parents=True, exist_ok=True)
+    for part in ("city", "radiation"):                   # the demo's city and sun, as ingested
+        link = data_dir / part
+        if not link.exists():
+            link.symlink_to(demo["data"] / part, target_is_directory=True)
+    feed = root / f"network_{n_lines}_lines_{len(days)}d.zip"
+    t = time.perf_counter()
+    counts = write_network_gtfs(feed, network_paths(build_layout(42, size), n_lines), days)
+    write_s = time.perf_counter() - t
+    inputs = {"citygml": [str(demo["input"] / "demo_city.gml")], "gtfs": str(feed),
+              "cams": [str(demo["input"] / "cams_radiation_demo.csv")]}
+    out = fresh_dir("network")
+    try:
+        cfg = demo_config(size, data_dir=data_dir, out_dir=out, months=[6], n_workers=2,
+                          inputs=inputs, scenario=f"network-{size}")
+        with PeakRSS() as mem:
+            t = time.perf_counter()
+            ensure_ingested(cfg, say=lambda *a: None)
+            ingest_s = time.perf_counter() - t
+        r = run_pipeline(cfg, YEAR, n_workers=2)
+        segments = len(pd.read_parquet(data_dir / "gtfs" / "segments.parquet", columns=["tile"]))
+        trip_days = len(pd.read_parquet(r["run_dir"] / "trip_energy.parquet", columns=["trip_id"]))
+    finally:
+        remove(out)
+    m = r["manifest"]
+    passes = m["passes_computed"]
+    week = len(days) == 7
+    figures = {
+        "lines": counts["lines"],
+        "network_km": counts["network_km"],
+        "segments": segments,
+        "trips_run": trip_days,
+        "passes": passes,
+        "wall_s": round(r["wall_s"], 1),
+        "map_s": m["timings_s"].get("map_s"),
+        "reduce_s": m["timings_s"].get("reduce_s"),
+        "passes_per_s": round(passes / r["wall_s"]),
+        "peak_rss_gb": round(r["peak_rss_mb"] / 1024, 3),
+        "gtfs_ingest_s": round(ingest_s, 1),
+        "year_passes_extrapolated": round(passes * (WEEKS_PER_YEAR if week else 365.25)),
+        "year_wall_min_extrapolated": round(r["wall_s"] * (WEEKS_PER_YEAR if week else 365.25) / 60, 1),
+    }
+    targets = {"wall_s": "< 600 here", "year_wall_min_extrapolated": "minutes (national network-year)"}
+    return {"figures": figures, "targets": targets,
+            "extrapolation": f"year = this {'week' if week else 'day'} x "
+                             f"{WEEKS_PER_YEAR if week else 365.25:.2f} (not measured; June days are "
+                             "long, so it leans high)",
+            "feed": counts, "feed_write_s": round(write_s, 1), "ingest_peak_rss_mb": round(mem.peak_mb),
+            "days": [d.isoformat() for d in days], "run_timings_s": m["timings_s"],
+            "partition_timings_s": m["partition_timings_s"]}
+
+
+if __name__ == "__main__":  # pragma: no cover
+    print(json.dumps(run(tiny="--tiny" in sys.argv), indent=2, default=str))

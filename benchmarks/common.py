@@ -1,0 +1,191 @@
+"""Helpers shared by the pipeline benchmarks.
+
+- :class:`PeakRSS`: peak resident memory of this process and all its descendants (the Dask
+  nanny and worker processes of a LocalCluster), sampled by a thread with psutil;
+- :func:`prepare_demo`: the demo scenario generated and ingested once into
+  ``benchmarks/work/demo-<size>/`` (gitignored), timed the first time and cached after;
+- :func:`demo_config` / :func:`run_pipeline`: a configuration for a part of the demo and one
+  timed :func:`vipvflow.simulation.run.run_simulation` of it from a fresh output folder.
+"""
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import threading
+import time
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+WORK = HERE / "work"
+YEAR = 2024
+
+
+class PeakRSS:
+    """Peak RSS (MB) of a process tree, sampled every *interval_s* while the block runs.
+
+    ``with PeakRSS() as mem: ...`` then ``mem.peak_mb`` (sum over the tree at the sampled
+    moment of its largest total) and ``mem.peak_self_mb`` (this process alone).  Sampling
+    misses peaks shorter than the interval; the OS high-water mark of this process is also
+    taken into account for ``peak_self_mb``.
+    """
+
+    def __init__(self, pid: int | None = None, interval_s: float = 0.05):
+        self.pid = pid or os.getpid()
+        self.interval_s = interval_s
+        self.peak_mb = 0.0
+        self.peak_self_mb = 0.0
+        self.samples = 0
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._poll, daemon=True, name="peak-rss")
+
+    def _sample(self, root) -> None:
+        import psutil
+
+        total = 0
+        try:
+            own = root.memory_info().rss
+        except psutil.Error:
+            return
+        total = own
+        for child in root.children(recursive=True):
+            try:
+                total += child.memory_info().rss
+            except psutil.Error:
+                pass
+        self.peak_mb = max(self.peak_mb, total / 2**20)
+        self.peak_self_mb = max(self.peak_self_mb, own / 2**20)
+        self.samples += 1
+
+    def _poll(self) -> None:
+        import psutil
+
+        root = psutil.Process(self.pid)
+        while not self._stop.is_set():
+            self._sample(root)
+            self._stop.wait(self.interval_s)
+
+    def __enter__(self) -> "PeakRSS":
+        self._thread.start()
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self._stop.set()
+        self._thread.join()
+        if self.pid == os.getpid():
+            import resource
+
+            self.peak_self_mb = max(self.peak_self_mb,
+                                    resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024)
+
+
+def _quiet(*_args, **_kw) -> None:
+    pass
+
+
+def demo_paths(size: str) -> dict:
+    root = WORK / f"demo-{size}"
+    return {"root": root, "input": root / "input", "data": root / "data"}
+
+
+def demo_config(size: str = "full", *, data_dir: Path | None = None, out_dir: Path | None = None,
+                routes=None, months=None, n_workers: int | None = None, inputs: dict | None = None,
+                scenario: str | None = None):
+    """The demo scenario of *size* with its inputs and data under ``benchmarks/work``."""
+    from vipvflow.config import load_config
+
+    p = demo_paths(size)
+    over = {
+        "scenario": scenario or f"bench-{size}",
+        "data_dir": str(data_dir or p["data"]),
+        "out_dir": str(out_dir or WORK / "runs"),
+        "demo": {"enabled": inputs is None, "seed": 42, "size": size},
+        "inputs": inputs or {"citygml": [str(p["input"] / "demo_city.gml")],
+                             "gtfs": str(p["input"] / "demo_gtfs.zip"),
+                             "cams": [str(p["input"] / "cams_radiation_demo.csv")]},
+        "run": {"months": list(months or range(1, 13)), "routes": routes},
+    }
+    if n_workers:
+        over["dask"] = {"n_workers": n_workers}
+    return load_config(None, over)
+
+
+def prepare_demo(size: str = "full", year: int = YEAR) -> dict:
+    """Generate and ingest the demo of *size* once; return the times of the first preparation
+    (``generate_s``, ``ingest_s``) and whether this call found it already done."""
+    from vipvflow.simulation.prepare import ensure_demo, ensure_ingested
+
+    p = demo_paths(size)
+    stamp = p["root"] / "prepared.json"
+    cfg = demo_config(size)
+    t0 = time.perf_counter()
+    ensure_demo(cfg, year, say=_quiet)
+    t1 = time.perf_counter()
+    ensure_ingested(cfg, say=_quiet)
+    t2 = time.perf_counter()
+    cached = stamp.exists() and (t2 - t0) < 5.0
+    if not cached:
+        stamp.write_text(json.dumps({"generate_s": round(t1 - t0, 2), "ingest_s": round(t2 - t1, 2),
+                                     "size": size, "year": year}))
+    info = json.loads(stamp.read_text())
+    info["cached"] = cached
+    return info
+
+
+def fresh_dir(name: str) -> Path:
+    """An empty folder ``benchmarks/work/runs/<name>-<pid>-<ns>`` (nothing to resume)."""
+    path = WORK / "runs" / f"{name}-{os.getpid()}-{time.time_ns()}"
+    path.mkdir(parents=True)
+    return path
+
+
+def remove(path: Path) -> None:
+    """Delete a benchmark's output folder unless ``VIPVFLOW_BENCH_KEEP`` is set."""
+    if not os.environ.get("VIPVFLOW_BENCH_KEEP"):
+        shutil.rmtree(path, ignore_errors=True)
+
+
+def run_pipeline(cfg, year: int = YEAR, n_workers: int | None = None) -> dict:
+    """One :func:`run_simulation` of *cfg*: wall time, peak RSS of the process tree, manifest."""
+    from vipvflow.simulation.run import run_simulation
+
+    log: list[str] = []
+    with PeakRSS() as mem:
+        t0 = time.perf_counter()
+        run_dir = run_simulation(cfg, year, n_workers=n_workers, say=lambda *a: log.append(" ".join(map(str, a))))
+        wall = time.perf_counter() - t0
+    manifest = json.loads((run_dir / "manifest.json").read_text())
+    return {"wall_s": wall, "peak_rss_mb": mem.peak_mb, "peak_rss_main_mb": mem.peak_self_mb,
+            "run_dir": run_dir, "manifest": manifest, "log": log}
+
+
+def stage_split(manifest: dict) -> dict:
+    """Worker time per stage (s, summed over partitions) and each stage's share of the sum.
+
+    Stages: pass generation, radiation lookup, ray-batch setup, Embree rays, irradiance
+    components (direct, diffuse, reflected), packing, per-trip/segment/hour aggregation, and
+    writing the partition files; ``load_and_other`` is the rest of the irradiance call (the
+    worker's first load of the radiation table and of the tile's BVH).  The per-tile
+    geometry tasks (sky view factor, reflector rays) are not in the partition timings.
+    """
+    t = manifest.get("partition_timings_s", {})
+    stages = {
+        "passes": t.get("passes_s", 0.0),
+        "lookup": t.get("irradiance_lookup_s", 0.0),
+        "ray_setup": t.get("irradiance_ray_setup_s", 0.0),
+        "rays": t.get("irradiance_rays_s", 0.0),
+        "components": t.get("irradiance_components_s", 0.0),
+        "pack": t.get("irradiance_pack_s", 0.0),
+        "aggregate": t.get("reduce_s", 0.0),
+        "write": t.get("write_s", 0.0),
+    }
+    untracked = t.get("irradiance_s", 0.0) - sum(stages[k] for k in
+                                                  ("lookup", "ray_setup", "rays", "components", "pack"))
+    # the rest of irradiance_s: the worker's first load of the radiation table (sun positions)
+    # and of the tile's BVH, both cached afterwards, and the segment index of evaluate_passes
+    stages["load_and_other"] = max(untracked, 0.0)
+    total = sum(stages.values())
+    out = {f"{k}_s": round(v, 2) for k, v in stages.items()}
+    out.update({f"{k}_share": round(v / total, 3) if total else 0.0 for k, v in stages.items()})
+    out["partition_work_s"] = round(total, 2)
+    return out

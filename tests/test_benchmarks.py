@@ -1,0 +1,58 @@
+"""Smoke test of the benchmarks: every one runs on a tiny input and writes its JSON.
+
+Nothing is asserted about time (tests never assert wall-clock figures); only that each
+benchmark completes, writes ``<name>.tiny.json`` with figures and targets, and that the
+figures that are facts rather than speeds hold (equal results, agreeing engines).
+"""
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+NAMES = sorted(p.stem[len("bench_"):] for p in (ROOT / "benchmarks").glob("bench_*.py"))
+
+
+def _postgres_available() -> bool:
+    from vipvflow.db.server import find_bindir, postgis_available
+
+    bindir = find_bindir()
+    return bindir is not None and postgis_available(bindir)
+
+
+@pytest.fixture(scope="module")
+def tiny_results(tmp_path_factory):
+    results = tmp_path_factory.mktemp("bench-results")
+    names = [n for n in NAMES if n != "postgis" or _postgres_available()]
+    proc = subprocess.run([sys.executable, "-m", "benchmarks", *names, "--tiny", "--results", str(results)],
+                          cwd=ROOT, capture_output=True, text=True, timeout=1800,
+                          env={**os.environ, "PYTHONPATH": str(ROOT)})
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    return results, names, proc.stdout
+
+
+def test_every_benchmark_writes_its_json(tiny_results):
+    results, names, stdout = tiny_results
+    for name in names:
+        doc = json.loads((results / f"{name}.tiny.json").read_text())
+        assert doc["name"] == name and doc["tiny"] is True
+        assert doc["figures"], name
+        assert set(doc["targets"]) <= set(doc["figures"]), name
+    assert "benchmark" in stdout.splitlines()[0]
+
+
+def test_facts_in_the_tiny_results(tiny_results):
+    results, names, _ = tiny_results
+    scaling = json.loads((results / "scaling.tiny.json").read_text())["figures"]
+    assert scaling["results_equal"] is True
+    line = json.loads((results / "line_year.tiny.json").read_text())["figures"]
+    assert line["passes"] > 0 and line["partitions"] > 0
+    if "postgis" in names:
+        pg = json.loads((results / "postgis.tiny.json").read_text())["figures"]
+        # every disagreement between PostGIS and Embree must be a graze (1 mm changes it)
+        assert pg["agreement_apart_from_grazes"] == 1.0
