@@ -150,6 +150,9 @@ class DaskCfg(_Model):
     threads_per_worker: int | None = Field(None, gt=0)
     memory_limit: str = "auto"
     bvh_cache_size: int = Field(8, gt=0)
+    # Embree threads per partition task; null: cores / workers on a LocalCluster, 1 on a
+    # remote cluster (one task per worker thread already fills the cores)
+    ray_threads: int | None = Field(None, gt=0)
 
 
 class RunCfg(_Model):

@@ -173,11 +173,12 @@ _cache: "collections.OrderedDict[tuple, Scene]" = collections.OrderedDict()
 _cache_lock = threading.Lock()
 
 
-def get_scene(data_dir, tile: str, cache_size: int = 8) -> Scene:
+def get_scene(data_dir, tile: str, cache_size: int = 8, n_threads: int | None = None) -> Scene:
     """The :class:`Scene` of a tile, from a bounded LRU cache of this process.
 
     Loads ``city/meshes/<tile>.npz`` and builds the BVH on a miss; each build is counted in
-    :data:`BVH_BUILDS` under the key ``(data_dir, tile)``.
+    :data:`BVH_BUILDS` under the key ``(data_dir, tile)``.  *n_threads* sets the ray-casting
+    threads of a new scene (default: the cores available).
     """
     key = (str(Path(data_dir).resolve()), tile)
     with _cache_lock:
@@ -185,7 +186,7 @@ def get_scene(data_dir, tile: str, cache_size: int = 8) -> Scene:
         if scene is not None:
             _cache.move_to_end(key)
             return scene
-    scene = Scene(TileMesh.load(Path(data_dir) / "city" / "meshes" / f"{tile}.npz"))
+    scene = Scene(TileMesh.load(Path(data_dir) / "city" / "meshes" / f"{tile}.npz"), n_threads=n_threads)
     with _cache_lock:
         BVH_BUILDS[key] += 1
         _cache[key] = scene

@@ -18,6 +18,7 @@ from ..config import IrradianceCfg, PVSystem
 from .storage import geometry_path, partition_path, write_parquet
 
 #: per-pass energy columns (kWh) and irradiation columns (Wh/m2) summed in a partition
+PV_COMPONENTS = ("direct", "diffuse", "reflected")
 VARIANTS = {
     "": "total", "_clear": "total_clear",
     "_unshaded": "total_unshaded", "_clear_unshaded": "total_clear_unshaded",
@@ -43,6 +44,7 @@ class RunContext:
     bvh_cache_size: int = 8
     ground_albedo: float = 0.2
     routes: tuple | None = None
+    ray_threads: int | None = None
     shapes: tuple | None = None
     route_of_trip: dict = field(default_factory=dict, compare=False, hash=False)
 
@@ -65,7 +67,7 @@ def _radiation(data_dir: str, year: int):
 def _scene(ctx: RunContext, tile: str):
     from ..shading import get_scene
 
-    return get_scene(ctx.data_dir, tile, cache_size=ctx.bvh_cache_size)
+    return get_scene(ctx.data_dir, tile, cache_size=ctx.bvh_cache_size, n_threads=ctx.ray_threads)
 
 
 def tile_geometry(ctx: RunContext, tile: str) -> pd.DataFrame:
@@ -129,14 +131,29 @@ def aggregate_partition(passes: pd.DataFrame, irr: pd.DataFrame, month: int, ctx
     """
     n = len(passes)
     dt = passes["dt_s"].to_numpy(np.float64)
-    speed = passes["speed_mps"].to_numpy(np.float64)
-    kwh = {f"pv_kwh{suffix}": pv_energy_kwh(irr[col].to_numpy(np.float64), dt, speed, month, ctx)
-           for suffix, col in VARIANTS.items()}
-    for comp in ("direct", "diffuse", "reflected"):
-        kwh[f"pv_kwh_{comp}"] = pv_energy_kwh(irr[comp].to_numpy(np.float64), dt, speed, month, ctx)
-    kwh["seconds"] = dt
     # irradiation (Wh/m2) received during each pass
     h = {f"h_{c}": irr[c].to_numpy(np.float64) * dt / 3600.0 for c in COMPONENTS}
+    pv_cols = [f"pv_kwh{suffix}" for suffix in VARIANTS] + [f"pv_kwh_{c}" for c in PV_COMPONENTS]
+    pv_source = {**{f"pv_kwh{suffix}": col for suffix, col in VARIANTS.items()},
+                 **{f"pv_kwh_{c}": c for c in PV_COMPONENTS}}
+    system = PVSystem(**ctx.pv_system)
+    linear = ctx.pv_mode == "paper"
+    if linear:
+        # paper mode is linear in the irradiation: kWh = kWp x PR x H / 1000 (H in Wh/m2),
+        # so the energy of any group of passes comes from its irradiation sum
+        sums = {"seconds": dt, **{f"h_{c}": h[f"h_{c}"] for c in sorted(set(pv_source.values()))}}
+    else:
+        speed = passes["speed_mps"].to_numpy(np.float64)
+        sums = {name: pv_energy_kwh(irr[col].to_numpy(np.float64), dt, speed, month, ctx)
+                for name, col in pv_source.items()}
+        sums["seconds"] = dt
+
+    def energy(table: dict) -> dict:
+        """PV kWh columns of a table of sums."""
+        if linear:
+            k = system.kwp * system.performance_ratio / 1000.0
+            return {name: k * table[f"h_{col}"] for name, col in pv_source.items()}
+        return {name: table[name] for name in pv_cols}
 
     # per trip and service date: runs of equal (date, trip) in the sorted passes
     trip_code = np.asarray(passes["trip_id"].cat.codes if hasattr(passes["trip_id"], "cat")
@@ -147,20 +164,22 @@ def aggregate_partition(passes: pd.DataFrame, irr: pd.DataFrame, month: int, ctx
         starts = np.concatenate([[0], change])
     else:
         starts = np.zeros(0, np.int64)
-    kwh_block = np.column_stack(list(kwh.values())) if n else np.zeros((0, len(kwh)))
-    sums = np.add.reduceat(kwh_block, starts, axis=0) if n else kwh_block
-    trip = pd.DataFrame(sums, columns=list(kwh))
+    names = list(sums)
+    block = np.column_stack([sums[k] for k in names]) if n else np.zeros((0, len(names)))
+    total = np.add.reduceat(block, starts, axis=0) if n else block
+    per_trip = {k: total[:, i] for i, k in enumerate(names)}
+    trip = pd.DataFrame({**energy(per_trip), "seconds": per_trip["seconds"]})
     trip.insert(0, "service_date", passes["service_date"].to_numpy()[starts])
     trip.insert(0, "trip_id", np.asarray(passes["trip_id"].to_numpy()[starts]).astype(str))
     trip = trip.groupby(["trip_id", "service_date"], sort=True).sum().reset_index()
 
     # per segment
     seg_ids, seg_pos = np.unique(passes["segment_id"].to_numpy(np.int64), return_inverse=True)
-    cols = {**kwh, **h}
+    cols = {**sums, **h}
+    per_seg = {name: np.bincount(seg_pos, weights=w, minlength=len(seg_ids)) for name, w in cols.items()}
     segm = pd.DataFrame({"segment_id": seg_ids,
-                         "n_passes": np.bincount(seg_pos, minlength=len(seg_ids)).astype(np.int64)})
-    for name in [c for c in kwh if c != "seconds"] + list(h) + ["seconds"]:
-        segm[name] = np.bincount(seg_pos, weights=cols[name], minlength=len(seg_ids))
+                         "n_passes": np.bincount(seg_pos, minlength=len(seg_ids)).astype(np.int64),
+                         **energy(per_seg), **{k: per_seg[k] for k in h}, "seconds": per_seg["seconds"]})
 
     # per local hour
     hour = _local_hours(passes["t_utc"].to_numpy(np.float64), ctx.timezone)

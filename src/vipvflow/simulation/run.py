@@ -1,6 +1,7 @@
 """Run a scenario-year on a Dask cluster: prepare, map over partitions, reduce, write."""
 from __future__ import annotations
 
+import dataclasses
 import json
 import logging
 import os
@@ -136,9 +137,14 @@ def run_simulation(cfg: Config, year: int, scheduler: str | None = None,
         todo = todo[:max_partitions]
     client, cluster = make_client(cfg, scheduler, n_workers)
     try:
+        n_workers_now = len(client.scheduler_info()["workers"])
+        # a LocalCluster's workers share the machine's cores for ray casting
+        ray_threads = cfg.dask.ray_threads or (
+            max(1, (os.cpu_count() or 1) // max(1, n_workers_now)) if cluster is not None else 1)
+        ctx = dataclasses.replace(ctx, ray_threads=ray_threads)
         say(f"dask dashboard: {client.dashboard_link}")
         say(f"{len(tiles)} tiles x {len(cfg.run.months)} months = {total} partitions, {len(todo)} to compute "
-            f"({total - len(todo)} already done) with {len(client.scheduler_info()['workers'])} workers")
+            f"({total - len(todo)} already done) with {n_workers_now} workers")
         t_map = time.perf_counter()
         results = _map(client, ctx, todo)
         timings["map_s"] = time.perf_counter() - t_map
