@@ -59,8 +59,9 @@ def make_client(cfg: Config, scheduler: str | None, n_workers: int | None):
 class FleetView:
     """Progress over partitions plus, per route, the partitions, trips and kWh done so far."""
 
-    def __init__(self, total: int, stream=sys.stderr, every_s: float = 2.0):
+    def __init__(self, total: int, stream=sys.stderr, every_s: float = 2.0, max_routes: int = 6):
         self.total, self.done, self.stream, self.every_s = total, 0, stream, every_s
+        self.max_routes = max_routes
         self.routes: dict[str, dict] = {}
         self._last = 0.0
         self.t0 = time.perf_counter()
@@ -80,8 +81,10 @@ class FleetView:
         width = 30
         filled = int(width * self.done / max(self.total, 1))
         bar = "#" * filled + "-" * (width - filled)
-        routes = "  ".join(f"{k}: {v['partitions']}p {v['kwh']:,.0f} kWh"
-                           for k, v in sorted(self.routes.items()))
+        top = sorted(self.routes.items(), key=lambda kv: -kv[1]["kwh"])[:self.max_routes]
+        routes = "  ".join(f"{k}: {v['partitions']}p {v['kwh']:,.0f} kWh" for k, v in top)
+        if len(self.routes) > self.max_routes:
+            routes += f"  (+{len(self.routes) - self.max_routes} routes)"
         print(f"\r[{bar}] {self.done}/{self.total} partitions  "
               f"{time.perf_counter() - self.t0:5.0f}s  {routes}", end="", file=self.stream, flush=True)
         if self.done == self.total:
