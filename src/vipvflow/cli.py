@@ -37,10 +37,16 @@ routes in a real 3D city (CityGML LoD2 + GTFS + CAMS radiation), set against wha
 buses consume.
 
 typical use:
-  vipvflow demo-data --out data/demo --year 2024     generate the embedded demo city
+  vipvflow demo-data --out data/demo/input --year 2024   generate the embedded demo town
   vipvflow simulate --config conf/demo.yaml --year 2024
   vipvflow simulate --config conf/luxembourg.yaml --year 2024 --scheduler tcp://host:8786
 """
+
+
+def register_all(subparsers, modules: list[str]) -> None:
+    """Let each module of :mod:`vipvflow.commands` named in *modules* add its subcommand."""
+    for name in modules:
+        importlib.import_module(f"vipvflow.commands.{name}").register(subparsers)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -51,14 +57,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("-v", "--verbose", action="count", default=0,
                         help="more log output (-vv for debug)")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
-    for name in COMMANDS:
-        try:
-            module = importlib.import_module(f"vipvflow.commands.{name}")
-        except ModuleNotFoundError as exc:
-            if exc.name == f"vipvflow.commands.{name}":
-                continue
-            raise
-        module.register(sub)
+    register_all(sub, COMMANDS)
     return parser
 
 

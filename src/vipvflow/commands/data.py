@@ -1,7 +1,6 @@
 """``vipvflow data fetch``: download the real datasets listed in ``data_manifest.yaml``."""
 from __future__ import annotations
 
-import hashlib
 import os
 import urllib.request
 from pathlib import Path
@@ -9,6 +8,7 @@ from pathlib import Path
 import yaml
 
 from ..errors import InputError
+from ..files import sha256
 
 
 def register(sub):
@@ -20,14 +20,6 @@ def register(sub):
     f.add_argument("names", nargs="*", help="datasets to fetch (default: all)")
     f.set_defaults(func=fetch)
     p.set_defaults(func=lambda args: p.print_help())
-
-
-def _sha256(path: Path) -> str:
-    h = hashlib.sha256()
-    with open(path, "rb") as fh:
-        for block in iter(lambda: fh.read(1 << 20), b""):
-            h.update(block)
-    return h.hexdigest()
 
 
 def fetch(args) -> int:
@@ -76,7 +68,7 @@ def fetch(args) -> int:
                 failed += 1
                 continue
             want = entry.get("sha256")
-            if want and _sha256(target) != want:
+            if want and sha256(target) != want:
                 print(f"{name}: checksum mismatch for {target}")
                 failed += 1
                 continue

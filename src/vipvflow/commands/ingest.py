@@ -5,20 +5,13 @@ defines ``register(subparsers)``.
 """
 from __future__ import annotations
 
-import importlib
-
 PARTS = ["ingest_city", "ingest_gtfs", "ingest_cams"]
 
 
 def register(sub):
     p = sub.add_parser("ingest", help="ingest CityGML, GTFS or CAMS files into a data dir")
     inner = p.add_subparsers(dest="what", metavar="WHAT")
-    for name in PARTS:
-        try:
-            module = importlib.import_module(f"vipvflow.commands.{name}")
-        except ModuleNotFoundError as exc:
-            if exc.name == f"vipvflow.commands.{name}":
-                continue
-            raise
-        module.register(inner)
+    from ..cli import register_all
+
+    register_all(inner, PARTS)
     p.set_defaults(func=lambda args: p.print_help())

@@ -11,7 +11,6 @@ The run directory is only read.
 """
 from __future__ import annotations
 
-import hashlib
 import io
 import json
 from collections.abc import Callable
@@ -24,6 +23,7 @@ import pyarrow.csv as pacsv
 import pyarrow.parquet as pq
 
 from ..errors import InputError, VipvError
+from ..files import sha256
 from . import schema as S
 
 COPY_BLOCK = 1 << 20  # bytes handed to COPY per write
@@ -149,14 +149,6 @@ def _arrow_type(sql_type: str) -> pa.DataType | None:
 
 
 # ---------------------------------------------------------------- reading the run
-
-def sha256(path: Path) -> str:
-    h = hashlib.sha256()
-    with open(path, "rb") as f:
-        for block in iter(lambda: f.read(1 << 20), b""):
-            h.update(block)
-    return h.hexdigest()
-
 
 def read_json(path: Path) -> dict:
     try:

@@ -1,23 +1,15 @@
 """Inputs of a run: generate the demo when asked, ingest each input once (cached by fingerprint)."""
 from __future__ import annotations
 
-import hashlib
 import json
 import logging
 from pathlib import Path
 
 from ..config import Config
 from ..errors import InputError
+from ..files import sha256
 
 log = logging.getLogger(__name__)
-
-
-def file_checksum(path: Path) -> str:
-    h = hashlib.sha256()
-    with open(path, "rb") as fh:
-        for block in iter(lambda: fh.read(1 << 20), b""):
-            h.update(block)
-    return h.hexdigest()
 
 
 def _fingerprint(paths: list[Path], extra: dict) -> dict:
@@ -95,7 +87,7 @@ def ensure_ingested(cfg: Config, say=print) -> dict:
         report = ingest_cams(cams_files, data_dir)
         say("  " + _summary(report))
         _stamp(stamp, cams_fp)
-    return {str(p): file_checksum(p) for p in [*city_files, gtfs, *cams_files]}
+    return {str(p): sha256(p) for p in [*city_files, gtfs, *cams_files]}
 
 
 def _summary(report) -> str:
