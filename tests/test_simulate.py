@@ -215,3 +215,17 @@ def test_vecto_cycles_written_and_vmod_replaces_consumption(small_run, small_con
     shutil.copy(next((test_data / "vecto").glob("*.vmod")), vmod_dir / "pattern_0.vmod")
     with pytest.raises(InputError, match="pattern_0.vmod.*battery"):
         trip_consumption(cfg, Path(cfg.data_dir), 2024, patterns.index, say=lambda *a: None)
+
+
+def test_plan_lists_the_graph_and_what_is_done(small_run, small_config):
+    import runpy
+
+    from vipvflow.simulation.run import plan
+
+    table = plan(load_config(small_config), 2024)
+    segs = pd.read_parquet(Path(load_config(small_config).data_dir) / "gtfs" / "segments.parquet")
+    assert sorted(table["tile"].unique()) == sorted(segs["tile"].unique())
+    assert (table["key"] == "irradiance-" + table["tile"] + "-2024-06").all()
+    assert table["done"].all()   # the session's run wrote every partition
+    main = runpy.run_path(str(Path(__file__).parents[1] / "pipeline" / "plan.py"))["main"]
+    assert main(["--config", str(small_config), "--year", "2024"]) == 0

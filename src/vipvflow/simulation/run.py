@@ -91,6 +91,36 @@ class FleetView:
             print(file=self.stream)
 
 
+def selected_network(cfg: Config) -> tuple[pd.DataFrame, tuple | None, list[str]]:
+    """The trips (``trip_id, route_id, shape_id``), shapes (``None``: all) and tiles that
+    the run covers, after ``run.routes``; needs the ingested GTFS in ``cfg.data_dir``."""
+    data_dir = Path(cfg.data_dir)
+    trips = pd.read_parquet(data_dir / "gtfs" / "trips.parquet", columns=["trip_id", "route_id", "shape_id"])
+    routes = cfg.run.routes
+    shapes = None
+    if routes is not None:
+        unknown = sorted(set(routes) - set(trips["route_id"].astype(str)))
+        if unknown:
+            raise InputError(f"{cfg._source}: run.routes: route_id(s) not in the feed: {', '.join(unknown)}")
+        trips = trips[trips["route_id"].astype(str).isin(routes)]
+        shapes = tuple(sorted(trips["shape_id"].unique()))
+    seg = pd.read_parquet(data_dir / "gtfs" / "segments.parquet", columns=["tile", "shape_id"])
+    if shapes is not None:
+        seg = seg[seg["shape_id"].isin(shapes)]
+    return trips, shapes, sorted(seg["tile"].unique())
+
+
+def plan(cfg: Config, year: int) -> pd.DataFrame:
+    """The task graph of a scenario-year as a table: one row per ``irradiance`` task with its
+    tile, month, key, the ``geometry`` task it depends on, and whether its partition is
+    already written (a resumed run skips those)."""
+    _, _, tiles = selected_network(cfg)
+    run_dir = run_dir_of(cfg, year)
+    rows = [{"tile": t, "month": m, "key": f"irradiance-{t}-{m}", "depends_on": f"geometry-{t}",
+             "done": partition_done(run_dir, t, m)} for t in tiles for m in _months(cfg, year)]
+    return pd.DataFrame(rows, columns=["tile", "month", "key", "depends_on", "done"])
+
+
 def run_simulation(cfg: Config, year: int, scheduler: str | None = None,
                    n_workers: int | None = None, say=print, max_partitions: int | None = None) -> Path:
     """Compute the scenario's fleet-year and write all outputs; returns the run directory.
@@ -112,19 +142,8 @@ def run_simulation(cfg: Config, year: int, scheduler: str | None = None,
     run_dir.mkdir(parents=True, exist_ok=True)
     _reset_if_config_changed(run_dir, cfg.digest())
     feed = json.loads((data_dir / "gtfs" / "feed.json").read_text())
-    trips = pd.read_parquet(data_dir / "gtfs" / "trips.parquet", columns=["trip_id", "route_id", "shape_id"])
+    trips, shapes, tiles = selected_network(cfg)
     routes = cfg.run.routes
-    shapes = None
-    if routes is not None:
-        unknown = sorted(set(routes) - set(trips["route_id"].astype(str)))
-        if unknown:
-            raise InputError(f"{cfg._source}: run.routes: route_id(s) not in the feed: {', '.join(unknown)}")
-        trips = trips[trips["route_id"].astype(str).isin(routes)]
-        shapes = tuple(sorted(trips["shape_id"].unique()))
-    seg = pd.read_parquet(data_dir / "gtfs" / "segments.parquet", columns=["tile", "shape_id"])
-    if shapes is not None:
-        seg = seg[seg["shape_id"].isin(shapes)]
-    tiles = sorted(seg["tile"].unique())
     ctx = RunContext(
         data_dir=str(data_dir.resolve()), run_dir=str(run_dir.resolve()), year=year,
         irradiance=cfg.irradiance.model_dump(), pv_system=cfg.pv_system().model_dump(),

@@ -1,0 +1,42 @@
+"""Print the Dask task graph of a scenario-year before (or between) runs.
+
+    .venv/bin/python pipeline/plan.py --config conf/demo.yaml --year 2024
+
+Shows the ``geometry-<TILE>`` and ``irradiance-<TILE>-<YYYY-MM>`` tasks the simulation will
+submit, how many are already written (a re-run resumes from them) and the partition count
+per tile, so a user can size a cluster. The inputs must have been ingested once
+(``vipvflow ingest ...`` or a first ``make simulate``). The graph itself is built by
+:mod:`vipvflow.simulation.run`; this script only prints :func:`vipvflow.simulation.run.plan`.
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+
+from vipvflow.config import load_config
+from vipvflow.errors import VipvError
+from vipvflow.simulation.run import plan
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--config", default="conf/demo.yaml")
+    ap.add_argument("--year", type=int, required=True)
+    ap.add_argument("--tasks", action="store_true", help="list every task key")
+    args = ap.parse_args(argv)
+    try:
+        table = plan(load_config(args.config), args.year)
+    except (VipvError, FileNotFoundError) as exc:
+        print(f"plan: {exc}", file=sys.stderr)
+        return 2
+    tiles = table["tile"].nunique()
+    print(f"{tiles} geometry tasks, {len(table)} irradiance tasks "
+          f"({int(table['done'].sum())} already written, {int((~table['done']).sum())} to compute)")
+    if args.tasks:
+        for row in table.itertuples():
+            print(f"{row.key:<40} <- {row.depends_on:<22} {'done' if row.done else 'to do'}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
