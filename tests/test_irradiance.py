@@ -29,6 +29,14 @@ def _kernel(scene, geometry, rows, zenith, azimuth, rad, cfg, ground_albedo=0.2)
                            scene, cfg, ground_albedo)
 
 
+def _constant_table(t, **values):
+    """A 1-min radiation table over the times *t* (Unix s), Luxembourg's sun, the given
+    columns constant (W/m2) and the others 0."""
+    grid = np.arange(np.floor(t.min() / 60) * 60 - 120, t.max() + 180, 60.0)
+    vals = {c: np.full(len(grid), float(values.get(c, 0.0))) for c in COLUMNS}
+    return RadiationTable.from_grid(grid, vals, 49.61, 6.13, 300.0)
+
+
 def test_roof_faces_downhill():
     tilt, az = roof_plane([0.0, 90.0, 90.0], [0.10, 0.10, -0.05])
     assert np.allclose(tilt, np.degrees(np.arctan([0.10, 0.10, 0.05])))
@@ -217,7 +225,7 @@ def test_partly_lit_facade_lit_fraction(P):
     H, W, zr, rho, el, dni = 16.0, 18.0, 3.2, 0.35, 20.0, 800.0
     scene = Scene(_canyon(H, W, rho))
     cfg = IrradianceCfg(svf_rays=64, reflection_rays=8192, ray_length_m=10_000.0,
-                        reflector_points=P, reflector_sky_rays=8)
+                        reflector_points=P, reflector_sky_rays=8, reflector_sampling="all")
     geometry = segment_geometry(scene, _segments([0.0], 0.0, zr), cfg)
     s_ = lambda h: (W / 2) / np.hypot(W / 2, h)
     z_s = H - W * np.tan(np.radians(el))
@@ -231,6 +239,50 @@ def test_partly_lit_facade_lit_fraction(P):
     assert not out["sun_visible"][0] and out["reflected"][0] == 0
     assert abs(out["reflected_clear"][0] - e_full * F_lit) <= e_full * F * (0.5 / P + 0.03)
     assert out["reflected_clear"][0] < 0.8 * e_full * F        # not lit all-or-nothing
+
+
+def test_rotating_reflector_sample_is_the_p_point_lit_fraction_on_average():
+    """``reflector_sampling: rotate`` traces one sample point per reflector group and pass:
+    over P passes that take the points in turn the mean reflected irradiance equals the
+    P-point lit fraction of ``all`` exactly, with one reflector ray per group instead of P;
+    through evaluate_passes (points chosen by a hash of segment and time) the mean over
+    many passes converges to it."""
+    H, W, zr, el, dni, P = 16.0, 18.0, 3.2, 20.0, 800.0, 8
+    scene = Scene(_canyon(H, W, 0.35))
+    all_ = IrradianceCfg(svf_rays=64, reflection_rays=4096, ray_length_m=10_000.0,
+                         reflector_points=P, reflector_sky_rays=8, reflector_sampling="all")
+    rot = all_.model_copy(update={"reflector_sampling": "rotate"})
+    geometry = segment_geometry(scene, _segments([0.0], 0.0, zr), all_)
+    rad = {"dni": [0.0] * P, "dhi": [0.0] * P, "ghi": [0.0] * P, "dni_clear": [dni] * P,
+           "dhi_clear": [0.0] * P, "ghi_clear": [0.0] * P}
+    zen, az = np.full(P, 90.0 - el), np.full(P, 90.0)
+    rows = np.zeros(P, np.int64)
+    exact = _kernel(scene, geometry, rows, zen, az, rad, all_)["reflected_clear"]
+    turns = _kernel(scene, geometry, rows, zen, az, rad, rot)["reflected_clear"]
+    assert np.ptp(exact) == 0 and 0 < exact[0]
+    assert len(np.unique(turns)) > 1                              # single points: lit or not
+    assert turns.mean() == pytest.approx(exact[0], rel=1e-5)
+
+    class Counting(Scene):
+        rays = 0
+
+        def occluded_local(self, o, d, tfar):
+            Counting.rays += len(o)
+            return super().occluded_local(o, d, tfar)
+
+    counting = Counting(_canyon(H, W, 0.35))
+    n = 4000
+    t = pd.Timestamp("2024-03-20 06:00", tz="UTC").timestamp() + np.arange(n) * 7.0
+    table = _constant_table(t, dni_clear=dni)
+    passes = pd.DataFrame({"segment_id": np.zeros(n, np.int64), "t_utc": t,
+                           "dt_s": np.full(n, 1.0, np.float32)})
+    a = evaluate_passes(passes, None, geometry, table, counting, all_)
+    rays_all, Counting.rays = Counting.rays, 0
+    b = evaluate_passes(passes, None, geometry, table, counting, rot)
+    assert Counting.rays < rays_all / 3
+    assert b["reflected_clear"].mean() == pytest.approx(a["reflected_clear"].mean(), rel=0.03)
+    assert (b["direct_clear"] == a["direct_clear"]).all()
+    np.testing.assert_array_equal(b["diffuse_clear"], a["diffuse_clear"])
 
 
 def test_canyon_facade_sees_its_own_sky_and_road():

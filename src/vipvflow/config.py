@@ -88,6 +88,7 @@ class IrradianceCfg(_Model):
     ray_offset_m: float = Field(0.05, ge=0)
     max_reflector_groups: int = Field(3, ge=0)
     reflector_points: int = Field(4, ge=1)
+    reflector_sampling: Literal["rotate", "all"] = "rotate"
     reflector_sky_rays: int = Field(32, ge=1)
     seed: int = 7
 

@@ -369,7 +369,8 @@ COMPONENTS = ("direct", "diffuse", "reflected", "total", "direct_clear", "diffus
               "reflected_clear", "total_clear", "total_unshaded", "total_clear_unshaded")
 
 
-def pack_geometry(geometry: pd.DataFrame, cfg: IrradianceCfg, ground_albedo: float = 0.20) -> dict:
+def pack_geometry(geometry: pd.DataFrame, cfg: IrradianceCfg, ground_albedo: float = 0.20,
+                  scene=None) -> dict:
     """Per-segment arrays for :func:`roof_irradiance`, with the time-independent parts of
     eq. (3) folded in.
 
@@ -382,6 +383,10 @@ def pack_geometry(geometry: pd.DataFrame, cfg: IrradianceCfg, ground_albedo: flo
     A geometry table without the per-group surroundings (older runs) is read as the open
     field of the paper: ``F_s = (1 + n_z)/2``, ``F_g = 0``, ``F_o = (1 - n_z)/2``, and its
     single representative point ``r{g}_x, r{g}_y, r{g}_z``.
+
+    With *scene*, the ray origins are also stored in that scene's float32 frame
+    (:meth:`vipvflow.shading.Scene.to_local`), so the hot path builds its rays without
+    converting them per pass.
     """
     f32 = np.float32
     cols = set(geometry.columns)
@@ -413,10 +418,15 @@ def pack_geometry(geometry: pd.DataFrame, cfg: IrradianceCfg, ground_albedo: flo
             f_s, f_g, f_o = (1 + nz) / 2, np.zeros(s, f32), (1 - nz) / 2
         sky += w * f_s
         gnd += w * (f_g + f32(ground_albedo) * f_o)
-    return {"p": np.ascontiguousarray(geometry[["px", "py", "pz"]].to_numpy(np.float64)),
-            "n": np.ascontiguousarray(geometry[["nx", "ny", "nz"]].to_numpy(f32)),
-            "svf": geometry["svf"].to_numpy(f32), "refl_sky": sky, "refl_gnd": gnd,
-            "wn": wn, "group_p": pts.reshape(s * G, -1, 3)}
+    geo = {"p": np.ascontiguousarray(geometry[["px", "py", "pz"]].to_numpy(np.float64)),
+           "n": np.ascontiguousarray(geometry[["nx", "ny", "nz"]].to_numpy(f32)),
+           "svf": geometry["svf"].to_numpy(f32), "refl_sky": sky, "refl_gnd": gnd,
+           "wn": wn, "group_p": pts.reshape(s * G, -1, 3)}
+    if scene is not None:
+        geo["scene_origin"] = np.asarray(scene.origin, np.float64).copy()
+        geo["p_local"] = scene.to_local(geo["p"])
+        geo["group_p_local"] = scene.to_local(geo["group_p"])
+    return geo
 
 
 def _finite(x) -> np.ndarray:
@@ -426,8 +436,14 @@ def _finite(x) -> np.ndarray:
     return np.where(bad, np.float32(0), x) if bad.any() else x
 
 
+def _local_frame(geo: dict, scene) -> bool:
+    """Whether *geo* holds ray origins in the frame of *scene* (see :func:`pack_geometry`)."""
+    o = geo.get("scene_origin")
+    return o is not None and hasattr(scene, "occluded_local") and np.array_equal(o, scene.origin)
+
+
 def roof_irradiance(geometry, rows, sun: np.ndarray, rad: dict, scene, cfg: IrradianceCfg,
-                    ground_albedo: float = 0.20) -> dict:
+                    ground_albedo: float = 0.20, sample=None) -> dict:
     """Irradiance components for arrays of passes (the hot path), eqs. (1)-(3).
 
     Parameters
@@ -439,18 +455,29 @@ def roof_irradiance(geometry, rows, sun: np.ndarray, rad: dict, scene, cfg: Irra
     scene : vipvflow.shading.Scene
     cfg : IrradianceCfg
     ground_albedo : float, albedo of the open ground seen by reflectors (used when packing)
+    sample : (n,) int, optional
+        With ``cfg.reflector_sampling == 'rotate'``: which of a reflector group's P sample
+        points each pass traces (group ``g`` of pass ``i`` traces point
+        ``(sample[i] + g) mod P``); default ``0, 1, 2, ...`` in the order of the passes.
+        :func:`evaluate_passes` derives it from a hash of the segment and the time, so it
+        does not depend on how passes are batched.
 
     Returns
     -------
     dict of (n,) float32 arrays, W/m2: :data:`COMPONENTS` and ``sun_visible`` (bool).
     Rays are cast only with the sun up and a beam in either channel: one per pass with the
-    sun in front of the roof, one per sample point of every reflector group facing the
-    sun, all in one occlusion query; the same visibility serves all-sky and clear-sky.
+    sun in front of the roof, and for every reflector group facing the sun either one ray
+    per sample point (``reflector_sampling: all``: the group's lit fraction, in steps of
+    1/P) or one ray from one sample point taken in turn (``rotate``: the lit fraction is 0 or
+    1 for that pass, and its mean over passes is the P-point lit fraction, an unbiased
+    estimate with P times fewer rays); all in one occlusion query, and the same visibility
+    serves all-sky and clear-sky.
     """
     f32 = np.float32
     clock = stage_seconds()
     t_start = time.perf_counter()
-    geo = geometry if isinstance(geometry, dict) else pack_geometry(geometry, cfg, ground_albedo)
+    geo = geometry if isinstance(geometry, dict) else pack_geometry(geometry, cfg, ground_albedo, scene)
+    local = _local_frame(geo, scene)
     rows = np.asarray(rows, np.int64)
     sun = np.asarray(sun, f32)
     n = len(rows)
@@ -460,33 +487,43 @@ def roof_irradiance(geometry, rows, sun: np.ndarray, rad: dict, scene, cfg: Irra
     dnic, dhic, ghic = _finite(rad["dni_clear"]), _finite(rad["dhi_clear"]), _finite(rad["ghi_clear"])
     lit = np.flatnonzero((sun[:, 2] > 0) & ((dni > 0) | (dnic > 0)))
     sl = sun[lit]
+    rows_lit = rows[lit]
     cos_aoi = np.zeros(n, f32)
     cos_aoi[lit] = np.maximum(np.einsum("ij,ij->i", nrm[lit], sl), 0)
     cand = lit[cos_aoi[lit] > 0]
     G = geo["wn"].shape[1] if (cfg.reflection and cfg.max_reflector_groups) else 0
-    # reflector groups facing the sun: (pass, group) pairs, P points each; every ray of
-    # the chunk (direct first) goes into one occlusion query
+    # reflector groups facing the sun: (pass, group) pairs, P points each (or one of them,
+    # in turn); every ray of the chunk (direct first) goes into one occlusion query
     nd = len(cand)
+    gp = geo["group_p_local"] if local else geo["group_p"]
+    P = gp.shape[1]
     if G and len(lit):
-        wc = np.einsum("igj,ij->ig", geo["wn"][rows[lit]], sl)
+        wc = np.einsum("igj,ij->ig", geo["wn"][rows_lit], sl)
         pi, gi = np.nonzero(wc > 0)
-        gp = geo["group_p"]
-        P = gp.shape[1]
     else:
         pi = gi = np.zeros(0, np.int64)
-        P = 1
-    nr = nd + P * len(pi)
+    rotate = cfg.reflector_sampling == "rotate" and P > 1
+    per_pair = 1 if rotate else P
+    nr = nd + per_pair * len(pi)
     visible = np.zeros(n, bool)
     if nr:
-        o = np.empty((nr, 3), np.float64)
+        o = np.empty((nr, 3), f32 if local else np.float64)
         d = np.empty((nr, 3), f32)
-        np.take(geo["p"], rows[cand], axis=0, out=o[:nd])
+        np.take(geo["p_local"] if local else geo["p"], rows[cand], axis=0, out=o[:nd])
         np.take(sun, cand, axis=0, out=d[:nd])
         if len(pi):
-            np.take(gp, rows[lit][pi] * G + gi, axis=0, out=o[nd:].reshape(-1, P, 3))
-            d[nd:].reshape(-1, P, 3)[:] = sl[pi][:, None, :]
+            pair = rows_lit[pi] * G + gi
+            if rotate:
+                base = np.arange(n, dtype=np.int64) if sample is None else np.asarray(sample, np.int64)
+                k = (base[lit][pi] + gi) % P
+                o[nd:] = gp[pair, k]
+                np.take(sl, pi, axis=0, out=d[nd:])
+            else:
+                np.take(gp, pair, axis=0, out=o[nd:].reshape(-1, P, 3))
+                d[nd:].reshape(-1, P, 3)[:] = sl[pi][:, None, :]
         t_rays = time.perf_counter()
-        occ = scene.occluded(o, d, cfg.ray_length_m)
+        occ = (scene.occluded_local(o, d, cfg.ray_length_m) if local
+               else scene.occluded(o, d, cfg.ray_length_m))
         t_done = time.perf_counter()
         clock["ray_setup_s"] += t_rays - t_start
         clock["rays_s"] += t_done - t_rays
@@ -501,8 +538,12 @@ def roof_irradiance(geometry, rows, sun: np.ndarray, rad: dict, scene, cfg: Irra
         rs, rgnd = geo["refl_sky"][rows], geo["refl_gnd"][rows]
         refl, refl_c = dhi * rs + ghi * rgnd, dhic * rs + ghic * rgnd
         if len(pi):
-            seen = P - occ[nd:].reshape(-1, P).sum(1, dtype=np.int32)
-            beam = np.bincount(pi, wc[pi, gi] * (seen * f32(1.0 / P)), len(lit)).astype(f32)
+            if rotate:
+                lit_share = (~occ[nd:]).astype(f32)
+            else:
+                seen = P - occ[nd:].reshape(-1, P).sum(1, dtype=np.int32)
+                lit_share = seen * f32(1.0 / P)
+            beam = np.bincount(pi, wc[pi, gi] * lit_share, len(lit)).astype(f32)
             refl[lit] += dni[lit] * beam
             refl_c[lit] += dnic[lit] * beam
     else:
@@ -518,9 +559,21 @@ def roof_irradiance(geometry, rows, sun: np.ndarray, rad: dict, scene, cfg: Irra
             "sun_visible": visible}
 
 
+def pass_sample_key(segment_id, t_utc) -> np.ndarray:
+    """A well-mixed integer per pass from its segment and time (splitmix64 finaliser), so
+    the reflector sample point a pass traces does not depend on batching or workers."""
+    x = (np.asarray(segment_id, np.int64).astype(np.uint64) * np.uint64(0x9E3779B97F4A7C15)
+         + np.round(np.asarray(t_utc, np.float64) * 1000.0).astype(np.int64).astype(np.uint64))
+    x = (x ^ (x >> np.uint64(30))) * np.uint64(0xBF58476D1CE4E5B9)
+    x = (x ^ (x >> np.uint64(27))) * np.uint64(0x94D049BB133111EB)
+    x = x ^ (x >> np.uint64(31))
+    return (x >> np.uint64(33)).astype(np.int64)
+
+
 def evaluate_passes(passes: pd.DataFrame, segments: pd.DataFrame, geometry: pd.DataFrame,
                     radiation_table, scene, cfg: IrradianceCfg | None = None,
-                    ground_albedo: float = 0.20, time_at: str = "mid") -> pd.DataFrame:
+                    ground_albedo: float = 0.20, time_at: str = "mid",
+                    packed: dict | None = None) -> pd.DataFrame:
     """Irradiance components on the roof for every pass (W/m2).
 
     Parameters
@@ -537,6 +590,9 @@ def evaluate_passes(passes: pd.DataFrame, segments: pd.DataFrame, geometry: pd.D
     cfg : IrradianceCfg
     ground_albedo : float, albedo of the ground lighting the reflectors (eq. 3)
     time_at : ``'mid'`` or ``'start'``
+    packed : dict, optional
+        ``pack_geometry(geometry, cfg, ground_albedo, scene)`` when the caller keeps it
+        (a worker evaluating the same tile for several months packs it once)
 
     Returns
     -------
@@ -555,31 +611,39 @@ def evaluate_passes(passes: pd.DataFrame, segments: pd.DataFrame, geometry: pd.D
     if len(seg) and (seg.max() >= len(pos) or seg.min() < 0 or (pos[seg] < 0).any()):
         raise KeyError("passes reference segments missing from the geometry")
     row = pos[seg]
-    t = passes["t_utc"].to_numpy(np.float64)
+    t_start = passes["t_utc"].to_numpy(np.float64)
+    t = t_start
     if time_at == "mid" and "dt_s" in passes.columns:
         t = t + 0.5 * passes["dt_s"].to_numpy(np.float64)
-    geo = pack_geometry(geometry, cfg, ground_albedo)
+    geo = packed if packed is not None else pack_geometry(geometry, cfg, ground_albedo, scene)
     loc_col = geometry["rad_location"].to_numpy(np.int64) if "rad_location" in geometry else None
     n = len(passes)
     columns = list(COMPONENTS) + ["ghi", "ghi_clear"]
-    block = np.empty((len(columns), n), np.float32).T      # column-major: one block per column
-    visible = np.empty(n, bool)
-    clock["pack_s"] += time.perf_counter() - t_pack
-    for a in range(0, n, _CHUNK):
-        sl = slice(a, min(n, a + _CHUNK))
+    block = np.zeros((len(columns), n), np.float32).T      # column-major: one block per column
+    visible = np.zeros(n, bool)
+    # passes at night (every radiation value exactly 0) have every component exactly 0:
+    # only the others are looked up and ray-cast
+    t_look = time.perf_counter()
+    clock["pack_s"] += t_look - t_pack
+    active = np.flatnonzero(radiation_table.has_light(
+        t, location=None if loc_col is None else loc_col[row]))
+    clock["lookup_s"] += time.perf_counter() - t_look
+    for a in range(0, len(active), _CHUNK):
+        idx = active[a:a + _CHUNK]
         t_look = time.perf_counter()
-        r = row[sl]
+        r = row[idx]
         loc = None if loc_col is None else loc_col[r]
-        rad = radiation_table.lookup(t[sl], location=loc, angles=False)
+        rad = radiation_table.lookup(t[idx], location=loc, angles=False)
         sun = np.stack([rad["sun_x"], rad["sun_y"], rad["sun_z"]], 1)
+        key = pass_sample_key(seg[idx], t_start[idx])
         clock["lookup_s"] += time.perf_counter() - t_look
-        out = roof_irradiance(geo, r, sun, rad, scene, cfg, ground_albedo)
+        out = roof_irradiance(geo, r, sun, rad, scene, cfg, ground_albedo, sample=key)
         t_pack = time.perf_counter()
         for j, k in enumerate(COMPONENTS):
-            block[sl, j] = out[k]
-        block[sl, -2] = np.nan_to_num(rad["ghi"])
-        block[sl, -1] = np.nan_to_num(rad["ghi_clear"])
-        visible[sl] = out["sun_visible"]
+            block[idx, j] = out[k]
+        block[idx, -2] = np.nan_to_num(rad["ghi"])
+        block[idx, -1] = np.nan_to_num(rad["ghi_clear"])
+        visible[idx] = out["sun_visible"]
         clock["pack_s"] += time.perf_counter() - t_pack
     df = pd.DataFrame(block, index=passes.index, columns=columns, copy=False)
     df["sun_visible"] = visible

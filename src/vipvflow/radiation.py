@@ -398,6 +398,40 @@ class RadiationTable:
             self.__dict__["_pack"] = cache
         return cache[0], cache[1]
 
+    def _light(self) -> np.ndarray:
+        """(K, N) bool: grid intervals [i, i + 1] in which any radiation value is non-zero or
+        missing (NaN) at either end; outside them every interpolated value is exactly 0."""
+        cache = self.__dict__.get("_light_cache")
+        arrays = tuple(self.data[c] for c in COLUMNS)
+        if cache is None or any(a is not b for a, b in zip(cache[0], arrays)):
+            lit = np.zeros(self.data["ghi"].shape, bool)
+            for a in arrays:
+                lit |= (a != 0) | np.isnan(a)
+            lit[:, :-1] |= lit[:, 1:]
+            cache = (arrays, lit)
+            self.__dict__["_light_cache"] = cache
+        return cache[1]
+
+    def has_light(self, t_utc, location=None) -> np.ndarray:
+        """Whether radiation may be non-zero at each time (bool array).
+
+        ``False`` means every value :meth:`lookup` would return at that time is exactly 0
+        (night, in CAMS), so callers may skip the pass; times outside the grid are ``True``
+        (their lookup is NaN, handled by the caller).
+
+        Parameters
+        ----------
+        t_utc : array of float, Unix seconds
+        location : None, int or int array, as in :meth:`lookup`
+        """
+        t = np.asarray(t_utc, dtype=np.float64)
+        f = (t - self.t0) / self.step_s
+        inside = (f >= 0) & (f <= self.n - 1)
+        i = np.clip(np.nan_to_num(f), 0, self.n - 1).astype(np.int64)
+        lit = self._light()
+        loc = 0 if location is None else np.asarray(location, np.int64)
+        return lit[loc, i] | ~inside
+
     @property
     def n(self) -> int:
         return self.data["ghi"].shape[1]

@@ -89,7 +89,7 @@ class Scene:
         n = len(o)
         k = min(self.n_threads, max(1, n // _MIN_SPLIT))
         if k <= 1:
-            return self._scene.run(o, d, dists=t.copy(), query=query, output=output)
+            return self._scene.run(o, d, dists=t, query=query, output=output)
         bounds = np.linspace(0, n, k + 1).astype(np.int64)
         sl = [slice(bounds[i], bounds[i + 1]) for i in range(k)]
         parts = list(_get_pool(k).map(
@@ -115,6 +115,22 @@ class Scene:
         o, d, t = self._prepare(origins, dirs, tfar)
         if self._scene is None or len(o) == 0:
             return np.zeros(len(o), bool)
+        return self._run(o, d, t, "OCCLUDED", None) != -1
+
+    def to_local(self, points) -> np.ndarray:
+        """Points (m, projected CRS) as float32 relative to :attr:`origin`, the form
+        :meth:`occluded_local` takes (millimetre precision within a tile)."""
+        p = np.asarray(points, np.float64)
+        return np.ascontiguousarray((p - self.origin).astype(np.float32))
+
+    def occluded_local(self, origins, dirs, tfar) -> np.ndarray:
+        """:meth:`occluded` for ray origins already in the scene's frame (:meth:`to_local`):
+        float32 (n, 3) origins and unit directions and a scalar *tfar* (m), no conversion."""
+        o = np.ascontiguousarray(origins, np.float32).reshape(-1, 3)
+        d = np.ascontiguousarray(dirs, np.float32).reshape(-1, 3)
+        if self._scene is None or len(o) == 0:
+            return np.zeros(len(o), bool)
+        t = np.full(len(o), min(float(tfar), float(_FAR)), np.float32)
         return self._run(o, d, t, "OCCLUDED", None) != -1
 
     def first_hit(self, origins, dirs, tfar=np.inf) -> tuple[np.ndarray, np.ndarray]:

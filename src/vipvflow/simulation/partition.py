@@ -6,6 +6,7 @@ pass of its partition with the irradiance engine and writes its partition files 
 """
 from __future__ import annotations
 
+import collections
 import time
 from dataclasses import dataclass, field
 from functools import lru_cache
@@ -70,6 +71,26 @@ def _scene(ctx: RunContext, tile: str):
     return get_scene(ctx.data_dir, tile, cache_size=ctx.bvh_cache_size, n_threads=ctx.ray_threads)
 
 
+_PACKED: "collections.OrderedDict[tuple, tuple]" = collections.OrderedDict()
+
+
+def _packed_geometry(ctx: RunContext, tile: str, geometry: pd.DataFrame, scene) -> dict:
+    """The tile's geometry packed for the hot path, once per worker while the same geometry
+    table and scene stay in memory (a bounded cache, like the scenes')."""
+    from ..irradiance import pack_geometry
+
+    key = (ctx.run_dir, tile)
+    hit = _PACKED.get(key)
+    if hit is not None and hit[0] is geometry and hit[1] is scene:
+        _PACKED.move_to_end(key)
+        return hit[2]
+    geo = pack_geometry(geometry, IrradianceCfg(**ctx.irradiance), ctx.ground_albedo, scene)
+    _PACKED[key] = (geometry, scene, geo)
+    while len(_PACKED) > max(1, ctx.bvh_cache_size):
+        _PACKED.popitem(last=False)
+    return geo
+
+
 def tile_geometry(ctx: RunContext, tile: str) -> pd.DataFrame:
     """Per-segment geometry factors of a tile (sky view factor, reflector groups), computed
     once per run and stored in ``parts/geometry/tile=<TILE>.parquet``, and the segments'
@@ -99,7 +120,8 @@ def tile_geometry(ctx: RunContext, tile: str) -> pd.DataFrame:
 
 def pv_energy_kwh(poa_wm2: np.ndarray, dt_s: np.ndarray, speed_mps: np.ndarray, month: int,
                   ctx: RunContext) -> np.ndarray:
-    """PV energy per pass (kWh) in the run's PV mode."""
+    """PV energy per pass (kWh) in the run's PV mode: paper (linear in POA) or pvlib
+    (PVWatts with a cell temperature cooled by the bus's own speed plus the ambient wind)."""
     from .. import pv
 
     system = PVSystem(**ctx.pv_system)
@@ -107,87 +129,136 @@ def pv_energy_kwh(poa_wm2: np.ndarray, dt_s: np.ndarray, speed_mps: np.ndarray, 
         return pv.energy_paper(poa_wm2, dt_s, system.kwp, system.performance_ratio)
     temp = ctx.monthly_temperature_c[month - 1]
     return pv.energy_pvlib(poa_wm2, dt_s, system, temp_air_c=temp,
-                           wind_speed_mps=ctx.wind_speed_mps + speed_mps)
+                           vehicle_speed_mps=speed_mps, wind_mps=ctx.wind_speed_mps)
 
 
 def _local_hours(t_utc: np.ndarray, timezone: str) -> np.ndarray:
-    """Local clock hour (0..23) of Unix times, converting each distinct UTC hour once."""
+    """Local clock hour (0..23) of Unix times (s).
+
+    The UTC offset is looked up per UTC hour of the span the times cover (clock changes
+    fall on UTC hour starts), from a table of that span: O(n) for the passes.
+    """
     if not len(t_utc):
         return np.zeros(0, np.int8)
     utc_hour = np.floor(t_utc / 3600.0).astype(np.int64)
-    uniq, inverse = np.unique(utc_hour, return_inverse=True)
-    start = pd.to_datetime(uniq * 3600, unit="s", utc=True).tz_convert(timezone)
-    # UTC offset of each distinct UTC hour (daylight-saving changes fall on UTC hour starts)
-    offset = np.asarray([o.total_seconds() for o in start.map(lambda t: t.utcoffset())])
-    return (np.floor((t_utc + offset[inverse]) / 3600.0).astype(np.int64) % 24).astype(np.int8)
+    lo, hi = int(utc_hour.min()), int(utc_hour.max())
+    span = pd.DatetimeIndex(pd.to_datetime(np.arange(lo, hi + 1) * 3600, unit="s", utc=True))
+    local = span.tz_convert(timezone).tz_localize(None)
+    offset = ((local - span.tz_localize(None)) / pd.Timedelta(seconds=1)).to_numpy(np.float64)
+    return (np.floor((t_utc + offset[utc_hour - lo]) / 3600.0).astype(np.int64) % 24).astype(np.int8)
+
+
+def _dense_positions(ids: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Sorted distinct integers of *ids* and each element's position among them (like
+    ``np.unique(..., return_inverse=True)`` in O(n + range) for ids from a compact range)."""
+    if not len(ids):
+        return ids[:0], np.zeros(0, np.int64)
+    lo, hi = int(ids.min()), int(ids.max())
+    if hi - lo > 8 * len(ids) + 1024:
+        return np.unique(ids, return_inverse=True)
+    present = np.zeros(hi - lo + 1, bool)
+    present[ids - lo] = True
+    pos = np.cumsum(present) - 1
+    return np.flatnonzero(present) + lo, pos[ids - lo]
 
 
 def aggregate_partition(passes: pd.DataFrame, irr: pd.DataFrame, month: int, ctx: RunContext):
     """Sum a partition's passes per trip and service date, per segment and per local hour.
 
-    Vectorised with numpy (``reduceat`` over the passes, which come sorted by service date,
-    trip and time; ``bincount`` per segment and hour), so the reduce costs a small part of
-    the irradiance evaluation.
+    Returns three tables: per trip (``trip_id, service_date``, PV kWh of all-sky, clear-sky,
+    the unshaded references and per component, ``seconds``), per segment (``segment_id,
+    n_passes``, the same kWh, irradiation ``h_<component>`` in Wh/m2, ``seconds``) and per
+    local clock hour (``hour``, irradiation, ``seconds``).
+
+    One ``bincount`` per column and grouping, over the passes that received any light only
+    (night passes add nothing but their time); the (trip, date) runs come from the pass
+    order (sorted by service date, trip and time, as :func:`vipvflow.trajectory.iter_passes`
+    gives them; a (trip, date) split over several runs is merged).
     """
     n = len(passes)
     dt = passes["dt_s"].to_numpy(np.float64)
-    # irradiation (Wh/m2) received during each pass
-    h = {f"h_{c}": irr[c].to_numpy(np.float64) * dt / 3600.0 for c in COMPONENTS}
-    pv_cols = [f"pv_kwh{suffix}" for suffix in VARIANTS] + [f"pv_kwh_{c}" for c in PV_COMPONENTS]
-    pv_source = {**{f"pv_kwh{suffix}": col for suffix, col in VARIANTS.items()},
-                 **{f"pv_kwh_{c}": c for c in PV_COMPONENTS}}
     system = PVSystem(**ctx.pv_system)
     linear = ctx.pv_mode == "paper"
-    if linear:
-        # paper mode is linear in the irradiation: kWh = kWp x PR x H / 1000 (H in Wh/m2),
-        # so the energy of any group of passes comes from its irradiation sum
-        sums = {"seconds": dt, **{f"h_{c}": h[f"h_{c}"] for c in sorted(set(pv_source.values()))}}
-    else:
-        speed = passes["speed_mps"].to_numpy(np.float64)
-        sums = {name: pv_energy_kwh(irr[col].to_numpy(np.float64), dt, speed, month, ctx)
-                for name, col in pv_source.items()}
-        sums["seconds"] = dt
+    pv_source = {**{f"pv_kwh{suffix}": col for suffix, col in VARIANTS.items()},
+                 **{f"pv_kwh_{c}": c for c in PV_COMPONENTS}}
 
-    def energy(table: dict) -> dict:
-        """PV kWh columns of a table of sums."""
-        if linear:
-            k = system.kwp * system.performance_ratio / 1000.0
-            return {name: k * table[f"h_{col}"] for name, col in pv_source.items()}
-        return {name: table[name] for name in pv_cols}
-
-    # per trip and service date: runs of equal (date, trip) in the sorted passes
-    trip_code = np.asarray(passes["trip_id"].cat.codes if hasattr(passes["trip_id"], "cat")
-                           else pd.factorize(passes["trip_id"])[0], dtype=np.int64)
+    # groups: (trip, date) run, segment, local hour
+    trip_col = passes["trip_id"]
+    trip_code = np.asarray(trip_col.cat.codes if hasattr(trip_col, "cat")
+                           else pd.factorize(trip_col)[0], dtype=np.int64)
     day = passes["service_date"].to_numpy().astype("datetime64[D]").astype(np.int64)
-    if n:
-        change = np.flatnonzero((np.diff(trip_code) != 0) | (np.diff(day) != 0)) + 1
-        starts = np.concatenate([[0], change])
+    new_run = np.ones(n, bool)
+    if n > 1:
+        new_run[1:] = (trip_code[1:] != trip_code[:-1]) | (day[1:] != day[:-1])
+    starts = np.flatnonzero(new_run)
+    run = np.cumsum(new_run) - 1
+    n_runs = len(starts)
+    seg_ids, seg_pos = _dense_positions(passes["segment_id"].to_numpy(np.int64))
+    n_seg = len(seg_ids)
+    hour = _local_hours(passes["t_utc"].to_numpy(np.float64), ctx.timezone).astype(np.int64)
+
+    # irradiation (Wh/m2) of the passes that received any light
+    comp = {c: irr[c].to_numpy(np.float32) for c in COMPONENTS}
+    lit = np.zeros(n, bool)
+    for v in comp.values():
+        lit |= v != 0
+    act = np.flatnonzero(lit)
+    w_act = dt[act] / 3600.0
+    groups = {"trip": (run[act], n_runs), "seg": (seg_pos[act], n_seg), "hour": (hour[act], 24)}
+    sums = {g: {} for g in groups}
+    h_all = np.empty((len(act), len(comp)), np.float64)
+    for j, v in enumerate(comp.values()):
+        np.multiply(v[act], w_act, out=h_all[:, j])
+        for g in ("seg", "hour"):
+            key, size = groups[g]
+            sums[g][f"h_{list(comp)[j]}"] = np.bincount(key, h_all[:, j], size)
+    # per trip: the runs are contiguous, so one reduceat sums every column
+    run_act = groups["trip"][0]
+    per_run = np.zeros((n_runs, len(comp)))
+    if len(act):
+        first = np.flatnonzero(np.r_[True, run_act[1:] != run_act[:-1]])
+        per_run[run_act[first]] = np.add.reduceat(h_all, first, axis=0)
+    for j, c in enumerate(comp):
+        sums["trip"][f"h_{c}"] = per_run[:, j]
+    if linear:
+        # paper mode is linear in the irradiation: kWh = kWp x PR x H / 1000 (H in Wh/m2)
+        k = system.kwp * system.performance_ratio / 1000.0
+        for g in ("trip", "seg"):
+            for name, col in pv_source.items():
+                sums[g][name] = k * sums[g][f"h_{col}"]
     else:
-        starts = np.zeros(0, np.int64)
-    names = list(sums)
-    block = np.column_stack([sums[k] for k in names]) if n else np.zeros((0, len(names)))
-    total = np.add.reduceat(block, starts, axis=0) if n else block
-    per_trip = {k: total[:, i] for i, k in enumerate(names)}
-    trip = pd.DataFrame({**energy(per_trip), "seconds": per_trip["seconds"]})
-    trip.insert(0, "service_date", passes["service_date"].to_numpy()[starts])
-    trip.insert(0, "trip_id", np.asarray(passes["trip_id"].to_numpy()[starts]).astype(str))
-    trip = trip.groupby(["trip_id", "service_date"], sort=True).sum().reset_index()
+        speed = passes["speed_mps"].to_numpy(np.float64)[act]
+        for name, col in pv_source.items():
+            e = pv_energy_kwh(comp[col][act].astype(np.float64), dt[act], speed, month, ctx)
+            for g in ("trip", "seg"):
+                key, size = groups[g]
+                sums[g][name] = np.bincount(key, e, size)
+    seconds = {"trip": np.bincount(run, dt, n_runs), "seg": np.bincount(seg_pos, dt, n_seg),
+               "hour": np.bincount(hour, dt, 24)}
+    pv_cols = list(pv_source)
+    h_cols = [f"h_{c}" for c in COMPONENTS]
 
-    # per segment
-    seg_ids, seg_pos = np.unique(passes["segment_id"].to_numpy(np.int64), return_inverse=True)
-    cols = {**sums, **h}
-    per_seg = {name: np.bincount(seg_pos, weights=w, minlength=len(seg_ids)) for name, w in cols.items()}
+    if hasattr(trip_col, "cat"):
+        trip_names = np.asarray(trip_col.cat.categories.to_numpy()[trip_code[starts]]).astype(str)
+    else:
+        trip_names = np.asarray(trip_col.to_numpy()[starts]).astype(str)
+    trip = pd.DataFrame({"trip_id": trip_names,
+                         "service_date": passes["service_date"].to_numpy()[starts],
+                         **{c: sums["trip"][c] for c in pv_cols}, "seconds": seconds["trip"]})
+    if trip.duplicated(["trip_id", "service_date"]).any():
+        trip = trip.groupby(["trip_id", "service_date"], sort=True).sum().reset_index()
+    else:
+        trip = trip.sort_values(["trip_id", "service_date"], kind="stable").reset_index(drop=True)
+
     segm = pd.DataFrame({"segment_id": seg_ids,
-                         "n_passes": np.bincount(seg_pos, minlength=len(seg_ids)).astype(np.int64),
-                         **energy(per_seg), **{k: per_seg[k] for k in h}, "seconds": per_seg["seconds"]})
+                         "n_passes": np.bincount(seg_pos, minlength=n_seg).astype(np.int64),
+                         **{c: sums["seg"][c] for c in pv_cols + h_cols},
+                         "seconds": seconds["seg"]})
 
-    # per local hour
-    hour = _local_hours(passes["t_utc"].to_numpy(np.float64), ctx.timezone)
-    hours = np.unique(hour)
-    pos = np.searchsorted(hours, hour)
-    hourly = pd.DataFrame({"hour": hours.astype(np.int8)})
-    for name in list(h) + ["seconds"]:
-        hourly[name] = np.bincount(pos, weights=cols[name], minlength=len(hours))
+    present = np.flatnonzero(np.bincount(hour, minlength=24) > 0)
+    hourly = pd.DataFrame({"hour": present.astype(np.int8),
+                           **{c: sums["hour"][c][present] for c in h_cols},
+                           "seconds": seconds["hour"][present]})
     return trip, segm, hourly
 
 
@@ -214,9 +285,11 @@ def run_partition(ctx: RunContext, tile: str, month: str, geometry: pd.DataFrame
     if n:
         t1 = time.perf_counter()
         before = dict(stage_seconds())
+        scene = _scene(ctx, tile)
         irr = evaluate_passes(passes, seg, geometry, _radiation(ctx.data_dir, ctx.year),
-                              _scene(ctx, tile), IrradianceCfg(**ctx.irradiance),
-                              ground_albedo=ctx.ground_albedo)
+                              scene, IrradianceCfg(**ctx.irradiance),
+                              ground_albedo=ctx.ground_albedo,
+                              packed=_packed_geometry(ctx, tile, geometry, scene))
         timings["irradiance_s"] = time.perf_counter() - t1
         # the irradiance time split by stage (lookup, ray setup, rays, components, pack)
         timings.update({f"irradiance_{k}": v - before[k] for k, v in stage_seconds().items()})

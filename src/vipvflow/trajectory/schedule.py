@@ -269,7 +269,8 @@ def _expand(runs: pd.DataFrame, pat: pd.DataFrame) -> pd.DataFrame:
     """Outer product of runs (trip, date, origin + start) with their pattern's segments."""
     if runs.empty or pat.empty:
         return _empty_passes()
-    pat = pat.sort_values(["pattern_id", "t_offset_s"], kind="stable").reset_index(drop=True)
+    if not pat.attrs.get("sorted_by_pattern_time"):
+        pat = pat.sort_values(["pattern_id", "t_offset_s"], kind="stable").reset_index(drop=True)
     pids = pat["pattern_id"].to_numpy()
     uniq, first = np.unique(pids, return_index=True)
     count = np.diff(np.r_[first, len(pids)])
@@ -280,7 +281,11 @@ def _expand(runs: pd.DataFrame, pat: pd.DataFrame) -> pd.DataFrame:
     within = np.arange(n.sum()) - np.repeat(np.cumsum(n) - n, n)
     row = first[loc][run_idx] + within
     t0 = runs["t0_utc"].to_numpy(float)[run_idx]
-    trip_code, trip_names = pd.factorize(runs["trip_id"].astype(str), sort=True)
+    if isinstance(runs["trip_id"].dtype, pd.CategoricalDtype):
+        trip_code = runs["trip_id"].cat.codes.to_numpy()
+        trip_names = runs["trip_id"].cat.categories
+    else:
+        trip_code, trip_names = pd.factorize(runs["trip_id"].astype(str), sort=True)
     return pd.DataFrame({
         "segment_id": pat["segment_id"].to_numpy(np.int64)[row],
         "trip_id": pd.Categorical.from_codes(trip_code[run_idx], trip_names),
@@ -313,7 +318,7 @@ def iter_passes(data_dir, tile: str, month, year: int | None = None,
     year : int, optional
         Checked against *month* when both are given.
     routes : list of str, optional
-        Only trips of these ``route_id``\ s (default: all).
+        Only trips of these route ids (default: all).
 
     Returns
     -------
@@ -326,36 +331,82 @@ def iter_passes(data_dir, tile: str, month, year: int | None = None,
         date (see module doc). Only this month and this tile are ever held in memory.
     """
     period = _parse_month(month, year)
-    segs = _read(data_dir, "segments.parquet", columns=["segment_id", "tile"],
-                 filters=[("tile", "==", tile)])
-    if segs.empty:
-        return _empty_passes()
-    pat = _read(data_dir, "patterns.parquet",
-                filters=[("segment_id", "in", segs["segment_id"].to_numpy().tolist())])
+    gdir = (Path(data_dir) / "gtfs").resolve()
+    stamp = _stamp(gdir, _GTFS_TABLES)
+    pat = _tile_patterns(str(gdir), tile, stamp)
     if pat.empty:
         return _empty_passes()
-    trips = _read(data_dir, "trips.parquet",
-                  columns=["trip_id", "route_id", "service_id", "pattern_id", "start_s"])
-    trips = trips[trips["pattern_id"].isin(np.unique(pat["pattern_id"]))]
-    if routes is not None:
-        trips = trips[trips["route_id"].astype(str).isin([str(r) for r in routes])]
-    trips = trips.drop(columns="route_id")
-    sd = service_dates(data_dir, period.year)
-    sd = sd[(sd["date"] >= period.start_time) & (sd["date"] <= period.end_time)]
-    return _passes(data_dir, trips, sd, pat)
-
-
-def _passes(data_dir, trips, sd, pat) -> pd.DataFrame:
-    runs = trips.merge(sd, on="service_id")
+    runs = _month_runs(str(gdir), str(period), None if routes is None else
+                       tuple(sorted(str(r) for r in routes)), stamp)
+    runs = runs[runs["pattern_id"].isin(pat.attrs["pattern_ids"])]
     if runs.empty:
         return _empty_passes()
+    return _expand(runs, pat)
+
+
+_GTFS_TABLES = ("trips.parquet", "patterns.parquet", "segments.parquet", "calendar.parquet",
+                "calendar_dates.parquet", "feed.json")
+
+
+@functools.lru_cache(maxsize=8)
+def _tile_patterns(gdir: str, tile: str, stamp: tuple) -> pd.DataFrame:
+    """The pattern rows of the segments of *tile*, sorted by pattern and time (cached per
+    process: a worker evaluates a tile for every month)."""
+    segs = pq.read_table(Path(gdir) / "segments.parquet", columns=["segment_id", "tile"],
+                         filters=[("tile", "==", tile)]).to_pandas()
+    if segs.empty:
+        return pd.DataFrame()
+    pat = pq.read_table(Path(gdir) / "patterns.parquet",
+                        filters=[("segment_id", "in", segs["segment_id"].to_numpy().tolist())]).to_pandas()
+    if pat.empty:
+        return pd.DataFrame()
+    pat = pat.sort_values(["pattern_id", "t_offset_s"], kind="stable").reset_index(drop=True)
+    pat.attrs["sorted_by_pattern_time"] = True
+    pat.attrs["pattern_ids"] = np.unique(pat["pattern_id"].to_numpy())
+    return pat
+
+
+@functools.lru_cache(maxsize=13)
+def _month_runs(gdir: str, month: str, routes: tuple | None, stamp: tuple) -> pd.DataFrame:
+    """Every run (trip x service date) of *month* with its pattern and UTC start, sorted by
+    service date and trip; ``trip_id`` categorical over all the feed's trips (cached per
+    process: the tiles of a worker share a month's runs)."""
+    period = pd.Period(month, freq="M")
+    trips = pq.read_table(Path(gdir) / "trips.parquet",
+                          columns=["trip_id", "route_id", "service_id", "pattern_id", "start_s"]).to_pandas()
+    names = np.unique(trips["trip_id"].astype(str).to_numpy())
+    if routes is not None:
+        trips = trips[trips["route_id"].astype(str).isin(routes)]
+    trips = trips.drop(columns="route_id")
+    sd = _service_dates_cached(gdir, period.year, _stamp(Path(gdir), ("calendar.parquet",
+                                                                       "calendar_dates.parquet")))
+    sd = sd[(sd["date"] >= period.start_time) & (sd["date"] <= period.end_time)]
+    runs = _runs(Path(gdir).parent, trips, sd)
+    if runs.empty:
+        return runs
+    runs["trip_id"] = pd.Categorical(runs["trip_id"].astype(str), categories=names)
+    return runs[["trip_id", "pattern_id", "service_date", "t0_utc"]]
+
+
+def _runs(data_dir, trips, sd) -> pd.DataFrame:
+    """Trips joined with their service dates: ``t0_utc`` (Unix s of the first departure),
+    sorted by service date and trip."""
+    runs = trips.merge(sd, on="service_id")
+    if runs.empty:
+        return runs
     tz = _feed_info(data_dir)["timezone"]
     udates = np.unique(runs["date"].to_numpy())
     origin = service_day_origin_utc(udates, tz)
     runs = runs.assign(
         t0_utc=origin[np.searchsorted(udates, runs["date"].to_numpy())] + runs["start_s"],
         service_date=runs["date"])
-    runs = runs.sort_values(["service_date", "trip_id"], kind="stable").reset_index(drop=True)
+    return runs.sort_values(["service_date", "trip_id"], kind="stable").reset_index(drop=True)
+
+
+def _passes(data_dir, trips, sd, pat) -> pd.DataFrame:
+    runs = _runs(data_dir, trips, sd)
+    if runs.empty:
+        return _empty_passes()
     # runs are in (date, trip) order and each pattern's segments in time order, so the
     # passes come out sorted by service date, trip and time
     return _expand(runs, pat)
