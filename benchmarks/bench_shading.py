@@ -9,10 +9,14 @@ Figures (all measured in one run, same process, same rays):
 - ``passes_per_s`` / ``passes_per_s_per_core``: :func:`vipvflow.irradiance.evaluate_passes`
   (radiation lookup, sun position, direct ray, diffuse, reflected with one ray per sample
   point of every sunlit reflector group, all-sky + clear-sky + unshaded) on a grid city of box
-  buildings, default configuration (``reflector_points`` = 4);
-- ``passes_per_s_P{1,4,8}`` and ``rays_per_pass_P{..}``: the same with 1, 4, 8 sample points
-  per reflector group (P's cost), ``segment_geometry_s_P{..}`` the geometry stage's time, and
-  ``reflected_mean_P{..}`` the mean reflected irradiance over all passes (P's effect on it).
+  buildings, default configuration (``reflector_points`` = 4, ``reflector_sampling`` =
+  rotate); pass times uniform over June days and nights, ``daylight_share`` of them with any
+  light (night passes cost only the check) and ``daylight_passes_per_s_per_core`` counting
+  those only;
+- ``passes_per_s_{rotate,all}_P{n}``, ``rays_per_pass_..``: the same with 1, 4, 8 sample
+  points per reflector group, traced one per pass in turn (rotate) or all every pass (all);
+  ``segment_geometry_s_P{n}`` the geometry stage's time, and ``reflected_mean_..`` the mean
+  reflected irradiance over the passes (the effect of P and of the sampling on it).
 """
 from __future__ import annotations
 
@@ -120,6 +124,8 @@ def run(tiny: bool = False) -> dict:
     t_pass = _best(lambda: res.update(r=evaluate_passes(passes, segs, geometry, table, scene, cfg)),
                    1 if tiny else 2)
     r = res["r"]
+    # passes with any light (the rest, at night, are skipped by the engine)
+    daylight = float(table.has_light(passes["t_utc"].to_numpy() + 0.75).mean())
     # --- the number of sample points per reflector group: cost and effect
     from vipvflow.shading import Scene as _Scene
 
@@ -132,19 +138,27 @@ def run(tiny: bool = False) -> dict:
             counted["rays"] += len(origins)
             return super().occluded(origins, dirs, tfar)
 
-    cscene = Counting(mesh)
-    for P in (1, 4, 8):
-        cfg_p = cfg.model_copy(update={"reflector_points": P})
-        t = time.perf_counter()
-        geo_p = segment_geometry(scene, segs, cfg_p)
-        per_p[f"segment_geometry_s_P{P}"] = time.perf_counter() - t
+    class CountingLocal(Counting):
+        def occluded_local(self, origins, dirs, tfar):
+            counted["rays"] += len(origins)
+            return super().occluded_local(origins, dirs, tfar)
+
+    cscene = CountingLocal(mesh)
+    geos = {}
+    for sampling, P in (("rotate", 1), ("rotate", 4), ("rotate", 8), ("all", 4), ("all", 8)):
+        cfg_p = cfg.model_copy(update={"reflector_points": P, "reflector_sampling": sampling})
+        if P not in geos:
+            t = time.perf_counter()
+            geos[P] = segment_geometry(scene, segs, cfg_p)
+            per_p[f"segment_geometry_s_P{P}"] = time.perf_counter() - t
+        name = f"{sampling}_P{P}"
         counted["rays"] = 0
-        rp = evaluate_passes(passes.iloc[:n_p], segs, geo_p, table, cscene, cfg_p)
-        per_p[f"rays_per_pass_P{P}"] = counted["rays"] / n_p
-        per_p[f"reflected_mean_P{P}"] = float(rp["reflected"].mean())
-        t_p = _best(lambda: evaluate_passes(passes.iloc[:n_p], segs, geo_p, table, scene, cfg_p),
+        rp = evaluate_passes(passes.iloc[:n_p], segs, geos[P], table, cscene, cfg_p)
+        per_p[f"rays_per_pass_{name}"] = counted["rays"] / n_p
+        per_p[f"reflected_mean_{name}"] = float(rp["reflected"].mean())
+        t_p = _best(lambda: evaluate_passes(passes.iloc[:n_p], segs, geos[P], table, scene, cfg_p),
                     1 if tiny else 2)
-        per_p[f"passes_per_s_P{P}"] = n_p / t_p
+        per_p[f"passes_per_s_{name}"] = n_p / t_p
     figures = {
         "raw_embreex_rays_per_s": n_rays / t_raw,
         "kernel_rays_per_s_1thread": n_rays / t_k1,
@@ -159,9 +173,12 @@ def run(tiny: bool = False) -> dict:
         "passes": n_pass,
         "passes_per_s": n_pass / t_pass,
         "passes_per_s_per_core": n_pass / t_pass / cores,
+        "daylight_share": daylight,
+        "daylight_passes_per_s_per_core": daylight * n_pass / t_pass / cores,
         "sun_visible_share": float(r["sun_visible"].mean()),
         "shading_loss_share": float(1 - r["total"].sum() / r["total_unshaded"].sum()),
         "reflector_points": cfg.reflector_points,
+        "reflector_sampling": cfg.reflector_sampling,
         **per_p,
     }
     targets = {"kernel_vs_raw": ">= 0.5", "passes_per_s_per_core": ">= 1e6 (full physics)",

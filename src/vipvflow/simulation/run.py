@@ -9,7 +9,6 @@ import sys
 import time
 from pathlib import Path
 
-import dask
 import pandas as pd
 
 from ..config import Config
@@ -51,28 +50,10 @@ def make_client(cfg: Config, scheduler: str | None, n_workers: int | None):
     if scheduler:
         return Client(scheduler), None
     n = n_workers or cfg.dask.n_workers or os.cpu_count() or 1
-    with dask.config.set({"distributed.nanny.pre-spawn-environ": worker_environ()}):
-        cluster = LocalCluster(n_workers=n, threads_per_worker=cfg.dask.threads_per_worker or 1,
-                               processes=True, memory_limit=cfg.dask.memory_limit,
-                               dashboard_address=":0", silence_logs=logging.ERROR)
+    cluster = LocalCluster(n_workers=n, threads_per_worker=cfg.dask.threads_per_worker or 1,
+                           processes=True, memory_limit=cfg.dask.memory_limit,
+                           dashboard_address=":0", silence_logs=logging.ERROR)
     return Client(cluster), cluster
-
-
-def worker_environ() -> dict:
-    """Environment for the worker processes a nanny spawns: Dask's default without
-    ``MALLOC_TRIM_THRESHOLD_``.
-
-    Dask sets that variable so workers give freed memory back to the OS; it also freezes
-    glibc's mmap threshold at 128 kB, so every large temporary numpy array is a fresh
-    mapping whose pages fault in again.  The irradiance and aggregation steps allocate such
-    arrays per chunk of passes and ran 2-3 times slower in a worker than in a plain process
-    (measured on the demo's line-year partitions); without it glibc adapts the threshold
-    as in any Python process.  Workers started by hand for a remote scheduler get the same
-    effect from ``DASK_DISTRIBUTED__NANNY__PRE_SPAWN_ENVIRON='{}'`` (see README).
-    """
-    env = dict(dask.config.get("distributed.nanny.pre-spawn-environ", default={}) or {})
-    env.pop("MALLOC_TRIM_THRESHOLD_", None)
-    return env
 
 
 class FleetView:
