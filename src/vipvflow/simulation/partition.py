@@ -188,6 +188,11 @@ def _dense_positions(ids: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return np.flatnonzero(present) + lo, pos[ids - lo]
 
 
+def trip_names_of(values) -> np.ndarray:
+    """Sort keys (int codes in sorted order) of trip ids given as any array-like."""
+    return np.unique(np.asarray(values).astype(str), return_inverse=True)[1]
+
+
 def aggregate_partition(passes: pd.DataFrame, irr: pd.DataFrame, month: int, ctx: RunContext):
     """Sum a partition's passes per trip and service date, per segment and per local hour.
 
@@ -230,22 +235,25 @@ def aggregate_partition(passes: pd.DataFrame, irr: pd.DataFrame, month: int, ctx
         lit |= v != 0
     act = np.flatnonzero(lit)
     w_act = dt[act] / 3600.0
-    groups = {"trip": (run[act], n_runs), "seg": (seg_pos[act], n_seg), "hour": (hour[act], 24)}
-    sums = {g: {} for g in groups}
-    h_all = np.empty((len(act), len(comp)), np.float64)
+    names = list(comp)
+    h_all = np.empty((len(names), len(act)), np.float64)      # one contiguous row per component
     for j, v in enumerate(comp.values()):
-        np.multiply(v[act], w_act, out=h_all[:, j])
-        for g in ("seg", "hour"):
-            key, size = groups[g]
-            sums[g][f"h_{list(comp)[j]}"] = np.bincount(key, h_all[:, j], size)
-    # per trip: the runs are contiguous, so one reduceat sums every column
-    run_act = groups["trip"][0]
-    per_run = np.zeros((n_runs, len(comp)))
+        np.multiply(v[act], w_act, out=h_all[j])
+    sums = {"trip": {}, "seg": {}, "hour": {}}
+    # per segment and local hour in one bincount per component: bins (segment, hour)
+    seg_hour = seg_pos[act] * 24 + hour[act]
+    for j, c in enumerate(names):
+        table = np.bincount(seg_hour, h_all[j], n_seg * 24).reshape(n_seg, 24)
+        sums["seg"][f"h_{c}"] = table.sum(axis=1)
+        sums["hour"][f"h_{c}"] = table.sum(axis=0)
+    # per trip: the runs are contiguous, so one reduceat sums every component
+    run_act = run[act]
+    per_run = np.zeros((len(names), n_runs))
     if len(act):
         first = np.flatnonzero(np.r_[True, run_act[1:] != run_act[:-1]])
-        per_run[run_act[first]] = np.add.reduceat(h_all, first, axis=0)
-    for j, c in enumerate(comp):
-        sums["trip"][f"h_{c}"] = per_run[:, j]
+        per_run[:, run_act[first]] = np.add.reduceat(h_all, first, axis=1)
+    for j, c in enumerate(names):
+        sums["trip"][f"h_{c}"] = per_run[j]
     if linear:
         # paper mode is linear in the irradiation: kWh = kWp x PR x H / 1000 (H in Wh/m2)
         k = system.kwp * system.performance_ratio / 1000.0
@@ -256,25 +264,27 @@ def aggregate_partition(passes: pd.DataFrame, irr: pd.DataFrame, month: int, ctx
         speed = passes["speed_mps"].to_numpy(np.float64)[act]
         for name, col in pv_source.items():
             e = pv_energy_kwh(comp[col][act].astype(np.float64), dt[act], speed, month, ctx)
-            for g in ("trip", "seg"):
-                key, size = groups[g]
-                sums[g][name] = np.bincount(key, e, size)
+            sums["trip"][name] = np.bincount(run_act, e, n_runs)
+            sums["seg"][name] = np.bincount(seg_pos[act], e, n_seg)
     seconds = {"trip": np.bincount(run, dt, n_runs), "seg": np.bincount(seg_pos, dt, n_seg),
                "hour": np.bincount(hour, dt, 24)}
     pv_cols = list(pv_source)
     h_cols = [f"h_{c}" for c in COMPONENTS]
 
+    # trips ordered by trip id and date (category codes follow the sorted names)
     if hasattr(trip_col, "cat"):
-        trip_names = np.asarray(trip_col.cat.categories.to_numpy()[trip_code[starts]]).astype(str)
+        order = np.lexsort((day[starts], trip_code[starts]))
+        trip_names = np.asarray(trip_col.cat.categories.to_numpy()[trip_code[starts][order]]).astype(str)
     else:
-        trip_names = np.asarray(trip_col.to_numpy()[starts]).astype(str)
+        order = np.lexsort((day[starts], trip_names_of(trip_col.to_numpy()[starts])))
+        trip_names = np.asarray(trip_col.to_numpy()[starts][order]).astype(str)
     trip = pd.DataFrame({"trip_id": trip_names,
-                         "service_date": passes["service_date"].to_numpy()[starts],
-                         **{c: sums["trip"][c] for c in pv_cols}, "seconds": seconds["trip"]})
-    if trip.duplicated(["trip_id", "service_date"]).any():
+                         "service_date": passes["service_date"].to_numpy()[starts][order],
+                         **{c: sums["trip"][c][order] for c in pv_cols},
+                         "seconds": seconds["trip"][order]})
+    same = (trip_names[1:] == trip_names[:-1]) & (day[starts][order][1:] == day[starts][order][:-1])
+    if same.any():       # a (trip, date) split over several runs: merge them
         trip = trip.groupby(["trip_id", "service_date"], sort=True).sum().reset_index()
-    else:
-        trip = trip.sort_values(["trip_id", "service_date"], kind="stable").reset_index(drop=True)
 
     segm = pd.DataFrame({"segment_id": seg_ids,
                          "n_passes": np.bincount(seg_pos, minlength=n_seg).astype(np.int64),
