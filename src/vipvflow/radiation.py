@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import json
 import logging
+import os
 import re
 from dataclasses import dataclass
 from pathlib import Path
@@ -366,6 +367,56 @@ def ingest_cams(paths, data_dir, clear_sky_margin=CLEAR_SKY_MARGIN) -> dict:
     return report
 
 
+# --------------------------------------------------------------------------- sun
+def sun_vectors(t_utc, lat, lon, altitude, step_s: float = 300.0) -> np.ndarray:
+    """Unit vectors towards the sun (east, north, up) on a time grid, (3, K, N) float32.
+
+    pvlib's solar position (SPA, apparent zenith) every *step_s* seconds, its unit vector
+    interpolated linearly to the grid *t_utc* (Unix s) and normalised.
+
+    Parameters
+    ----------
+    t_utc : (N,) float, Unix s;  lat, lon : (K,) degrees;  altitude : (K,) m
+    """
+    t = np.asarray(t_utc, np.float64)
+    lat, lon = np.atleast_1d(lat), np.atleast_1d(lon)
+    alt = np.broadcast_to(np.asarray(altitude, np.float64), lat.shape)
+    sun = np.empty((3, len(lat), len(t)), np.float32)
+    coarse = np.arange(t[0] - step_s, t[-1] + 2 * step_s, step_s)
+    times = pd.to_datetime(np.round(coarse * 1e3).astype(np.int64), unit="ms", utc=True)
+    for i in range(len(lat)):
+        sp = pvlib.solarposition.get_solarposition(times, lat[i], lon[i], altitude=alt[i])
+        z, a = np.radians(sp["apparent_zenith"].to_numpy()), np.radians(sp["azimuth"].to_numpy())
+        for j, comp in enumerate((np.sin(z) * np.sin(a), np.sin(z) * np.cos(a), np.cos(z))):
+            sun[j, i] = np.interp(t, coarse, comp)
+    return sun / np.sqrt((sun ** 2).sum(axis=0))
+
+
+def _cached_sun(path: Path, grid, lat, lon, alt) -> np.ndarray:
+    """:func:`sun_vectors` for a radiation file's grid, kept beside the file
+    (``sun_<first>_<n>.npz``) so each worker of a run loads it instead of running SPA; the
+    cache names the radiation file's size and time, the grid and the locations it is for,
+    and is rewritten when any differ (or ignored where the folder is read-only)."""
+    st = path.stat()
+    key = json.dumps([st.st_size, st.st_mtime_ns, float(grid[0]), float(grid[-1]), len(grid),
+                      np.round(lat, 8).tolist(), np.round(lon, 8).tolist(), np.round(alt, 3).tolist()])
+    cache = path.with_name(f"sun_{int(grid[0])}_{len(grid)}.npz")
+    try:
+        with np.load(cache) as z:
+            if str(z["key"]) == key:
+                return z["sun"]
+    except (OSError, KeyError, ValueError):
+        pass
+    sun = sun_vectors(grid, lat, lon, alt)
+    tmp = cache.with_name(f".{cache.name}.{os.getpid()}.tmp.npz")
+    try:
+        np.savez(tmp, sun=sun, key=np.array(key))
+        os.replace(tmp, cache)
+    except OSError:
+        pass
+    return sun
+
+
 # --------------------------------------------------------------------------- lookup
 @dataclass
 class RadiationTable:
@@ -441,7 +492,8 @@ class RadiationTable:
         return self.t0 + (self.n - 1) * self.step_s
 
     @classmethod
-    def from_grid(cls, t_utc, values: dict, lat, lon, altitude=0.0, sun_step_s: float = 300.0):
+    def from_grid(cls, t_utc, values: dict, lat, lon, altitude=0.0, sun_step_s: float = 300.0,
+                  sun: np.ndarray | None = None):
         """Build from arrays on a regular grid; computes the sun position once.
 
         Parameters
@@ -452,6 +504,8 @@ class RadiationTable:
         sun_step_s : float
             pvlib's solar position is evaluated every ``sun_step_s`` and the unit vector
             interpolated (chord error below 1e-4 degrees for 5 min).
+        sun : (3, K, N) float32, optional
+            The unit sun vectors of an earlier call on the same grid (see :meth:`load`).
         """
         t = np.asarray(t_utc, dtype=np.float64)
         lat = np.atleast_1d(np.asarray(lat, np.float64))
@@ -465,17 +519,10 @@ class RadiationTable:
         for c in COLUMNS:
             if data[c].shape[0] != k:
                 data[c] = np.broadcast_to(data[c], (k, len(t))).copy()
-        sun = np.empty((3, k, len(t)), np.float32)
-        coarse = np.arange(t[0] - sun_step_s, t[-1] + 2 * sun_step_s, sun_step_s)
-        times = pd.to_datetime(np.round(coarse * 1e3).astype(np.int64), unit="ms", utc=True)
-        for i in range(k):
-            sp = pvlib.solarposition.get_solarposition(times, lat[i], lon[i], altitude=alt[i])
-            z, a = np.radians(sp["apparent_zenith"].to_numpy()), np.radians(sp["azimuth"].to_numpy())
-            for j, comp in enumerate((np.sin(z) * np.sin(a), np.sin(z) * np.cos(a), np.cos(z))):
-                sun[j, i] = np.interp(t, coarse, comp)
-        norm = np.sqrt((sun ** 2).sum(axis=0))
+        if sun is None:
+            sun = sun_vectors(t, lat, lon, alt, sun_step_s)
         for j, name in enumerate(("sun_x", "sun_y", "sun_z")):
-            data[name] = sun[j] / norm
+            data[name] = sun[j]
         return cls(t0=float(t[0]), step_s=step, data=data, lat=lat, lon=lon)
 
     @classmethod
@@ -497,8 +544,8 @@ class RadiationTable:
             raise InputError(f"{path}: holds no radiation for {year} (re-ingest CAMS data "
                              f"covering {year})")
         locs = table[["lat", "lon"]].drop_duplicates().to_numpy()
-        t_all = np.unique(table["t_utc"].to_numpy())
-        grid = np.arange(t_all[0], t_all[-1] + 1, _GRID_S, dtype=np.float64)
+        t_all = table["t_utc"].to_numpy()
+        grid = np.arange(t_all.min(), t_all.max() + 1, _GRID_S, dtype=np.float64)
         values = {c: np.full((len(locs), len(grid)), np.nan, np.float32) for c in COLUMNS}
         alts = []
         for i, (la, lo_) in enumerate(locs):
@@ -511,7 +558,9 @@ class RadiationTable:
         if covered < 1.0:
             log.warning("%s: %.1f %% of %d's minute grid has no radiation (NaN)", path,
                         100 * (1 - covered), year)
-        return cls.from_grid(grid, values, locs[:, 0], locs[:, 1], np.array(alts))
+        alts = np.array(alts)
+        sun = _cached_sun(path, grid, locs[:, 0], locs[:, 1], alts)
+        return cls.from_grid(grid, values, locs[:, 0], locs[:, 1], alts, sun=sun)
 
     @classmethod
     def from_cams(cls, paths) -> "RadiationTable":

@@ -2,10 +2,12 @@
 from __future__ import annotations
 
 import dataclasses
+import importlib
 import json
 import logging
 import os
 import sys
+import threading
 import time
 from pathlib import Path
 
@@ -157,6 +159,11 @@ def run_simulation(cfg: Config, year: int, scheduler: str | None = None,
     total = len(tiles) * len(cfg.run.months)
     if max_partitions is not None:
         todo = todo[:max_partitions]
+    # the radiation table's sun positions are computed (and cached beside the radiation
+    # file, where every worker loads them) while the cluster starts
+    warm = threading.Thread(target=_warm_radiation, args=(ctx.data_dir, year), daemon=True,
+                            name="sun-positions")
+    warm.start()
     client, cluster = make_client(cfg, scheduler, n_workers)
     try:
         n_workers_now = len(client.scheduler_info()["workers"])
@@ -167,7 +174,11 @@ def run_simulation(cfg: Config, year: int, scheduler: str | None = None,
         say(f"dask dashboard: {client.dashboard_link}")
         say(f"{len(tiles)} tiles x {len(cfg.run.months)} months = {total} partitions, {len(todo)} to compute "
             f"({total - len(todo)} already done) with {n_workers_now} workers")
+        warm.join()
         t_map = time.perf_counter()
+        # the reduce's plotting libraries load while the workers compute
+        threading.Thread(target=importlib.import_module, args=("vipvflow.simulation.report",),
+                         daemon=True, name="import-report").start()
         results = _map(client, ctx, todo)
         timings["map_s"] = time.perf_counter() - t_map
         builds = client.run(worker_bvh_builds)
@@ -186,6 +197,17 @@ def run_simulation(cfg: Config, year: int, scheduler: str | None = None,
     say(_summary_line(summary))
     say(f"outputs in {run_dir}")
     return run_dir
+
+
+def _warm_radiation(data_dir: str, year: int) -> None:
+    """Load the radiation table once in this process (writes its sun-position cache); a
+    failure is left for the workers to report with the file named."""
+    from ..radiation import RadiationTable
+
+    try:
+        RadiationTable.load(data_dir, year)
+    except Exception:  # noqa: BLE001 - the same load fails again in the tasks, with its message
+        pass
 
 
 def _map(client, ctx: RunContext, todo: list[tuple[str, str]]) -> list[dict]:
