@@ -8,11 +8,41 @@ from pathlib import Path
 import pandas as pd
 
 
+def _plain_table(df: pd.DataFrame):
+    """*df* as a pyarrow Table built column by column from numpy, when every column is a
+    number, bool, datetime64 or string (the partition and geometry tables); ``None``
+    otherwise (GeoDataFrames, categoricals, ...), for pandas to convert."""
+    import pyarrow as pa
+
+    if hasattr(df, "geometry") or not df.columns.is_unique:
+        return None
+    arrays = []
+    for name in df.columns:
+        col = df[name]
+        kind = col.dtype.kind
+        if kind in "biuf" or (kind == "M" and getattr(col.dtype, "tz", None) is None):
+            arrays.append(pa.array(col.to_numpy()))
+        elif pd.api.types.is_string_dtype(col.dtype) and not isinstance(col.dtype, pd.CategoricalDtype):
+            arrays.append(pa.array(col.to_numpy(dtype=object), type=pa.string()))
+        else:
+            return None
+    return pa.Table.from_arrays(arrays, names=[str(c) for c in df.columns])
+
+
 def write_parquet(df: pd.DataFrame, path: Path) -> Path:
-    """Write *df* (DataFrame or GeoDataFrame) to *path* atomically (temporary name, rename)."""
+    """Write *df* (DataFrame or GeoDataFrame) to *path* atomically (temporary name, rename).
+
+    Plain tables (numbers, bools, dates, strings) go straight to pyarrow: pandas' own
+    conversion costs more than the write for the run's wide, small tables."""
+    import pyarrow.parquet as pq
+
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    df.to_parquet(tmp, index=False)
+    table = _plain_table(df)
+    if table is None:
+        df.to_parquet(tmp, index=False)
+    else:
+        pq.write_table(table, tmp)
     os.replace(tmp, path)
     return path
 
