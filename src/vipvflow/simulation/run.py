@@ -182,21 +182,32 @@ def run_simulation(cfg: Config, year: int, scheduler: str | None = None,
         results = _map(client, ctx, todo)
         timings["map_s"] = time.perf_counter() - t_map
         builds = client.run(worker_bvh_builds)
+    except BaseException:
+        _close(client, cluster)
+        raise
+    # the cluster shuts down while this process reduces
+    closer = threading.Thread(target=_close, args=(client, cluster), name="close-cluster")
+    closer.start()
+    try:
+        if not all(partition_done(run_dir, t, m) for t in tiles for m in _months(cfg, year)):
+            say("stopped before all partitions were computed; run the same command again to resume")
+            return run_dir
+        t_red = time.perf_counter()
+        summary = reduce_run(cfg, year, run_dir, say=say)
+        timings["reduce_s"] = time.perf_counter() - t_red
     finally:
-        client.close()
-        if cluster is not None:
-            cluster.close()
-    if not all(partition_done(run_dir, t, m) for t in tiles for m in _months(cfg, year)):
-        say("stopped before all partitions were computed; run the same command again to resume")
-        return run_dir
-    t_red = time.perf_counter()
-    summary = reduce_run(cfg, year, run_dir, say=say)
-    timings["reduce_s"] = time.perf_counter() - t_red
+        closer.join()
     timings["total_s"] = time.perf_counter() - t_start
     _write_manifest(cfg, year, run_dir, checksums, timings, results, builds)
     say(_summary_line(summary))
     say(f"outputs in {run_dir}")
     return run_dir
+
+
+def _close(client, cluster) -> None:
+    client.close()
+    if cluster is not None:
+        cluster.close()
 
 
 def _warm_radiation(data_dir: str, year: int) -> None:
