@@ -15,7 +15,12 @@ The paper's model (sections 3.2.1 to 3.2.3):
   with rays from those points: sky ``F_s``, modelled ground/terrain ``F_g`` (albedo-weighted)
   and open ground beyond the mesh ``F_o``.  Per pass
   ``E_j = DNI max(cos theta_j, 0) L_j + DHI F_s + GHI (F_g + rho_g F_o)``, with ``L_j`` the
-  lit fraction of the sample points (one occlusion ray each).  Only one bounce: light
+  lit fraction of the sample points: by default (``reflector_sampling: rotate``) one point
+  per pass, taken in turn by a hash of segment and time, is traced and counts as 0 or 1, so
+  the mean over a segment's passes is the P-point fraction with one ray per group instead
+  of P (on the demo's line-year: annual reflected light within 0.02 % of tracing every
+  point, per trip within 2.6 % RMS of the reflected part); ``all`` traces every point
+  every pass (one sun at a time: the Radiance cross-check).  Only one bounce: light
   reaching a reflector from other facades or roofs (bounced at least twice) is left out,
   which underestimates the reflected part slightly (in a 16 m canyon 5-11 % of it, about
   1-4 W/m2, against Radiance); the ground seen by a facade is lit as an open field (GHI),

@@ -23,7 +23,14 @@ def _plain_table(df: pd.DataFrame):
         if kind in "biuf" or (kind == "M" and getattr(col.dtype, "tz", None) is None):
             arrays.append(pa.array(col.to_numpy()))
         elif pd.api.types.is_string_dtype(col.dtype) and not isinstance(col.dtype, pd.CategoricalDtype):
-            arrays.append(pa.array(col.to_numpy(dtype=object), type=pa.string()))
+            try:        # object columns may hold anything: only real strings take this path
+                arr = pa.array(col.to_numpy(dtype=object), from_pandas=True)
+            except (pa.ArrowInvalid, pa.ArrowTypeError):
+                return None
+            if not (pa.types.is_string(arr.type) or pa.types.is_large_string(arr.type)
+                    or (pa.types.is_null(arr.type) and col.dtype != object)):
+                return None
+            arrays.append(arr.cast(pa.string()))
         else:
             return None
     return pa.Table.from_arrays(arrays, names=[str(c) for c in df.columns])
