@@ -138,12 +138,11 @@ def run(tiny: bool = False) -> dict:
             counted["rays"] += len(origins)
             return super().occluded(origins, dirs, tfar)
 
-    class CountingLocal(Counting):
         def occluded_local(self, origins, dirs, tfar):
             counted["rays"] += len(origins)
             return super().occluded_local(origins, dirs, tfar)
 
-    cscene = CountingLocal(mesh)
+    cscene = Counting(mesh)
     geos = {}
     for sampling, P in (("rotate", 1), ("rotate", 4), ("rotate", 8), ("all", 4), ("all", 8)):
         cfg_p = cfg.model_copy(update={"reflector_points": P, "reflector_sampling": sampling})

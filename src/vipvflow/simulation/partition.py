@@ -188,11 +188,6 @@ def _dense_positions(ids: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return np.flatnonzero(present) + lo, pos[ids - lo]
 
 
-def trip_names_of(values) -> np.ndarray:
-    """Sort keys (int codes in sorted order) of trip ids given as any array-like."""
-    return np.unique(np.asarray(values).astype(str), return_inverse=True)[1]
-
-
 def aggregate_partition(passes: pd.DataFrame, irr: pd.DataFrame, month: int, ctx: RunContext):
     """Sum a partition's passes per trip and service date, per segment and per local hour.
 
@@ -201,8 +196,9 @@ def aggregate_partition(passes: pd.DataFrame, irr: pd.DataFrame, month: int, ctx
     n_passes``, the same kWh, irradiation ``h_<component>`` in Wh/m2, ``seconds``) and per
     local clock hour (``hour``, irradiation, ``seconds``).
 
-    One ``bincount`` per column and grouping, over the passes that received any light only
-    (night passes add nothing but their time); the (trip, date) runs come from the pass
+    One ``bincount`` per component over (segment, local hour) bins and one ``reduceat`` over
+    the (trip, date) runs, over the passes that received any light only (night passes add
+    nothing but their time); the (trip, date) runs come from the pass
     order (sorted by service date, trip and time, as :func:`vipvflow.trajectory.iter_passes`
     gives them; a (trip, date) split over several runs is merged).
     """
@@ -214,9 +210,13 @@ def aggregate_partition(passes: pd.DataFrame, irr: pd.DataFrame, month: int, ctx
                  **{f"pv_kwh_{c}": c for c in PV_COMPONENTS}}
 
     # groups: (trip, date) run, segment, local hour
+    # trip codes in the order of the trip names (categories are sorted by iter_passes)
     trip_col = passes["trip_id"]
-    trip_code = np.asarray(trip_col.cat.codes if hasattr(trip_col, "cat")
-                           else pd.factorize(trip_col)[0], dtype=np.int64)
+    if hasattr(trip_col, "cat"):
+        trip_code, trip_uniques = trip_col.cat.codes.to_numpy(), trip_col.cat.categories
+    else:
+        trip_code, trip_uniques = pd.factorize(trip_col, sort=True)
+    trip_code = np.asarray(trip_code, dtype=np.int64)
     day = passes["service_date"].to_numpy().astype("datetime64[D]").astype(np.int64)
     new_run = np.ones(n, bool)
     if n > 1:
@@ -271,13 +271,9 @@ def aggregate_partition(passes: pd.DataFrame, irr: pd.DataFrame, month: int, ctx
     pv_cols = list(pv_source)
     h_cols = [f"h_{c}" for c in COMPONENTS]
 
-    # trips ordered by trip id and date (category codes follow the sorted names)
-    if hasattr(trip_col, "cat"):
-        order = np.lexsort((day[starts], trip_code[starts]))
-        trip_names = np.asarray(trip_col.cat.categories.to_numpy()[trip_code[starts][order]]).astype(str)
-    else:
-        order = np.lexsort((day[starts], trip_names_of(trip_col.to_numpy()[starts])))
-        trip_names = np.asarray(trip_col.to_numpy()[starts][order]).astype(str)
+    # trips ordered by trip id and date
+    order = np.lexsort((day[starts], trip_code[starts]))
+    trip_names = np.asarray(np.asarray(trip_uniques)[trip_code[starts][order]]).astype(str)
     trip = pd.DataFrame({"trip_id": trip_names,
                          "service_date": passes["service_date"].to_numpy()[starts][order],
                          **{c: sums["trip"][c][order] for c in pv_cols},

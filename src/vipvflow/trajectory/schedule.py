@@ -352,12 +352,13 @@ _GTFS_TABLES = ("trips.parquet", "patterns.parquet", "segments.parquet", "calend
 def _tile_patterns(gdir: str, tile: str, stamp: tuple) -> pd.DataFrame:
     """The pattern rows of the segments of *tile*, sorted by pattern and time (cached per
     process: a worker evaluates a tile for every month)."""
-    segs = pq.read_table(Path(gdir) / "segments.parquet", columns=["segment_id", "tile"],
-                         filters=[("tile", "==", tile)]).to_pandas()
+    data_dir = Path(gdir).parent
+    segs = _read(data_dir, "segments.parquet", columns=["segment_id", "tile"],
+                 filters=[("tile", "==", tile)])
     if segs.empty:
         return pd.DataFrame()
-    pat = pq.read_table(Path(gdir) / "patterns.parquet",
-                        filters=[("segment_id", "in", segs["segment_id"].to_numpy().tolist())]).to_pandas()
+    pat = _read(data_dir, "patterns.parquet",
+                filters=[("segment_id", "in", segs["segment_id"].to_numpy().tolist())])
     if pat.empty:
         return pd.DataFrame()
     pat = pat.sort_values(["pattern_id", "t_offset_s"], kind="stable").reset_index(drop=True)
@@ -372,8 +373,8 @@ def _month_runs(gdir: str, month: str, routes: tuple | None, stamp: tuple) -> pd
     service date and trip; ``trip_id`` categorical over all the feed's trips (cached per
     process: the tiles of a worker share a month's runs)."""
     period = pd.Period(month, freq="M")
-    trips = pq.read_table(Path(gdir) / "trips.parquet",
-                          columns=["trip_id", "route_id", "service_id", "pattern_id", "start_s"]).to_pandas()
+    trips = _read(Path(gdir).parent, "trips.parquet",
+                  columns=["trip_id", "route_id", "service_id", "pattern_id", "start_s"])
     names = np.unique(trips["trip_id"].astype(str).to_numpy())
     if routes is not None:
         trips = trips[trips["route_id"].astype(str).isin(routes)]
