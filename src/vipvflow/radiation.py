@@ -34,7 +34,6 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
-import pvlib
 
 from .errors import InputError
 
@@ -64,6 +63,7 @@ _GRID_S = 60
 # --------------------------------------------------------------------------- reading
 def _scan_header(path: Path) -> dict:
     """Check the '#' header of a CAMS CSV; return the line numbers and values found."""
+    import pvlib  # here and below imported where used: a worker's radiation lookups never need it
     try:
         fh = open(path, encoding="utf-8", errors="replace")
     except OSError as exc:
@@ -137,6 +137,8 @@ def tst_to_utc(t_tst: pd.DatetimeIndex, longitude: float) -> pd.DatetimeIndex:
     t_tst : DatetimeIndex, naive or UTC-labelled, true solar time
     longitude : float, degrees east
     """
+    import pvlib
+
     naive = t_tst.tz_localize(None) if t_tst.tz is not None else t_tst
     # equation of time changes by < 30 s per day: evaluating it at the TST date is exact enough
     eot_min = pvlib.solarposition.equation_of_time_spencer71(naive.day_of_year.to_numpy())
@@ -171,6 +173,8 @@ def read_cams_file(path, clear_sky_margin=CLEAR_SKY_MARGIN) -> tuple[pd.DataFram
     InputError
         Naming the file and the header line or column that is wrong.
     """
+    import pvlib
+
     path = Path(path)
     info = _scan_header(path)
     try:
@@ -378,6 +382,8 @@ def sun_vectors(t_utc, lat, lon, altitude, step_s: float = 300.0) -> np.ndarray:
     ----------
     t_utc : (N,) float, Unix s;  lat, lon : (K,) degrees;  altitude : (K,) m
     """
+    import pvlib
+
     t = np.asarray(t_utc, np.float64)
     lat, lon = np.atleast_1d(lat), np.atleast_1d(lon)
     alt = np.broadcast_to(np.asarray(altitude, np.float64), lat.shape)

@@ -14,6 +14,7 @@ import geopandas as gpd
 import numpy as np
 import pandas as pd
 import pyarrow as pa
+import pyarrow.dataset as ds
 import pyarrow.parquet as pq
 
 from ..config import Config
@@ -23,22 +24,49 @@ from .storage import write_json, write_parquet
 log = logging.getLogger(__name__)
 
 
-def _read_parts(run_dir: Path, kind: str) -> pd.DataFrame:
-    """Every partition file of *kind*, in path order, as one DataFrame.
+def _part_table(run_dir: Path, kind: str, pattern: str = "tile=*/month=*.parquet") -> pa.Table | None:
+    """Every partition file of *kind* (``parts/<kind>/<pattern>``), in path order, as one Arrow
+    table (``None``: no files).
 
-    Files are read by pyarrow on a few threads and concatenated as Arrow tables (a run has
-    hundreds to thousands of small files: one pandas read each cost most of the reduce)."""
-    files = sorted((run_dir / "parts" / kind).glob("tile=*/month=*.parquet"))
+    One pyarrow dataset over the files, read by Arrow's own threads (a run has hundreds to
+    thousands of small files: one pandas read each cost most of the reduce); files whose
+    schemas differ (an empty partition's columns, say) are read one by one and their
+    schemas promoted instead."""
+    files = sorted((run_dir / "parts" / kind).glob(pattern))
     if not files:
-        return pd.DataFrame()
+        return None
+    try:
+        return ds.dataset([str(f) for f in files], format="parquet").to_table()
+    except (pa.ArrowInvalid, pa.ArrowTypeError, pa.ArrowNotImplementedError):
+        pass
     with ThreadPoolExecutor(max_workers=4) as pool:
         tables = list(pool.map(pq.read_table, files))
     filled = [t for t in tables if t.num_rows] or tables[:1]
-    try:
-        table = pa.concat_tables(filled, promote_options="permissive")
-    except (pa.ArrowInvalid, pa.ArrowTypeError, pa.ArrowNotImplementedError):
-        return pd.concat([t.to_pandas() for t in filled], ignore_index=True)
-    return table.to_pandas()
+    return pa.concat_tables(filled, promote_options="permissive")
+
+
+def _read_parts(run_dir: Path, kind: str) -> pd.DataFrame:
+    """Every partition file of *kind*, in path order, as one DataFrame."""
+    table = _part_table(run_dir, kind)
+    return pd.DataFrame() if table is None else table.to_pandas()
+
+
+def _trip_totals(run_dir: Path) -> pd.DataFrame:
+    """The trip partitions summed per trip and service date (a trip crosses many tiles),
+    sorted by both; the PV columns (``pv_kwh*``) and ``seconds``.
+
+    Summed by Arrow on one thread (a fixed order of addition, so a run gives the same
+    figures every time) before anything becomes a pandas object."""
+    table = _part_table(run_dir, "trip")
+    if table is None or not table.num_rows:
+        raise InputError(f"{run_dir / 'parts' / 'trip'}: no trip partitions with passes: "
+                         "the run's routes never pass its tiles in its months")
+    cols = [c for c in table.column_names if c.startswith("pv_kwh")] + ["seconds"]
+    keys = ["trip_id", "service_date"]
+    summed = table.group_by(keys, use_threads=False).aggregate([(c, "sum") for c in cols])
+    summed = summed.select(keys + [f"{c}_sum" for c in cols]).rename_columns(keys + cols)
+    summed = summed.sort_by([(k, "ascending") for k in keys])
+    return summed.to_pandas()
 
 
 def shading_loss(shaded, unshaded):
@@ -102,9 +130,8 @@ def reduce_run(cfg: Config, year: int, run_dir: Path, say=print) -> dict:
     trips_meta = pd.read_parquet(data_dir / "gtfs" / "trips.parquet")
 
     # --- per trip and service date
-    parts = _read_parts(run_dir, "trip")
-    kwh_cols = [c for c in parts.columns if c.startswith("pv_kwh")] + ["seconds"]
-    trip = parts.groupby(["trip_id", "service_date"], sort=True)[kwh_cols].sum().reset_index()
+    trip = _trip_totals(run_dir)
+    kwh_cols = [c for c in trip.columns if c.startswith("pv_kwh")] + ["seconds"]
     trip = trip.merge(trips_meta[["trip_id", "route_id", "route_short_name", "direction_id",
                                   "shape_id", "service_id", "block_id", "pattern_id", "start_s"]],
                       on="trip_id", how="left", validate="many_to_one")
@@ -118,9 +145,9 @@ def reduce_run(cfg: Config, year: int, run_dir: Path, say=print) -> dict:
     # --- segments with their geometry factors
     segments = gpd.read_parquet(data_dir / "gtfs" / "segments.parquet")
     segments = segments[segments["shape_id"].isin(trip["shape_id"].unique())]
-    geom_files = sorted((run_dir / "parts" / "geometry").glob("tile=*.parquet"))
-    if geom_files:
-        geo = pd.concat([pd.read_parquet(f) for f in geom_files], ignore_index=True)
+    geo = _part_table(run_dir, "geometry", "tile=*.parquet")
+    if geo is not None:
+        geo = geo.to_pandas()
         keep = [c for c in geo.columns if c == "segment_id" or geo[c].dtype.kind in "fiub"]
         segments = segments.merge(geo[keep], on="segment_id", how="left")
     write_parquet(segments, run_dir / "segments.parquet")
