@@ -229,3 +229,31 @@ def test_plan_lists_the_graph_and_what_is_done(small_run, small_config):
     assert table["done"].all()   # the session's run wrote every partition
     main = runpy.run_path(str(Path(__file__).parents[1] / "pipeline" / "plan.py"))["main"]
     assert main(["--config", str(small_config), "--year", "2024"]) == 0
+
+
+def _busy(seconds: float) -> int:
+    n, end = 0, time.perf_counter() + seconds
+    while time.perf_counter() < end:
+        n += 1
+    return n
+
+
+@pytest.mark.parametrize("profile", [False, True])
+def test_local_cluster_profiles_workers_only_when_asked(small_config, tmp_path, profile):
+    import dask
+
+    from vipvflow.simulation.run import LOCAL_CLUSTER_DASK_CONFIG, make_client
+
+    cfg = _cfg(small_config, tmp_path, worker_profile=profile)
+    client, cluster = make_client(cfg, None, 1)
+    try:
+        settings = client.run(lambda: {k: dask.config.get(k) for k in LOCAL_CLUSTER_DASK_CONFIG})
+        assert list(settings.values()) == [LOCAL_CLUSTER_DASK_CONFIG]
+        client.submit(_busy, 1.5, pure=False).result()
+        samples = client.profile()["count"]
+        assert (samples > 0) is profile, samples
+    finally:
+        client.close()
+        cluster.close()
+    # this process's own Dask configuration is left as it was
+    assert dask.config.get("distributed.admin.tick.interval") == "20ms"

@@ -154,6 +154,9 @@ class DaskCfg(_Model):
     # Embree threads per partition task; null: cores / workers on a LocalCluster, 1 on a
     # remote cluster (one task per worker thread already fills the cores)
     ray_threads: int | None = Field(None, gt=0)
+    # Dask's statistical profiler (the dashboard's Profile tab) on the LocalCluster's workers:
+    # it samples every worker's stack 100 times a second, which cost a worker ~7 % of its CPU
+    worker_profile: bool = False
 
 
 class RunCfg(_Model):
