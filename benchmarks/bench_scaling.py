@@ -92,7 +92,7 @@ def run(tiny: bool = False) -> dict:
         try:
             cfg = demo_config(size, out_dir=out, routes=["L1"], months=months, n_workers=workers)
             cfg.dask.ray_threads = ray_threads
-            r = run_pipeline(cfg, YEAR, n_workers=workers)
+            r = run_pipeline(cfg, YEAR, n_workers=workers, rss_interval_s=1.0)
             tables.append({name: pd.read_parquet(r["run_dir"] / f"{name}.parquet")
                            for name in ("trip_energy", "segment_month")})
         finally:
