@@ -1,0 +1,61 @@
+"""The reduce's reading of partition files: one Arrow dataset per kind, trips summed in Arrow."""
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from vipvflow.errors import InputError
+from vipvflow.simulation.reduce import _read_parts, _trip_totals
+from vipvflow.simulation.storage import partition_path, write_parquet
+
+PV = ["pv_kwh", "pv_kwh_clear", "pv_kwh_direct"]
+
+
+def _trip_part(rng, trips, dates) -> pd.DataFrame:
+    rows = [(t, d) for t in trips for d in dates]
+    df = pd.DataFrame(rows, columns=["trip_id", "service_date"])
+    df["service_date"] = pd.to_datetime(df["service_date"])
+    for c in PV + ["seconds"]:
+        df[c] = rng.random(len(df))
+    return df
+
+
+def test_trips_are_summed_over_tiles_and_sorted(tmp_path):
+    rng = np.random.default_rng(3)
+    parts = []
+    for tile, trips in [("a", ["t2", "t1"]), ("b", ["t1", "t3"]), ("c", ["t3", "t2", "t1"])]:
+        for month, dates in [("2024-01", ["2024-01-02", "2024-01-01"]), ("2024-02", ["2024-02-05"])]:
+            df = _trip_part(rng, trips, dates)
+            df["tile"] = tile
+            write_parquet(df, partition_path(tmp_path, "trip", tile, month))
+            parts.append(df)
+    # a partition without passes
+    write_parquet(parts[0].iloc[:0], partition_path(tmp_path, "trip", "d", "2024-01"))
+    got = _trip_totals(tmp_path)
+    want = (pd.concat(parts).groupby(["trip_id", "service_date"], sort=True)[PV + ["seconds"]]
+            .sum().reset_index())
+    assert list(got.columns) == ["trip_id", "service_date"] + PV + ["seconds"]
+    assert got[["trip_id", "service_date"]].equals(want[["trip_id", "service_date"]])
+    np.testing.assert_allclose(got[PV + ["seconds"]].to_numpy(), want[PV + ["seconds"]].to_numpy(),
+                               rtol=1e-14)
+    assert len(got) == 3 * 3
+
+
+def test_files_with_different_schemas_are_promoted(tmp_path):
+    a = pd.DataFrame({"segment_id": np.array([1, 2], np.int64), "h_total": [1.0, 2.0]})
+    b = pd.DataFrame({"segment_id": np.array([3], np.int32), "h_total": np.array([3.0], np.float32)})
+    write_parquet(a, partition_path(tmp_path, "segment_month", "a", "2024-01"))
+    write_parquet(b, partition_path(tmp_path, "segment_month", "b", "2024-01"))
+    got = _read_parts(tmp_path, "segment_month")
+    assert got["segment_id"].tolist() == [1, 2, 3]
+    assert got["h_total"].tolist() == [1.0, 2.0, 3.0]
+
+
+def test_a_run_without_any_pass_is_named(tmp_path):
+    empty = _trip_part(np.random.default_rng(0), ["t1"], ["2024-01-01"]).iloc[:0]
+    write_parquet(empty, partition_path(tmp_path, "trip", "a", "2024-01"))
+    with pytest.raises(InputError, match="no trip partitions with passes"):
+        _trip_totals(tmp_path)
+    with pytest.raises(InputError, match="parts/trip"):
+        _trip_totals(tmp_path / "elsewhere")
