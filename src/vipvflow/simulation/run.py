@@ -256,9 +256,9 @@ def _map(client, ctx: RunContext, todo: list[tuple[str, str]], every_s: float = 
     # the finished partitions' summaries are fetched together about once a second: one
     # fetch per partition kept the scheduler's event loop (in this process) busy ~15 % of a
     # core, taken from the workers when they fill the machine
-    for n_left, fut in enumerate(as_completed(futures), start=1):
+    for n_done, fut in enumerate(as_completed(futures), start=1):
         done.append(fut)
-        if time.perf_counter() - last >= every_s or n_left == len(futures):
+        if time.perf_counter() - last >= every_s or n_done == len(futures):
             for res in client.gather(done):
                 results.append(res)
                 view.update(res)
