@@ -158,8 +158,8 @@ class CityGMLReader:
             raise InputError(f"{self.label}: line {line}: not well-formed XML: {exc.msg}") from None
         except (EOFError, zlib.error, zipfile.BadZipFile, OSError) as exc:
             # raised while reading a .gz / .zip member: corrupt or truncated archive
-            raise InputError(f"{self.label}: corrupt or truncated file ({type(exc).__name__}: "
-                             f"{exc})") from None
+            kind = "zlib.error" if isinstance(exc, zlib.error) else type(exc).__name__
+            raise InputError(f"{self.label}: corrupt or truncated file ({kind}: {exc})") from None
         finally:
             del ctx
 
