@@ -18,7 +18,8 @@ def register(sub):
     p.add_argument("--data-dir", type=Path, default=None,
                    help="scenario data dir (default: data_dir of the config)")
     p.add_argument("--crs", default=None,
-                   help="output CRS, also assumed for files without srsName (e.g. EPSG:2169)")
+                   help="output CRS (projected), also assumed for files without srsName (e.g. "
+                        "EPSG:2169); default: the file's CRS, or its local UTM zone when geographic")
     p.add_argument("--config", "-c", default=None, help="scenario YAML (tile size, buffer, albedo)")
     p.set_defaults(func=run)
 
