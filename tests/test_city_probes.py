@@ -129,7 +129,21 @@ def _broken_xml(tmp: Path) -> Path:
     return p
 
 
+def _directory(tmp: Path) -> Path:
+    p = tmp / "tiles.gml"
+    p.mkdir()
+    return p
+
+
+def _empty(tmp: Path) -> Path:
+    p = tmp / "empty.gml"
+    p.write_bytes(b"")
+    return p
+
+
 FATAL = {
+    "directory": (_directory, "is a directory"),
+    "empty_file": (_empty, "empty file"),
     "gz_corrupt": (_gz_corrupt, "corrupt or truncated"),
     "gz_truncated": (_gz_truncated, "corrupt or truncated"),
     "gz_not_gzip": (_gz_not_gzip, "corrupt or truncated"),

@@ -422,6 +422,10 @@ def open_sources(path: Path):
     path = Path(path)
     if not path.exists():
         raise InputError(f"{path}: file not found")
+    if path.is_dir():
+        raise InputError(f"{path}: is a directory, not a CityGML file")
+    if path.stat().st_size == 0:
+        raise InputError(f"{path}: empty file")
     if path.suffix.lower() == ".zip":
         try:
             zf = zipfile.ZipFile(path)
@@ -434,6 +438,13 @@ def open_sources(path: Path):
                 raise InputError(f"{path}: zip holds no .gml or .xml file")
             yield [(f"{path}!{n}", (lambda n=n: zf.open(n))) for n in names]
     elif path.suffix.lower() == ".gz":
-        yield [(str(path), lambda: gzip.open(path, "rb"))]
+        yield [(str(path), lambda: _readable(path, gzip.open))]
     else:
-        yield [(str(path), lambda: open(path, "rb"))]
+        yield [(str(path), lambda: _readable(path, open))]
+
+
+def _readable(path: Path, opener):
+    try:
+        return opener(path, "rb")
+    except OSError as exc:
+        raise InputError(f"{path}: cannot be read ({exc.strerror or exc})") from None
