@@ -274,3 +274,17 @@ def test_a_running_ingests_folder_is_left_alone(data_dir):
     mine = data_dir / f".city-ingest-{os.getppid()}"
     mine.mkdir()
     assert remove_stale_ingests(data_dir) == [] and mine.is_dir()
+
+
+def test_kill_between_the_swaps_renames_puts_the_old_city_back(data_dir, tmp_path):
+    """A kill after `city/` was moved aside but before the new one took its place: the next
+    ingest's clean-up restores the previous city (no data dir is ever left without one)."""
+    before = snapshot(data_dir)
+    gone = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"],
+                          capture_output=True, text=True, check=True)
+    pid = int(gone.stdout)                                   # a process that has ended
+    (data_dir / "city").rename(data_dir / f".city-old-{pid}")
+    (data_dir / f".city-ingest-{pid}").mkdir()               # its unfinished new city
+    remove_stale_ingests(data_dir)
+    assert sorted(p.name for p in data_dir.iterdir()) == ["city"]
+    assert snapshot(data_dir) == before
