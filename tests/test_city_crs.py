@@ -115,6 +115,38 @@ def test_latlon_file_gives_the_projected_surfaces(test_data, tmp_path, srs):
 
 
 # -- PLATEAU Osaka (EPSG:6697, lat lon height) ------------------------------------------------
+def check_vertices_by_pyproj(path, out, every: int = 1) -> int:
+    """Stored roof/wall vertices equal pyproj's transform of the file's (lat, lon), heights as
+    written, to 1 mm; returns the number of surfaces checked."""
+    tree = etree.parse(str(path))
+    t = Transformer.from_crs("EPSG:6668", "EPSG:6690")       # authority order in: lat, lon
+    gdf = surfaces_of(out).set_index("surface_id")
+    surfaces = tree.xpath("//*[local-name()='RoofSurface' or local-name()='WallSurface']")[::every]
+    for surf in surfaces:
+        sid = surf.get("{http://www.opengis.net/gml}id")
+        pos = np.array(surf.xpath(".//*[local-name()='posList']/text()")[0].split(), float).reshape(-1, 3)
+        e, n = t.transform(pos[:, 0], pos[:, 1])
+        stored = np.asarray(gdf.loc[sid].geometry.exterior.coords)
+        expect = np.column_stack([e, n, pos[:, 2]])
+        # the same points (the writer may drop the closing duplicate or re-close)
+        d = np.linalg.norm(stored[:, None, :] - expect[None, :, :], axis=2).min(axis=1)
+        assert d.max() < 1e-3, sid
+    return len(surfaces)
+
+
+def test_plateau_excerpt_in_tests_data(test_data, tmp_path):
+    """4 buildings of the PLATEAU tile (kept in tests/data): read lat, lon, put into UTM 53N."""
+    path = test_data / "citygml" / "plateau_52350301_4bldg.gml"
+    report = ingest_city(path, tmp_path)
+    tree = etree.parse(str(path))
+    expected = {t: int(tree.xpath(f"count(//*[local-name()='{c}'])")) for t, c in TYPES.items()}
+    assert report.surfaces == report.thematic_surfaces == expected and report.n_skipped == 0
+    assert report.buildings == 4 and report.buildings_by_lod == {"lod2": 4}
+    assert (report.crs, report.crs_source) == ("EPSG:6690", "local UTM zone for geographic EPSG:6668")
+    assert report.axis_order == {str(path): "lat,lon (EPSG order)"}
+    assert check_vertices_by_pyproj(path, tmp_path) == expected["roof"] + expected["wall"]
+
+
 @pytest.fixture(scope="module")
 def plateau(shared_data, tmp_path_factory):
     path = shared_data.joinpath(*PLATEAU)
@@ -148,18 +180,9 @@ def test_plateau_coordinates_by_independent_transform(plateau):
     """Every stored vertex equals pyproj's transform of the file's (lat, lon) to 1 mm, heights as
     written, and the mesh lies within the file's envelope."""
     path, out, _ = plateau
+    assert check_vertices_by_pyproj(path, out, every=5) >= 100
     tree = etree.parse(str(path))
-    t = Transformer.from_crs("EPSG:6668", "EPSG:6690")       # authority order in: lat, lon
-    gdf = surfaces_of(out).set_index("surface_id")
-    for surf in tree.xpath("//*[local-name()='RoofSurface' or local-name()='WallSurface']")[::25]:
-        sid = surf.get("{http://www.opengis.net/gml}id")
-        pos = np.array(surf.xpath(".//*[local-name()='posList']/text()")[0].split(), float).reshape(-1, 3)
-        e, n = t.transform(pos[:, 0], pos[:, 1])
-        stored = np.asarray(gdf.loc[sid].geometry.exterior.coords)
-        expect = np.column_stack([e, n, pos[:, 2]])
-        # the same points (the writer may drop the closing duplicate or re-close)
-        d = np.linalg.norm(stored[:, None, :] - expect[None, :, :], axis=2).min(axis=1)
-        assert d.max() < 1e-3, sid
+    t = Transformer.from_crs("EPSG:6668", "EPSG:6690")
     lo = [float(v) for v in tree.xpath("//*[local-name()='Envelope']/*[local-name()='lowerCorner']/text()")[0].split()]
     hi = [float(v) for v in tree.xpath("//*[local-name()='Envelope']/*[local-name()='upperCorner']/text()")[0].split()]
     lat = np.linspace(lo[0], hi[0], 50)
