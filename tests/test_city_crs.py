@@ -248,3 +248,29 @@ def test_plateau_lod1_only_buildings_still_shade(shared_data, tmp_path):
         assert np.allclose(dist, 50.0, atol=0.01)
         hits += len(tri)
     assert hits == int((lod1.surface_type == "roof").sum())
+
+
+def test_axis_order_option_for_northing_first_files(tmp_path, capsys):
+    """EPSG:2169 (LUREF) is northing first in EPSG, but Luxembourg fits its area of use either way
+    round: `auto` reads easting first (as producers write); a file really written northing first
+    is read right with --axis-order epsg."""
+    from vipvflow.city.synthetic import HEADER, building_xml, house_polygons
+    from vipvflow.cli import main
+
+    polys = house_polygons(77000.0, 75000.0, 300.0, 12, 10, 6, 3)
+    swapped = {t: [r[:, [1, 0, 2]] for r in rings] for t, rings in polys.items()}
+    head = HEADER.format(srs="urn:ogc:def:crs:EPSG::2169", x0=0, y0=0, x1=1, y1=1)
+    (tmp_path / "en.gml").write_text(head + building_xml("H", polys) + "</core:CityModel>\n")
+    (tmp_path / "ne.gml").write_text(head + building_xml("H", swapped) + "</core:CityModel>\n")
+    assert main(["ingest", "city", str(tmp_path / "en.gml"), "--data-dir", str(tmp_path / "en")]) == 0
+    assert main(["ingest", "city", str(tmp_path / "ne.gml"), "--data-dir", str(tmp_path / "ne"),
+                 "--axis-order", "epsg"]) == 0
+    a = surfaces_of(tmp_path / "en").set_index("surface_id").sort_index()
+    b = surfaces_of(tmp_path / "ne").set_index("surface_id").sort_index()
+    for ga, gb in zip(a.geometry, b.geometry):
+        assert np.abs(np.asarray(ga.exterior.coords) - np.asarray(gb.exterior.coords)).max() < 1e-6
+    assert (a.nz > 0.5).sum() == 2 and np.allclose(a[["nx", "ny", "nz"]], b[["nx", "ny", "nz"]])
+    report = json.loads((tmp_path / "ne" / "city" / "ingest_report.json").read_text())
+    assert report["axis_order"] == {str(tmp_path / "ne.gml"): "north,east (--axis-order epsg)"}
+    report = json.loads((tmp_path / "en" / "city" / "ingest_report.json").read_text())
+    assert report["axis_order"][str(tmp_path / "en.gml")].startswith("east,north (as written by")

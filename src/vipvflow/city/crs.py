@@ -37,6 +37,8 @@ log = logging.getLogger(__name__)
 #: degrees by which a CRS's area of use is widened before a vertex counts as outside it
 #: (UTM zones are used well beyond their 6 degrees; a misread axis or a vertex at 1e30 is not)
 AREA_MARGIN_DEG = 3.0
+#: how a file's axis order is chosen (see :meth:`SourceCRS.decide`)
+AXIS_MODES = ("auto", "epsg", "xy")
 
 #: horizontal part of the German AdV CRS names
 ADV_CRS = {
@@ -207,17 +209,24 @@ class SourceCRS:
     bounds: tuple | None
 
     @classmethod
-    def decide(cls, crs: str, sample_xy: np.ndarray) -> "SourceCRS":
+    def decide(cls, crs: str, sample_xy: np.ndarray, mode: str = "auto") -> "SourceCRS":
         """Axis order of a file in *crs* whose first building has vertices *sample_xy* (as written).
 
-        The order that puts the sample inside the CRS's area of use wins; when both do (or
-        neither), the EPSG order for geographic CRSs and easting first for projected ones.
+        *mode* ``auto``: the order that puts the sample inside the CRS's area of use wins; when
+        both do (or neither), the EPSG order for geographic CRSs and easting first for projected
+        ones.  ``epsg``: the EPSG order, always.  ``xy``: easting / longitude first, always.
         """
+        if mode not in AXIS_MODES:
+            raise InputError(f"axis order '{mode}': use one of {', '.join(AXIS_MODES)}")
         crs = horizontal(crs)
         geographic = is_geographic(crs)
         bounds = area_bounds(crs)
         epsg_north = north_first(crs)
         names = ("lat,lon", "lon,lat") if geographic else ("north,east", "east,north")
+        if mode != "auto":
+            swap = epsg_north if mode == "epsg" else False
+            order = names[0] if swap else names[1]
+            return cls(crs, swap, f"{order} (--axis-order {mode})", bounds)
         pts = sample_xy[np.isfinite(sample_xy).all(axis=1)]
         if len(pts):
             as_written = inside(pts, bounds).mean()       # read (x=east, y=north)

@@ -313,7 +313,7 @@ def _write_tile(name: str, spool: Path, city_dir: Path, cfg: CityCfg, crs: str) 
 
 
 def ingest_city(paths, data_dir, city_cfg: CityCfg | None = None, crs: str | None = None,
-                chunk_surfaces: int = CHUNK_SURFACES) -> IngestReport:
+                chunk_surfaces: int = CHUNK_SURFACES, axis_order: str = "auto") -> IngestReport:
     """Read CityGML files into tiled surfaces, tile meshes and a terrain model.
 
     Parameters
@@ -331,6 +331,10 @@ def ingest_city(paths, data_dir, city_cfg: CityCfg | None = None, crs: str | Non
         PLATEAU's EPSG:6697) the local UTM zone of its first building.
     chunk_surfaces : int
         Surfaces held in memory before they are spooled to disk.
+    axis_order : str
+        ``auto`` (default): each file's axis order from its CRS and data (docs/city.md);
+        ``epsg``: the EPSG order (latitude / northing first where EPSG says so); ``xy``:
+        easting / longitude first.
 
     Returns
     -------
@@ -380,7 +384,8 @@ def ingest_city(paths, data_dir, city_cfg: CityCfg | None = None, crs: str | Non
                         src = None
                         for feature in reader:
                             if src is None and _has_coordinates(feature):
-                                src, target = _resolve_crs(reader, label, feature, target, report)
+                                src, target = _resolve_crs(reader, label, feature, target, report,
+                                                           axis_order)
                             _add_feature(feature, acc, src, target, cfg, albedo, counts)
                             counts.problems.update(feature.problems)
                             if feature.kind == "building":
@@ -448,7 +453,7 @@ def _has_coordinates(feature) -> bool:
 
 
 def _resolve_crs(reader: CityGMLReader, label: str, feature, target: str | None,
-                 report: IngestReport):
+                 report: IngestReport, axis_order: str = "auto"):
     """(how this file's coordinates are read, output CRS), settled on its first feature."""
     if reader.srs_name:
         name = parse_srs_name(reader.srs_name)
@@ -457,7 +462,7 @@ def _resolve_crs(reader: CityGMLReader, label: str, feature, target: str | None,
     else:
         raise InputError(f"{label}: the file names no CRS (no srsName); pass --crs EPSG:xxxx")
     sample = np.concatenate([r for s in feature.surfaces for r in s.rings])[:, :2]
-    src = SourceCRS.decide(name, sample)
+    src = SourceCRS.decide(name, sample, axis_order)
     report.file_crs[label] = src.crs
     report.axis_order[label] = src.axis_order
     if target is None:
