@@ -288,3 +288,11 @@ def test_kill_between_the_swaps_renames_puts_the_old_city_back(data_dir, tmp_pat
     remove_stale_ingests(data_dir)
     assert sorted(p.name for p in data_dir.iterdir()) == ["city"]
     assert snapshot(data_dir) == before
+
+
+def test_geographic_crs_option_refused_before_anything_is_written(data_dir, tmp_path, capsys):
+    good = tmp_path / "good.gml"
+    before = snapshot(data_dir)
+    rc, _, err = run_cli(capsys, good, data_dir, "--crs", "EPSG:4326")
+    assert rc == 2 and "projected CRS" in err and len(err.strip().splitlines()) == 1
+    assert snapshot(data_dir) == before and sorted(p.name for p in data_dir.iterdir()) == ["city"]

@@ -356,6 +356,9 @@ def ingest_city(paths, data_dir, city_cfg: CityCfg | None = None, crs: str | Non
     for path in paths:
         if not path.exists():
             raise InputError(f"{path}: file not found")
+    target = horizontal(normalise_crs(crs)) if crs else None
+    if target and not is_projected(target):
+        raise InputError(f"--crs {crs}: tiles need a projected CRS in metres, not {target}")
     data_dir = Path(data_dir)
     data_dir.mkdir(parents=True, exist_ok=True)
     remove_stale_ingests(data_dir)
@@ -364,17 +367,14 @@ def ingest_city(paths, data_dir, city_cfg: CityCfg | None = None, crs: str | Non
     if city_dir.exists():
         shutil.rmtree(city_dir)
     city_dir.mkdir()
-    target = horizontal(normalise_crs(crs)) if crs else None
-    if target and not is_projected(target):
-        raise InputError(f"--crs {crs}: tiles need a projected CRS in metres, not {target}")
     albedo = cfg.albedo.model_dump()
     report = IngestReport(crs_source="--crs" if target else "")
     counts = _Counts()
     ignored = Counter()
     spool = city_dir / ".spool"
-    spool.mkdir()
-    acc = _Accumulator(spool, cfg, chunk_surfaces)
     try:
+        spool.mkdir()
+        acc = _Accumulator(spool, cfg, chunk_surfaces)
         for path in paths:
             with open_sources(path) as sources:
                 for label, opener in sources:
