@@ -252,5 +252,5 @@ def reduce_run(cfg: Config, year: int, run_dir: Path, say=print) -> dict:
         **annual.per_bus_figures(tot, n_buses, annualise, hours_per_bus, data_dir, year),
     }
     write_json(summary, run_dir / "summary.json")
-    write_report(run_dir, summary, monthly, smg, hp, rm)
+    write_report(run_dir, summary, monthly, smg, hp, rm, cfg=cfg, segments=segments)
     return summary
