@@ -66,7 +66,7 @@ _COMPONENTS = ["direct", "diffuse", "reflected", "total", "total_unshaded",
 COLUMNS: dict[str, Column] = {
     # keys and labels
     "segment_id": Column("", "segment number (gtfs/segments.parquet), 0..N-1"),
-    "shape_id": Column("", "GTFS shape the segment belongs to"),
+    "shape_id": Column("", "GTFS shape_id: the path the buses drive"),
     "seg_index": Column("", "position of the segment along its shape, from 0"),
     "tile": Column("", "city tile holding the segment's start, E<x/100 m>N<y/100 m> in the city CRS"),
     "trip_id": Column("", "GTFS trip_id"),
@@ -252,7 +252,11 @@ def describe(output: str, column: str) -> Column | None:
 def annotate(table, output: str):
     """*table* (pyarrow) as written for the output file *output*: ``month`` strings
     (``YYYY-MM``) as dates (first day), each documented field with ``unit`` and
-    ``description`` metadata, the file's title in the schema metadata (``vipvflow:rows``)."""
+    ``description`` metadata; in the file's key-value metadata the file's title
+    (``vipvflow:rows``) and the same column entries as JSON (``vipvflow:columns``, for readers
+    that do not show Arrow field metadata, e.g. DuckDB's ``parquet_kv_metadata``)."""
+    import json
+
     import pyarrow as pa
     import pyarrow.compute as pc
 
@@ -265,16 +269,18 @@ def annotate(table, output: str):
                                format="%Y-%m-%d", unit="s")
             table = table.set_column(i, pa.field("month", pa.date32()), days.cast(pa.date32()))
             table = table.replace_schema_metadata(_pandas_month_as_date(table.schema.metadata))
-    fields = []
+    fields, columns = [], {}
     for f in table.schema:
         entry = describe(output, f.name)
         if entry is not None:
             meta = dict(f.metadata or {})
             meta.update({b"unit": entry.unit.encode(), b"description": entry.meaning.encode()})
             f = f.with_metadata(meta)
+            columns[f.name] = {"unit": entry.unit, "description": entry.meaning}
         fields.append(f)
     meta = dict(table.schema.metadata or {})
     meta[b"vipvflow:rows"] = f"{spec.title}: {spec.rows}".encode()
+    meta[b"vipvflow:columns"] = json.dumps(columns).encode()
     return table.cast(pa.schema(fields, metadata=meta))
 
 
@@ -301,9 +307,11 @@ def render_markdown() -> str:
         "`python -m vipvflow.simulation.dictionary > docs/outputs.md`; a test keeps it in sync -->",
         "",
         "A run writes its outputs into `out/<scenario>/<year>/`. Every Parquet file carries the "
-        "unit and meaning of each column as field metadata (`unit`, `description`; in Python "
-        "`pyarrow.parquet.read_schema(path).field('pv_kwh').metadata`, in DuckDB "
-        "`SELECT name, key_value_metadata FROM parquet_schema('segments.parquet')` after `LOAD parquet`). "
+        "unit and meaning of each column: as Arrow field metadata (`unit`, `description`; in Python "
+        "`pyarrow.parquet.read_schema(path).field('pv_kwh').metadata`) and, for other readers, as "
+        "JSON in the file's key-value metadata `vipvflow:columns` (DuckDB: "
+        "`SELECT decode(value) FROM parquet_kv_metadata('segments.parquet') "
+        "WHERE decode(key) = 'vipvflow:columns'`). "
         "Geometries are in the city's projected CRS (named in the GeoParquet metadata and in "
         "`report.html`). `month` is a date: the first day of the month. Units: `fraction` is 0..1 "
         "(x 100 for %), `Wh/m2` and `kWh/m2` are irradiation (energy per m2 of roof), `W/m2` "
