@@ -78,7 +78,10 @@ def close_up_window(segments, side_m: float = CLOSE_UP_M) -> tuple[float, float,
     """(xmin, ymin, xmax, ymax) of a square of *side_m* around the street canyons: the
     middle of the 5 % of segments whose roofs see the least sky (``svf``), or of the most
     shaded ones when the run has no sky view factors."""
-    mid = np.array([np.asarray(g.interpolate(0.5, normalized=True).coords)[0, :2] for g in segments.geometry])
+    import shapely
+
+    mid = shapely.get_coordinates(shapely.line_interpolate_point(
+        np.asarray(segments.geometry.values), 0.5, normalized=True))
     key = segments["svf"] if "svf" in segments and segments["svf"].notna().any() else -segments["shading_loss"]
     key = key.fillna(key.max()).to_numpy()
     n = max(1, int(0.05 * len(key)))
@@ -256,8 +259,8 @@ def _how_to_read(summary: dict) -> str:
     s = summary
     pct = lambda k: _fmt(s.get(k), 1, True)  # noqa: E731
     return (
-        "<p>Every bus of the timetable carries the same PV roof. For each 10 m road segment a bus "
-        "passes, vipvflow computes the sun and sky light on the roof from CAMS radiation, with the "
+        "<p>Every bus of the timetable carries the same PV roof. For each short road segment "
+        "(10 m by default) a bus passes, vipvflow computes the sun and sky light on the roof from CAMS radiation, with the "
         "3D city model's buildings casting shadows, hiding sky and reflecting light, and turns it "
         "into PV energy. <b>Specific yield</b> is the PV energy per installed kWp in a year: "
         f"{_fmt(s.get('kwh_per_kwp_allsky'), 0)} kWh/kWp here under the real (all-sky) weather, "
