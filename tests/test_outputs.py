@@ -161,3 +161,26 @@ def test_close_up_is_on_the_canyons(small_run):
     assert xmax - xmin == pytest.approx(CLOSE_UP_M)
     darkest = seg.loc[seg["svf"].idxmin(), "geometry"].interpolate(0.5, normalized=True)
     assert xmin <= darkest.x <= xmax and ymin <= darkest.y <= ymax
+
+
+def test_app_map_draws_the_same_footprints(small_run):
+    """The web app's map background is the report's building footprints (city model, offline)."""
+    from bokeh.document import Document
+    from bokeh.models import GlyphRenderer, Patches
+
+    from vipvflow.app.layout import build_document
+    from vipvflow.app.model import TripModel
+    from vipvflow.city.footprints import building_footprints
+
+    model = TripModel(small_run)
+    doc = Document()
+    build_document(model, doc)
+    patches = [r for r in doc.select({"type": GlyphRenderer}) if isinstance(r.glyph, Patches)]
+    assert len(patches) == 1
+    xs = patches[0].data_source.data["xs"]
+    g = model.geometry
+    bounds = (min(g["x"].min(), g["x_end"].min()) - 200, min(g["y"].min(), g["y_end"].min()) - 200,
+              max(g["x"].max(), g["x_end"].max()) + 200, max(g["y"].max(), g["y_end"].max()) + 200)
+    rings = building_footprints(model.data_dir, tiles=sorted(g["tile"].unique()), bounds=bounds)
+    assert len(xs) == len(rings) > 0
+    assert [list(r[:, 0]) for r in rings] == [list(x) for x in xs]
