@@ -68,7 +68,8 @@ COLUMNS: dict[str, Column] = {
     "segment_id": Column("", "segment number (gtfs/segments.parquet), 0..N-1"),
     "shape_id": Column("", "GTFS shape_id: the path the buses drive"),
     "seg_index": Column("", "position of the segment along its shape, from 0"),
-    "tile": Column("", "city tile holding the segment's start, E<x/100 m>N<y/100 m> in the city CRS"),
+    "tile": Column("", "city tile holding the segment's start, named by its south-west corner in "
+                       "hundreds of metres of the city CRS (E0770N0750: x 77,000 m, y 75,000 m)"),
     "trip_id": Column("", "GTFS trip_id"),
     "service_date": Column("date", "GTFS service date (local calendar of the feed)"),
     "month": Column("date", "month, as its first day (local calendar of the feed)"),
