@@ -153,7 +153,7 @@ def test_values_round_trip_exactly(exports, small_run, encoding):
     sm = gpd.read_parquet(small_run / "segment_month.parquet")
     seg = df[df["object_id"].str.startswith("vipv_seg_")].copy()
     seg["segment_id"] = seg["object_id"].str.slice(len("vipv_seg_")).astype(np.int64)
-    seg["month"] = seg["timestamp"].dt.tz_convert("Europe/Luxembourg").dt.strftime("%Y-%m")
+    seg["month"] = seg["timestamp"].dt.tz_convert("Europe/Luxembourg").dt.date  # months are dates
     wide = seg.pivot_table(index=["segment_id", "month"], columns="attribute", values="value",
                            aggfunc="first")
     expect = sm.set_index(["segment_id", "month"])[list(SEGMENT_SERIES)].sort_index()

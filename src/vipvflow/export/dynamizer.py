@@ -122,9 +122,11 @@ def _iso(ts: pd.Timestamp) -> str:
     return ts.isoformat()
 
 
-def _month_bounds(months: Iterable[str], tz: str) -> tuple[list[str], str]:
-    starts = [pd.Timestamp(f"{m}-01", tz=tz) for m in months]
-    end = (pd.Timestamp(f"{max(months)}-01") + pd.offsets.MonthBegin(1)).tz_localize(tz)
+def _month_bounds(months: Iterable, tz: str) -> tuple[list[str], str]:
+    """Local starts of months (dates of their first day, or ``YYYY-MM``) and the end of the last."""
+    firsts = [pd.Timestamp(str(m)[:7] + "-01") for m in months]
+    starts = [f.tz_localize(tz) for f in firsts]
+    end = (max(firsts) + pd.offsets.MonthBegin(1)).tz_localize(tz)
     return [_iso(s) for s in starts], _iso(end)
 
 
@@ -375,7 +377,7 @@ def _members(run: RunData, encoding: str, table: _Tabulated | None, prefix: str,
         oid = f"{prefix}network"
         net = _sub(member, "gen:GenericLogicalSpace", **{"gml:id": oid})
         _sub(net, "gml:name", "bus network of the run (hourly pattern, all segments)")
-        stamps = [_iso(pd.Timestamp(f"{m}-01", tz=run.timezone) + pd.Timedelta(hours=int(h)))
+        stamps = [_iso(pd.Timestamp(str(m)[:7] + "-01", tz=run.timezone) + pd.Timedelta(hours=int(h)))
                   for m, h in zip(hp["month"], hp["hour"])]
         _, end = _month_bounds(hp["month"], run.timezone)
         net_series = [Series(oid, CITY_OBJECT["network"], a, obs, uom, stamps,
