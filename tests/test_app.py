@@ -2,7 +2,6 @@
 Bokeh app driven in a real headless Chromium."""
 from __future__ import annotations
 
-import shutil
 import socket
 import subprocess
 import sys
@@ -18,7 +17,6 @@ from vipvflow.horizon import horizon_at, horizon_profile
 from vipvflow.shading import Scene, box_mesh
 
 X0, Y0 = 77_000.0, 75_000.0        # LUREF-like coordinates: float32 precision must hold
-CHROMIUM = "/usr/bin/chromium"
 CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
                  "--disable-background-networking", "--disable-component-update", "--disable-sync"]
 ROOT = Path(__file__).resolve().parents[1]
@@ -208,15 +206,13 @@ def _expected(model, shown) -> dict:
             "share": f"{100 * n['share']:.{DECIMALS['share_percent']}f}"}
 
 
-def test_app_in_browser(app_url, trip_model, artifacts):
+def test_app_in_browser(chromium, app_url, trip_model, tmp_path):
     playwright = pytest.importorskip("playwright.sync_api")
-    if not Path(CHROMIUM).exists():
-        pytest.skip(f"{CHROMIUM} not installed (Debian package chromium)")
     from playwright.sync_api import expect
 
     errors, requests = [], []
     with playwright.sync_playwright() as p:
-        browser = p.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS)
+        browser = p.chromium.launch(executable_path=str(chromium), args=CHROMIUM_ARGS)
         try:
             page = browser.new_page(viewport={"width": 1500, "height": 1250})
             page.on("console", lambda m: errors.append(m.text) if m.type == "error" else None)
@@ -259,7 +255,7 @@ def test_app_in_browser(app_url, trip_model, artifacts):
             exp = _expected(trip_model, back)
             assert {k: back[k] for k in exp} == exp
 
-            shot = artifacts / "app.png"
+            shot = tmp_path / "app.png"
             page.screenshot(path=str(shot), full_page=True)
         finally:
             browser.close()
@@ -268,4 +264,3 @@ def test_app_in_browser(app_url, trip_model, artifacts):
     outside = [u for u in requests if not (u.startswith(host + "/") or u.startswith("ws://127.0.0.1"))]
     assert not outside, outside
     assert shot.stat().st_size > 10_000
-    shutil.copyfile(shot, ROOT / "docs" / "app.png")
