@@ -4,16 +4,19 @@ PYTHON ?= python3
 VENV   ?= .venv
 BIN    := $(VENV)/bin
 YEAR   ?= 2024
-CONF   ?= conf/demo.yaml
+CONF   ?= demo
 SCHEDULER ?=
 WORKERS ?=
 RUN    ?= out/demo/$(YEAR)
 DB_DIR ?= data/pg
+# Debian packages of the database and browser tests (make system-deps)
+SYSTEM_PACKAGES := postgresql-15 postgresql-15-postgis-3 chromium
 
-.PHONY: setup simulate test bench data app db db-stop clean help
+.PHONY: setup system-deps simulate test bench data app db db-stop clean help
 help:
-	@echo "make setup                    create $(VENV) and install vipvflow with its test extras"
-	@echo "make simulate YEAR=2024 [CONF=conf/demo.yaml] [SCHEDULER=tcp://host:8786] [WORKERS=N]"
+	@echo "make setup                    system-deps, then $(VENV) with vipvflow[test,db,app]"
+	@echo "make system-deps              apt-get install $(SYSTEM_PACKAGES) (Debian, root or sudo)"
+	@echo "make simulate YEAR=2024 [CONF=demo|luxembourg|my.yaml] [SCHEDULER=tcp://host:8786] [WORKERS=N]"
 	@echo "make test                     run the test suite"
 	@echo "make bench                    run benchmarks/, write benchmarks/results/*.json"
 	@echo "make data                     fetch the real datasets of data_manifest.yaml (needs a network)"
@@ -23,10 +26,27 @@ help:
 setup: $(VENV)/.installed
 
 $(VENV)/.installed: pyproject.toml
+	@$(MAKE) --no-print-directory system-deps
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install -q --upgrade pip
-	$(BIN)/python -m pip install -q -e '.[test]'
+	$(BIN)/python -m pip install -q -e '.[test,db,app]'
 	touch $@
+
+# The database (PostgreSQL 15 + PostGIS 3) and browser (Chromium) tests' system packages.
+# Installs the missing ones on Debian as root or with passwordless sudo; otherwise says in one
+# line what to install and succeeds (those tests then skip, naming the same packages).
+system-deps:
+	@missing=""; for p in $(SYSTEM_PACKAGES); do \
+	  dpkg -s $$p >/dev/null 2>&1 || missing="$$missing $$p"; done; \
+	if [ -z "$$missing" ]; then exit 0; fi; \
+	if ! command -v apt-get >/dev/null 2>&1; then \
+	  echo "system-deps: skipped (not Debian): install PostgreSQL 15 with PostGIS 3 and Chromium for the DB and browser tests"; exit 0; fi; \
+	if [ "$$(id -u)" = 0 ]; then sudo=""; elif sudo -n true 2>/dev/null; then sudo="sudo -n"; else \
+	  echo "system-deps: skipped (needs root or passwordless sudo): apt-get install$$missing"; exit 0; fi; \
+	echo "system-deps: apt-get install$$missing"; \
+	$$sudo env DEBIAN_FRONTEND=noninteractive apt-get update -qq && \
+	$$sudo env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends$$missing >/dev/null || \
+	  echo "system-deps: apt-get install$$missing failed: the DB and browser tests will skip"
 
 simulate: setup
 	$(BIN)/vipvflow simulate --config $(CONF) --year $(YEAR) \

@@ -38,8 +38,8 @@ buses consume.
 
 typical use:
   vipvflow demo-data --out data/demo/input --year 2024   generate the embedded demo town
-  vipvflow simulate --config conf/demo.yaml --year 2024
-  vipvflow simulate --config conf/luxembourg.yaml --year 2024 --scheduler tcp://host:8786
+  vipvflow simulate --config demo --year 2024 [--out DIR]
+  vipvflow simulate --config my_city.yaml --year 2024 --scheduler tcp://host:8786
 """
 
 
