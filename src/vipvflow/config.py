@@ -179,6 +179,8 @@ class DaskCfg(_Model):
     # Dask's statistical profiler (the dashboard's Profile tab) on the LocalCluster's workers:
     # it samples every worker's stack 100 times a second, which cost a worker ~7 % of its CPU
     worker_profile: bool = False
+    # the LocalCluster's dashboard: this port when free, else (or null) any free one
+    dashboard_port: int | None = Field(8787, ge=0, le=65535)
 
 
 class RunCfg(_Model):

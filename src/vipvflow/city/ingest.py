@@ -28,6 +28,7 @@ import numpy as np
 from ..config import CityCfg
 from ..errors import InputError
 from ..mesh import SURFACE_CODE, SURFACE_TYPES, TileMesh
+from ..progress import Progress, citygml_bytes, file_position
 from ..tiles import tile_bounds, tile_index, tile_name
 from .citygml import CityGMLReader, open_sources
 from .crs import is_projected, normalise_crs, parse_srs_name, transform_xyz
@@ -332,6 +333,8 @@ def ingest_city(paths, data_dir, city_cfg: CityCfg | None = None, crs: str | Non
         shutil.rmtree(spool)
     spool.mkdir()
     acc = _Accumulator(spool, cfg, chunk_surfaces)
+    bar = Progress("CityGML ingest", citygml_bytes(paths), unit="B")
+    read_before = 0
     try:
         for path in paths:
             with open_sources(path) as sources:
@@ -340,7 +343,9 @@ def ingest_city(paths, data_dir, city_cfg: CityCfg | None = None, crs: str | Non
                     with opener() as fh:
                         reader = CityGMLReader(fh, label)
                         src = None
-                        for feature in reader:
+                        for n_feature, feature in enumerate(reader):
+                            if n_feature % 64 == 0:
+                                bar.advance_to(read_before + file_position(fh))
                             if src is None:
                                 src, target = _resolve_crs(reader, label, target, crs)
                                 report.file_crs[label] = src
@@ -357,6 +362,8 @@ def ingest_city(paths, data_dir, city_cfg: CityCfg | None = None, crs: str | Non
                         ignored.update(reader.ignored)
                         if src is None:
                             report.file_crs[label] = None
+                        read_before += file_position(fh)
+                        bar.advance_to(read_before, "tiles and meshes next")
                     log.info("read %s", label)
         acc.flush()
         report.crs = target
@@ -366,6 +373,7 @@ def ingest_city(paths, data_dir, city_cfg: CityCfg | None = None, crs: str | Non
         _remove_stale(city_dir, set(tiles))
         terrain_tris = _write_terrain(city_dir, acc, target)
     finally:
+        bar.close()
         shutil.rmtree(spool, ignore_errors=True)
     _atomic_json(city_dir / "tiles.json", {
         "crs": target, "tile_size_m": cfg.tile_size_m, "buffer_m": cfg.buffer_m, "tiles": tiles})

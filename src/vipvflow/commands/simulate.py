@@ -4,6 +4,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..config import load_config
+from ..progress import set_quiet
 
 
 def register(sub):
@@ -21,12 +22,15 @@ def register(sub):
                    help="address of a running Dask scheduler (tcp://host:8786); default: a LocalCluster")
     p.add_argument("--workers", type=int, default=None, help="LocalCluster worker processes (default: cores)")
     p.add_argument("--db", default=None, help="PostgreSQL DSN: mirror the finished run into PostGIS/Citus")
+    p.add_argument("--quiet", "-q", action="store_true",
+                   help="no progress bars or progress lines")
     p.set_defaults(func=run)
 
 
 def run(args):
     from ..simulation import run_simulation
 
+    set_quiet(args.quiet)
     overrides = {"db": {"dsn": args.db}} if args.db else {}
     cfg = load_config(args.config, overrides=overrides)
     if args.out is not None:
