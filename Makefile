@@ -16,7 +16,7 @@ SYSTEM_PACKAGES := postgresql-15 postgresql-15-postgis-3 chromium
 help:
 	@echo "make setup                    system-deps, then $(VENV) with vipvflow[test,db,app]"
 	@echo "make system-deps              apt-get install $(SYSTEM_PACKAGES) (Debian, root or sudo)"
-	@echo "make simulate YEAR=2024 [CONF=demo|luxembourg|my.yaml] [SCHEDULER=tcp://host:8786] [WORKERS=N]"
+	@echo "make simulate YEAR=2024 [CONF=demo|luxembourg|my.yaml] [SCHEDULER=tcp://host:8786] [WORKERS=N] [QUIET=1]"
 	@echo "make test                     run the test suite"
 	@echo "make bench                    run benchmarks/, write benchmarks/results/*.json"
 	@echo "make data                     fetch the real datasets of data_manifest.yaml (needs a network)"
@@ -50,7 +50,7 @@ system-deps:
 
 simulate: setup
 	$(BIN)/vipvflow simulate --config $(CONF) --year $(YEAR) \
-		$(if $(SCHEDULER),--scheduler $(SCHEDULER)) $(if $(WORKERS),--workers $(WORKERS))
+		$(if $(SCHEDULER),--scheduler $(SCHEDULER)) $(if $(WORKERS),--workers $(WORKERS)) $(if $(QUIET),--quiet)
 
 test: setup
 	$(BIN)/python -m pytest $(PYTEST_ARGS)
