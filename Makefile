@@ -32,21 +32,10 @@ $(VENV)/.installed: pyproject.toml
 	$(BIN)/python -m pip install -q -e '.[test,db,app]'
 	touch $@
 
-# The database (PostgreSQL 15 + PostGIS 3) and browser (Chromium) tests' system packages.
-# Installs the missing ones on Debian as root or with passwordless sudo; otherwise says in one
-# line what to install and succeeds (those tests then skip, naming the same packages).
+# The database (PostgreSQL 15 + PostGIS 3) and browser (Chromium) tests' system packages:
+# installed on Debian as root or with passwordless sudo, else one line saying what to install.
 system-deps:
-	@missing=""; for p in $(SYSTEM_PACKAGES); do \
-	  dpkg -s $$p >/dev/null 2>&1 || missing="$$missing $$p"; done; \
-	if [ -z "$$missing" ]; then exit 0; fi; \
-	if ! command -v apt-get >/dev/null 2>&1; then \
-	  echo "system-deps: skipped (not Debian): install PostgreSQL 15 with PostGIS 3 and Chromium for the DB and browser tests"; exit 0; fi; \
-	if [ "$$(id -u)" = 0 ]; then sudo=""; elif sudo -n true 2>/dev/null; then sudo="sudo -n"; else \
-	  echo "system-deps: skipped (needs root or passwordless sudo): apt-get install$$missing"; exit 0; fi; \
-	echo "system-deps: apt-get install$$missing"; \
-	$$sudo env DEBIAN_FRONTEND=noninteractive apt-get update -qq && \
-	$$sudo env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends$$missing >/dev/null || \
-	  echo "system-deps: apt-get install$$missing failed: the DB and browser tests will skip"
+	@sh .ci/system-deps $(SYSTEM_PACKAGES)
 
 simulate: setup
 	$(BIN)/vipvflow simulate --config $(CONF) --year $(YEAR) \
