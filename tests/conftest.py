@@ -10,6 +10,25 @@ ROOT = Path(__file__).resolve().parents[1]
 SHARED_DATA = Path(os.environ.get("VIPVFLOW_SHARED_DATA", ROOT.parent / "shared" / "data"))
 TEST_DATA = ROOT / "tests" / "data"
 ARTIFACTS = ROOT / "tests" / "artifacts"
+CHROMIUM = Path("/usr/bin/chromium")
+# CI (.ci/run) installs the system packages first and sets this: there a missing one is a failure
+REQUIRE_SYSTEM_DEPS = os.environ.get("VIPVFLOW_REQUIRE_SYSTEM_DEPS") == "1"
+
+
+def missing_system_package(problem: str, packages: str) -> None:
+    """Skip (fail under VIPVFLOW_REQUIRE_SYSTEM_DEPS=1) with one line saying what to install."""
+    line = f"{problem}: install it with `make system-deps` (Debian: apt-get install {packages})"
+    if REQUIRE_SYSTEM_DEPS:
+        pytest.fail(line)
+    pytest.skip(line)
+
+
+@pytest.fixture(scope="session")
+def chromium() -> Path:
+    """The headless browser of the web-app tests; skipped with what to install when absent."""
+    if not CHROMIUM.exists():
+        missing_system_package(f"Chromium not found at {CHROMIUM}", "chromium")
+    return CHROMIUM
 
 
 @pytest.fixture(scope="session")

@@ -2,7 +2,6 @@
 Bokeh app driven in a real headless Chromium."""
 from __future__ import annotations
 
-import shutil
 import socket
 import subprocess
 import sys
@@ -18,7 +17,6 @@ from vipvflow.horizon import horizon_at, horizon_profile
 from vipvflow.shading import Scene, box_mesh
 
 X0, Y0 = 77_000.0, 75_000.0        # LUREF-like coordinates: float32 precision must hold
-CHROMIUM = "/usr/bin/chromium"
 CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
                  "--disable-background-networking", "--disable-component-update", "--disable-sync"]
 ROOT = Path(__file__).resolve().parents[1]
@@ -147,6 +145,33 @@ def test_departure_rule_and_pv_scaling(trip_model):
     np.testing.assert_allclose(mon["allsky"], 2 * mon1["allsky"])
 
 
+def test_app_opens_on_a_clear_summer_noon_of_the_busiest_route(trip_model):
+    """Not 1 January at 08:00: the busiest route-direction, the clearest service day of the
+    run's summer months by GHI / clear-sky GHI, departing at noon."""
+    from vipvflow.app.layout import default_view
+
+    start = default_view(trip_model)
+    routes = trip_model.routes()
+    busiest = routes[routes["trips"] == routes["trips"].max()]
+    assert (start["route_id"], start["direction_id"]) in set(
+        zip(busiest["route_id"], busiest["direction_id"].astype(int)))
+    assert start["depart"] == 12 * 60
+    date = pd.Timestamp(start["date"])
+    assert date.month == 6                                      # the run's only month
+    # clearness of every June day from the radiation table, computed here per day
+    rad = trip_model.radiation
+    t = pd.to_datetime(rad.t0 + rad.step_s * np.arange(rad.data["ghi"].shape[1]), unit="s", utc=True)
+    local = t.tz_convert(trip_model.timezone).tz_localize(None)
+    ratio = {}
+    for day in pd.date_range(f"{trip_model.year}-06-01", f"{trip_model.year}-06-30"):
+        m = (local >= day) & (local < day + pd.Timedelta(days=1))
+        if len(trip_model.departures(start["route_id"], start["direction_id"], day)):
+            ratio[day] = rad.data["ghi"][0, m].sum() / rad.data["ghi_clear"][0, m].sum()
+    assert ratio[date] == pytest.approx(max(ratio.values()), rel=1e-6)
+    res = trip_model.trip(start["route_id"], start["direction_id"], start["date"], start["depart"])
+    assert res.numbers["pv_kwh"] > 0 and res.departure.hour in (12, 13)
+
+
 # ----------------------------------------------------------------------------- browser
 def _free_port() -> int:
     with socket.socket() as s:
@@ -208,15 +233,15 @@ def _expected(model, shown) -> dict:
             "share": f"{100 * n['share']:.{DECIMALS['share_percent']}f}"}
 
 
-def test_app_in_browser(app_url, trip_model, artifacts):
+def test_app_in_browser(chromium, app_url, trip_model, tmp_path):
     playwright = pytest.importorskip("playwright.sync_api")
-    if not Path(CHROMIUM).exists():
-        pytest.skip(f"{CHROMIUM} not installed (Debian package chromium)")
     from playwright.sync_api import expect
+
+    from vipvflow.app.layout import default_view
 
     errors, requests = [], []
     with playwright.sync_playwright() as p:
-        browser = p.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS)
+        browser = p.chromium.launch(executable_path=str(chromium), args=CHROMIUM_ARGS)
         try:
             page = browser.new_page(viewport={"width": 1500, "height": 1250})
             page.on("console", lambda m: errors.append(m.text) if m.type == "error" else None)
@@ -225,28 +250,32 @@ def test_app_in_browser(app_url, trip_model, artifacts):
             page.goto(app_url)
             page.wait_for_selector("#pv-kwh", timeout=60_000)
             first = _displayed(page)
-            assert first["requested"] == "08:00"
+            # opens on the busiest route, the clearest simulated summer day, at noon
+            start = default_view(trip_model)
+            assert (first["route"], int(first["direction"]), first["date"], first["requested"]) == \
+                (start["route_id"], start["direction_id"], start["date"], "12:00")
+            assert float(first["pv_kwh"]) > 0
             exp = _expected(trip_model, first)
             assert {k: first[k] for k in exp} == exp
 
-            # departure slider: 48 steps of 5 min with the keyboard -> 12:00
+            # departure slider: 48 steps of 5 min with the keyboard -> 16:00
             handle = page.locator(".depart-slider .noUi-handle")
             handle.focus()
             for _ in range(48):
                 page.keyboard.press("ArrowRight")
             numbers = page.locator("#trip-numbers")
-            expect(numbers).to_have_attribute("data-requested", "12:00", timeout=30_000)
+            expect(numbers).to_have_attribute("data-requested", "16:00", timeout=30_000)
             page.wait_for_timeout(500)
-            noon = _displayed(page)
-            assert noon["pv_kwh"] != first["pv_kwh"]
-            exp = _expected(trip_model, noon)
-            assert {k: noon[k] for k in exp} == exp
+            later = _displayed(page)
+            assert later["pv_kwh"] != first["pv_kwh"]
+            exp = _expected(trip_model, later)
+            assert {k: later[k] for k in exp} == exp
 
             # route and direction: the other direction of the line
             select = page.locator(".route-select select")
             routes = trip_model.routes()
-            assert (noon["route"], int(noon["direction"])) == (routes.iloc[0]["route_id"],
-                                                               int(routes.iloc[0]["direction_id"]))
+            assert (routes.iloc[0]["route_id"], int(routes.iloc[0]["direction_id"])) == \
+                (start["route_id"], start["direction_id"])       # both directions: as many trips
             select.select_option(index=1)
             expect(numbers).to_have_attribute("data-direction", str(int(routes.iloc[1]["direction_id"])),
                                               timeout=30_000)
@@ -255,11 +284,11 @@ def test_app_in_browser(app_url, trip_model, artifacts):
             back = _displayed(page)
             # the small demo's line is open and runs both ways at the same times: its PV is
             # the same to 1e-4 kWh, its consumption is not (one direction climbs)
-            assert (back["pv_kwh"], back["consumption_kwh"]) != (noon["pv_kwh"], noon["consumption_kwh"])
+            assert (back["pv_kwh"], back["consumption_kwh"]) != (later["pv_kwh"], later["consumption_kwh"])
             exp = _expected(trip_model, back)
             assert {k: back[k] for k in exp} == exp
 
-            shot = artifacts / "app.png"
+            shot = tmp_path / "app.png"
             page.screenshot(path=str(shot), full_page=True)
         finally:
             browser.close()
@@ -268,4 +297,3 @@ def test_app_in_browser(app_url, trip_model, artifacts):
     outside = [u for u in requests if not (u.startswith(host + "/") or u.startswith("ws://127.0.0.1"))]
     assert not outside, outside
     assert shot.stat().st_size > 10_000
-    shutil.copyfile(shot, ROOT / "docs" / "app.png")

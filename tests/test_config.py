@@ -77,3 +77,19 @@ def test_cli_bad_config_is_one_line(tmp_path, capsys):
     assert main(["config", "--config", str(bad)]) == 2
     err = capsys.readouterr().err
     assert "Traceback" not in err and "nonsense" in err and str(bad) in err
+
+
+def test_scenarios_by_name_from_any_directory(tmp_path, monkeypatch):
+    """The shipped scenarios by name, and the repository's former conf/<name>.yaml paths;
+    a local file of that name wins."""
+    from vipvflow.config import scenario_path, shipped_scenarios
+
+    monkeypatch.chdir(tmp_path)
+    assert shipped_scenarios() == ["demo", "luxembourg"]
+    for name in ("demo", "demo.yaml", "conf/demo.yaml"):
+        assert scenario_path(name) == CONF_DIR / "demo.yaml"
+        assert load_config(name).scenario == "demo"
+    (tmp_path / "demo.yaml").write_text("scenario: mine\n")
+    assert load_config("demo.yaml").scenario == "mine"
+    with pytest.raises(ConfigError, match="^elsewhere/demo.yaml: file not found"):
+        load_config("elsewhere/demo.yaml")

@@ -22,6 +22,7 @@ import pandas as pd
 import pyarrow.parquet as pq
 import pytest
 
+from conftest import missing_system_package
 from db_run import checksums, clone_run
 from vipvflow.db import DatabaseError, citus_statements, ddl, mirror_run, run_id_of, schema
 from vipvflow.db import server as pgserver
@@ -37,20 +38,15 @@ _db_counter = itertools.count()
 def pg():
     """A PostgreSQL + PostGIS cluster in a temporary folder on a free port, for the session.
 
-    Never skipped in CI: without the server programs the fixture fails there; on a developer
-    machine without them (CI unset) the database tests are skipped with the reason.
+    Skipped with what to install when the server programs or PostGIS are absent (a failure
+    under ``VIPVFLOW_REQUIRE_SYSTEM_DEPS=1``, as in CI).
     """
     bindir = pgserver.find_bindir()
-    problem = None
     if bindir is None:
-        problem = "PostgreSQL server programs (initdb, pg_ctl) not found"
-    elif not pgserver.postgis_available(bindir):
-        problem = f"PostGIS not installed for {bindir}"
-    if problem:
-        hint = "; install postgresql-15 and postgresql-15-postgis-3"
-        if os.environ.get("CI") or bindir is not None:
-            pytest.fail(problem + hint)
-        pytest.skip(problem + hint)
+        missing_system_package("PostgreSQL server programs (initdb, pg_ctl) not found",
+                               "postgresql-15 postgresql-15-postgis-3")
+    if not pgserver.postgis_available(bindir):
+        missing_system_package(f"PostGIS not installed for {bindir}", "postgresql-15-postgis-3")
     folder = tempfile.mkdtemp(prefix="vipvflow-pg-")  # under /tmp: reachable by 'postgres'
     srv = pgserver.start(folder, durable=False, say=lambda msg: None)
     try:

@@ -153,7 +153,7 @@ def test_shading_where_the_buildings_are_and_nowhere_else(osaka_run):
     sm = gpd.read_parquet(root / "out" / "osaka" / str(YEAR) / "segment_month.parquet")
     segs = gpd.read_parquet(data / "gtfs" / "segments.parquet").set_index("segment_id")
     sm = sm.join(segs[["x", "y", "z", "x_end", "y_end"]], on="segment_id")
-    assert (sm.month == f"{YEAR}-{MONTH}").all() and len(sm) == len(segs)
+    assert (pd.to_datetime(sm.month) == pd.Timestamp(f"{YEAR}-{MONTH}-01")).all() and len(sm) == len(segs)
     start = shapely.points(sm.x, sm.y)                 # a segment is evaluated at its start
     dist = shapely.distance(start, footprints)
     loss = 1 - (sm.h_direct + sm.h_diffuse) / sm.h_total_unshaded

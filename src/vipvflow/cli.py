@@ -38,8 +38,8 @@ buses consume.
 
 typical use:
   vipvflow demo-data --out data/demo/input --year 2024   generate the embedded demo town
-  vipvflow simulate --config conf/demo.yaml --year 2024
-  vipvflow simulate --config conf/luxembourg.yaml --year 2024 --scheduler tcp://host:8786
+  vipvflow simulate --config demo --year 2024 [--out DIR]
+  vipvflow simulate --config my_city.yaml --year 2024 --scheduler tcp://host:8786
 """
 
 
@@ -61,6 +61,10 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+# optional packages and the extra that installs them (pyproject.toml)
+OPTIONAL = {"bokeh": "app", "psycopg": "db"}
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
@@ -74,6 +78,13 @@ def main(argv: list[str] | None = None) -> int:
         return int(args.func(args) or 0)
     except VipvError as exc:
         print(f"vipvflow {args.command}: error: {exc}", file=sys.stderr)
+        return 2
+    except ModuleNotFoundError as exc:
+        extra = OPTIONAL.get((exc.name or "").split(".")[0])
+        if extra is None:
+            raise
+        print(f"vipvflow {args.command}: error: needs the optional package '{exc.name}': "
+              f"pip install 'vipvflow[{extra}]'", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         print("vipvflow: interrupted", file=sys.stderr)

@@ -1,9 +1,11 @@
 """Scenario configuration: one schema, validated on load.
 
-``conf/default.yaml`` holds every default; a scenario YAML (``conf/demo.yaml``,
-``conf/luxembourg.yaml``) overrides any part of it.  Catalog entries (vehicles in
-``conf/vehicles.yaml``, PV systems in ``conf/pv_systems.yaml``) are chosen by name.
-A wrong key or value raises :class:`ConfigError` naming the file, the key and the reason.
+``default.yaml`` holds every default; a scenario YAML (``demo.yaml``, ``luxembourg.yaml`` or
+a user's file) overrides any part of it.  Catalog entries (vehicles in ``vehicles.yaml``, PV
+systems in ``pv_systems.yaml``) are chosen by name.  The shipped files live inside the package
+(``src/vipvflow/conf/``, found with importlib.resources), so an installed vipvflow has them;
+``$VIPVFLOW_CONF_DIR`` replaces that folder.  A wrong key or value raises :class:`ConfigError`
+naming the file, the key and the reason.
 """
 from __future__ import annotations
 
@@ -11,6 +13,7 @@ import copy
 import hashlib
 import json
 import os
+from importlib import resources
 from pathlib import Path
 from typing import Any, Literal
 
@@ -19,8 +22,27 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_valida
 
 from .errors import ConfigError
 
-REPO_ROOT = Path(__file__).resolve().parents[2]
-CONF_DIR = Path(os.environ.get("VIPVFLOW_CONF_DIR", REPO_ROOT / "conf"))
+CONF_DIR = Path(os.environ.get("VIPVFLOW_CONF_DIR") or str(resources.files("vipvflow") / "conf"))
+_NOT_SCENARIOS = {"default", "vehicles", "pv_systems"}
+
+
+def shipped_scenarios() -> list[str]:
+    """Names of the scenario files shipped with vipvflow (``demo``, ``luxembourg``)."""
+    return sorted(p.stem for p in CONF_DIR.glob("*.yaml") if p.stem not in _NOT_SCENARIOS)
+
+
+def scenario_path(name: str | Path) -> Path:
+    """The scenario file *name* stands for: an existing file as given; else a shipped scenario
+    by name (``demo``, ``demo.yaml``, or the repository's former ``conf/demo.yaml``); else
+    *name* unchanged (reading it then reports the missing file)."""
+    path = Path(name)
+    if path.is_file():
+        return path
+    if path.parent in (Path("."), Path("conf")):
+        shipped = CONF_DIR / f"{path.stem}.yaml"
+        if path.suffix in ("", ".yaml") and path.stem not in _NOT_SCENARIOS and shipped.is_file():
+            return shipped
+    return path
 
 
 class _Model(BaseModel):
@@ -157,6 +179,8 @@ class DaskCfg(_Model):
     # Dask's statistical profiler (the dashboard's Profile tab) on the LocalCluster's workers:
     # it samples every worker's stack 100 times a second, which cost a worker ~7 % of its CPU
     worker_profile: bool = False
+    # the LocalCluster's dashboard: this port when free, else (or null) any free one
+    dashboard_port: int | None = Field(8787, ge=0, le=65535)
 
 
 class RunCfg(_Model):
@@ -287,12 +311,13 @@ def _catalog_entry(catalog: dict, name: str, overrides: dict, model, path: Path,
 
 
 def load_config(path: str | Path | None = None, overrides: dict | None = None) -> Config:
-    """Load ``conf/default.yaml``, apply the scenario file at *path* and *overrides*, validate.
+    """Load the shipped ``default.yaml``, apply the scenario at *path* and *overrides*, validate.
 
     Parameters
     ----------
     path : str or Path, optional
-        Scenario YAML. ``None`` gives the defaults alone.
+        Scenario YAML, or a shipped scenario's name (:func:`scenario_path`). ``None`` gives
+        the defaults alone.
     overrides : dict, optional
         Nested mapping applied last (command-line options).
 
@@ -304,7 +329,11 @@ def load_config(path: str | Path | None = None, overrides: dict | None = None) -
     default_path = CONF_DIR / "default.yaml"
     files = [(default_path, _read_yaml(default_path))]
     if path is not None:
-        files.append((Path(path), _read_yaml(Path(path))))
+        path = scenario_path(path)
+        if not path.is_file():
+            raise ConfigError(f"{path}: file not found (shipped scenarios by name: "
+                              f"{', '.join(shipped_scenarios())})")
+        files.append((path, _read_yaml(path)))
     if overrides:
         files.append((Path("<command line>"), overrides))
     merged: dict = {}

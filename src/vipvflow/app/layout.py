@@ -31,15 +31,47 @@ DECIMALS = {"pv_kwh": 3, "consumption_kwh": 2, "share_percent": 2}
 _HHMM = "const m = Math.round(tick); return String(Math.floor(m / 60)).padStart(2, '0') + ':' + String(m % 60).padStart(2, '0');"
 
 
-def _default_date(model: TripModel, route_id, direction_id) -> str:
-    """A service date of the route in the run's first simulated month."""
-    months = model.cfg.run.months
+SUMMER = (6, 7, 5, 8)            # months a first look prefers, best first
+NOON_MIN = 12 * 60
+
+
+def default_view(model: TripModel) -> dict:
+    """The trip the app opens on, one worth looking at: the busiest route-direction, on the
+    clearest day (highest GHI / clear-sky GHI over the day) of the simulated summer months
+    (of the simulated months when none is in summer) on which it runs, at noon.
+
+    Returns ``route_id, direction_id, date ('YYYY-MM-DD'), depart (minutes)``.
+    """
+    routes = model.routes()
+    best = routes.loc[routes["trips"].idxmax()]
+    route_id, direction_id = best["route_id"], int(best["direction_id"])
+    months = list(model.cfg.run.months or range(1, 13))
+    summer = [m for m in SUMMER if m in months] or months
+    rad = model.radiation
+    times = pd.to_datetime(rad.t0 + rad.step_s * np.arange(rad.data["ghi"].shape[1]), unit="s",
+                           utc=True).tz_convert(model.timezone)
+    day = pd.DataFrame({"date": times.tz_localize(None).normalize(),
+                        "ghi": rad.data["ghi"].mean(axis=0), "clear": rad.data["ghi_clear"].mean(axis=0)})
+    daily = day.groupby("date")[["ghi", "clear"]].sum()
+    clearness = (daily["ghi"] / daily["clear"].where(daily["clear"] > 0)).dropna()
     sd = model.service_dates
-    sd = sd[(sd["date"].dt.year == model.year) & (sd["date"].dt.month == months[0])]
-    for d in sorted(sd["date"].unique()):
-        if len(model.departures(route_id, direction_id, d)):
-            return pd.Timestamp(d).strftime("%Y-%m-%d")
-    return f"{model.year}-{months[0]:02d}-15"
+    sd = sd[(sd["date"].dt.year == model.year) & sd["date"].dt.month.isin(summer)]
+    candidates = [d for d in clearness.index.intersection(pd.DatetimeIndex(sd["date"].unique()))
+                  if len(model.departures(route_id, direction_id, d))]
+    if candidates:
+        date = max(candidates, key=lambda d: (clearness[d], -abs(d.day_of_year - 172)))
+    else:                                    # no radiation or no service day found: mid-month
+        date = pd.Timestamp(model.year, summer[0], 15)
+    return {"route_id": route_id, "direction_id": direction_id,
+            "date": date.strftime("%Y-%m-%d"), "depart": NOON_MIN}
+
+
+def month_labels(months) -> list[str]:
+    """Axis labels of months (``'2024-06'`` or a date): ``'Jun'``, with the year when the
+    months span more than one."""
+    when = pd.to_datetime(pd.Series(months, dtype=object).astype(str))
+    fmt = "%b" if when.dt.year.nunique() <= 1 else "%b %Y"
+    return list(when.dt.strftime(fmt))
 
 
 @lru_cache(maxsize=4)
@@ -110,7 +142,7 @@ def build_document(model: TripModel, doc) -> None:
     route_opts = [(f"{r.route_id}|{r.direction_id}",
                    f"{r.route_short_name} direction {r.direction_id} ({r.trips} trips)")
                   for r in routes.itertuples()]
-    first_route, first_dir = routes.iloc[0]["route_id"], int(routes.iloc[0]["direction_id"])
+    start = default_view(model)
     run_pv = model.run_pv_choice
 
     # ------------------------------------------------------------------ controls
@@ -128,12 +160,12 @@ def build_document(model: TripModel, doc) -> None:
                 end=0.95, step=0.01, width=w, css_classes=["pv-pr"])
     losses = Slider(title="DC system losses % (pvlib model)", value=run_pv.losses_percent, start=0,
                     end=40, step=0.5, width=w, css_classes=["pv-losses"])
-    route = Select(title="route and direction", value=route_opts[0][0], options=route_opts, width=w,
-                   css_classes=["route-select"])
-    date = DatePicker(title="date", value=_default_date(model, first_route, first_dir),
+    route = Select(title="route and direction", value=f"{start['route_id']}|{start['direction_id']}",
+                   options=route_opts, width=w, css_classes=["route-select"])
+    date = DatePicker(title="date", value=start["date"],
                       min_date=f"{model.year}-01-01", max_date=f"{model.year}-12-31", width=w,
                       css_classes=["date-picker"])
-    depart = Slider(title="departure: next scheduled trip at or after", value=8 * 60, start=0,
+    depart = Slider(title="departure: next scheduled trip at or after", value=start["depart"], start=0,
                     end=24 * 60 - 5, step=5, width=w, css_classes=["depart-slider"],
                     format=CustomJSTickFormatter(code=_HHMM))
     aux = Spinner(title="auxiliary base load (kW; HVAC on top)", value=model.vehicle.aux_base_kw,
@@ -195,7 +227,7 @@ def build_document(model: TripModel, doc) -> None:
     f_soc.legend.location = "bottom_left"
 
     f_mon = figure(title="Monthly PV energy of the route-direction (run, rescaled to this PV)",
-                   x_range=FactorRange(), height=300, width=560, y_axis_label="kWh",
+                   x_range=FactorRange(), height=330, width=560, y_axis_label="kWh",
                    tools="save,reset")
     f_mon.vbar(x=dodge("month", -0.18, range=f_mon.x_range), top="allsky", width=0.34, source=src_mon,
                color="#ff7f0e", legend_label="all-sky")
@@ -208,7 +240,10 @@ def build_document(model: TripModel, doc) -> None:
     f_mon.add_tools(HoverTool(tooltips=[("month", "@month"), ("all-sky", "@allsky{0,0} kWh"),
                                         ("clear-sky", "@clearsky{0,0} kWh"),
                                         ("shading loss", "@shading_loss{0.0%}")]))
-    f_mon.legend.location = "bottom_right"
+    # the legend in one row above the plot, never over the bars; month names on the axis
+    f_mon.legend.orientation = "horizontal"
+    f_mon.add_layout(f_mon.legend[0], "above")
+    f_mon.xaxis.major_label_text_font_size = "11pt"
     f_mon.y_range.start = 0
 
     # ------------------------------------------------------------------ callbacks
@@ -225,6 +260,7 @@ def build_document(model: TripModel, doc) -> None:
     def update_monthly(pv: PVChoice):
         rid, d = selected()
         mon = model.monthly(rid, d, pv)
+        mon["month"] = month_labels(mon["month"])
         f_mon.x_range.factors = list(mon["month"])
         src_mon.data = {k: list(mon[k]) for k in src_mon.data}
         fleet = model.monthly(None, None, pv)

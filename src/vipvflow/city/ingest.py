@@ -40,6 +40,7 @@ import numpy as np
 from ..config import CityCfg
 from ..errors import InputError
 from ..mesh import SURFACE_CODE, SURFACE_TYPES, TileMesh
+from ..progress import Progress, citygml_bytes, file_position
 from ..tiles import tile_bounds, tile_index, tile_name
 from .citygml import CityGMLReader, open_sources
 from .crs import (SourceCRS, horizontal, inside, is_projected, local_utm, normalise_crs,
@@ -372,6 +373,8 @@ def ingest_city(paths, data_dir, city_cfg: CityCfg | None = None, crs: str | Non
     counts = _Counts()
     ignored = Counter()
     spool = city_dir / ".spool"
+    bar = Progress("CityGML ingest", citygml_bytes(paths), unit="B")
+    read_before = 0
     try:
         spool.mkdir()
         acc = _Accumulator(spool, cfg, chunk_surfaces)
@@ -382,7 +385,9 @@ def ingest_city(paths, data_dir, city_cfg: CityCfg | None = None, crs: str | Non
                     with opener() as fh:
                         reader = CityGMLReader(fh, label)
                         src = None
-                        for feature in reader:
+                        for n_feature, feature in enumerate(reader):
+                            if n_feature % 64 == 0:
+                                bar.advance_to(read_before + file_position(fh))
                             if src is None and _has_coordinates(feature):
                                 src, target = _resolve_crs(reader, label, feature, target, report,
                                                            axis_order)
@@ -399,6 +404,8 @@ def ingest_city(paths, data_dir, city_cfg: CityCfg | None = None, crs: str | Non
                         ignored.update(reader.ignored)
                         if src is None:
                             report.file_crs[label] = None
+                        read_before += file_position(fh)
+                        bar.advance_to(read_before, "tiles and meshes next")
                     log.info("read %s", label)
         acc.flush()
         report.crs = target
@@ -426,7 +433,11 @@ def ingest_city(paths, data_dir, city_cfg: CityCfg | None = None, crs: str | Non
         report.report_path = str(final_dir / "ingest_report.json")
         _atomic_json(city_dir / "ingest_report.json", json.loads(report.to_json()))
         _swap_in(city_dir, final_dir)
+    except BaseException:
+        bar.close(failed=True)
+        raise
     finally:
+        bar.close()
         shutil.rmtree(city_dir, ignore_errors=True)
     return report
 

@@ -8,7 +8,8 @@ from ..config import load_config
 
 def register(sub):
     p = sub.add_parser("config", help="validate a scenario YAML and print the merged configuration")
-    p.add_argument("--config", "-c", default=None, help="scenario YAML (default: conf/default.yaml only)")
+    p.add_argument("--config", "-c", default=None, help="scenario YAML or a shipped scenario's name "
+                   "(demo, luxembourg); default: the defaults alone")
     p.set_defaults(func=run)
 
 

@@ -3,6 +3,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from ..progress import set_quiet
+
 
 def register(sub):
     p = sub.add_parser(
@@ -16,10 +18,13 @@ def register(sub):
     p.add_argument("--seed", default=42, type=int, help="random seed (default: 42)")
     p.add_argument("--size", default="full", choices=["full", "small"],
                    help="full: 18 km line + 6.5 km line, ~3,600 buildings; small: a 3 km line")
+    p.add_argument("--quiet", "-q", action="store_true",
+                   help="no progress bars or progress lines")
     p.set_defaults(func=run)
 
 
 def run(args):
+    set_quiet(args.quiet)
     from ..demo import generate_demo
 
     res = generate_demo(args.out, year=args.year, seed=args.seed, size=args.size)

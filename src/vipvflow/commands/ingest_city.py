@@ -5,6 +5,7 @@ from pathlib import Path
 
 from ..config import load_config
 from ..errors import InputError
+from ..progress import set_quiet
 
 
 def register(sub):
@@ -26,10 +27,13 @@ def register(sub):
                         "of use, easting first when both do), epsg (always the EPSG order), "
                         "xy (always easting/longitude first)")
     p.add_argument("--config", "-c", default=None, help="scenario YAML (tile size, buffer, albedo)")
+    p.add_argument("--quiet", "-q", action="store_true",
+                   help="no progress bars or progress lines")
     p.set_defaults(func=run)
 
 
 def run(args):
+    set_quiet(args.quiet)
     from ..city import ingest_city
 
     cfg = load_config(args.config)

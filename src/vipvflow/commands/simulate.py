@@ -1,7 +1,10 @@
 """``vipvflow simulate``: the fleet-year of a scenario on a LocalCluster or any Dask scheduler."""
 from __future__ import annotations
 
+from pathlib import Path
+
 from ..config import load_config
+from ..progress import set_quiet
 
 
 def register(sub):
@@ -9,23 +12,45 @@ def register(sub):
                        description="Prepare inputs (demo generation, ingest), evaluate every pass of "
                        "every trip of the year per (tile, month) partition, reduce and write "
                        "out/<scenario>/<year>/. Re-running resumes an interrupted run.")
-    p.add_argument("--config", "-c", default="conf/demo.yaml", help="scenario YAML (default conf/demo.yaml)")
+    p.add_argument("--config", "-c", default="demo",
+                   help="scenario YAML, or a shipped scenario's name: demo (default), luxembourg")
     p.add_argument("--year", type=int, required=True)
+    p.add_argument("--out", type=Path, default=None,
+                   help="folder for the scenario's relative data_dir and out_dir (and the demo's "
+                        "generated inputs) instead of the current directory")
     p.add_argument("--scheduler", default=None,
                    help="address of a running Dask scheduler (tcp://host:8786); default: a LocalCluster")
     p.add_argument("--workers", type=int, default=None, help="LocalCluster worker processes (default: cores)")
     p.add_argument("--db", default=None, help="PostgreSQL DSN: mirror the finished run into PostGIS/Citus")
+    p.add_argument("--quiet", "-q", action="store_true",
+                   help="no progress bars or progress lines")
     p.set_defaults(func=run)
 
 
 def run(args):
     from ..simulation import run_simulation
 
-    overrides = {"db": {"dsn": args.db}} if args.db else None
+    set_quiet(args.quiet)
+    overrides = {"db": {"dsn": args.db}} if args.db else {}
     cfg = load_config(args.config, overrides=overrides)
+    if args.out is not None:
+        cfg = load_config(args.config, overrides={**overrides, **under(cfg, args.out)})
     run_dir = run_simulation(cfg, args.year, scheduler=args.scheduler, n_workers=args.workers)
     if cfg.db.dsn and (run_dir / "summary.json").exists():
         from ..db import mirror_run
 
         mirror_run(cfg.db.dsn, run_dir)
     return 0
+
+
+def under(cfg, folder: Path) -> dict:
+    """Overrides that put the relative ``data_dir``, ``out_dir`` (and, for the demo, its
+    generated input files) under *folder*."""
+    def moved(p):
+        return str(p if Path(p).is_absolute() else Path(folder) / p)
+
+    out = {"data_dir": moved(cfg.data_dir), "out_dir": moved(cfg.out_dir)}
+    if cfg.demo.enabled:
+        out["inputs"] = {"citygml": [moved(p) for p in cfg.inputs.citygml],
+                         "gtfs": moved(cfg.inputs.gtfs), "cams": [moved(p) for p in cfg.inputs.cams]}
+    return out

@@ -29,6 +29,7 @@ import numpy as np
 import shapely
 from pyproj import Transformer
 
+from ..progress import Progress
 from .cams import write_cams_csv
 from .city import SRS_NAME, Terrain, place_buildings, write_citygml
 from .gtfs import AVERAGE_SPEED_KMH, AGENCY_TZ, stop_positions, stop_offsets, trips_per_year, write_gtfs
@@ -136,7 +137,16 @@ def generate_demo(out_dir, year: int, seed: int = 42, size: str = "full") -> dic
     out.mkdir(parents=True, exist_ok=True)
     paths = {k: out / v for k, v in FILES.items()}
     seconds = {}
+    bar = Progress("demo generation", len(FILES), unit="files")
+    bar.update(0, "town and CityGML")
+    try:
+        return _generate(paths, seconds, year, seed, size, bar)
+    finally:
+        bar.close()
 
+
+def _generate(paths: dict, seconds: dict, year: int, seed: int, size: str, bar) -> dict:
+    """The files of :func:`generate_demo`, one after the other, counted on *bar*."""
     t = time.perf_counter()
     layout = build_layout(seed, size)
     terrain = Terrain(layout.bounds(TERRAIN_MARGIN_M), seed)
@@ -146,11 +156,13 @@ def generate_demo(out_dir, year: int, seed: int = 42, size: str = "full") -> dic
     city = write_citygml(_tmp(paths["citygml"]), buildings, terrain, near)
     _commit(paths["citygml"])
     seconds["citygml"] = time.perf_counter() - t
+    bar.update(1, "GTFS")
 
     t = time.perf_counter()
     gtfs = write_gtfs(_tmp(paths["gtfs"]), layout, year)
     _commit(paths["gtfs"])
     seconds["gtfs"] = time.perf_counter() - t
+    bar.update(1, "layout")
 
     t = time.perf_counter()
     doc = layout_document(layout, year, buildings, terrain)
@@ -159,6 +171,7 @@ def generate_demo(out_dir, year: int, seed: int = 42, size: str = "full") -> dic
                                   json.dumps(doc, indent=1)) + "\n")
     _commit(paths["layout"])
     seconds["layout"] = time.perf_counter() - t
+    bar.update(1, "CAMS radiation year")
 
     t = time.perf_counter()
     alt = round(float(terrain.z(*CENTRE_XY)), 2)
@@ -166,6 +179,7 @@ def generate_demo(out_dir, year: int, seed: int = 42, size: str = "full") -> dic
                           round(doc["centre"]["lon"], 4), alt, seed)
     _commit(paths["cams"])
     seconds["cams"] = time.perf_counter() - t
+    bar.update(1, "done")
 
     counts = dict(city)
     counts.update({

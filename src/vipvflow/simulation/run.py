@@ -3,10 +3,10 @@ from __future__ import annotations
 
 import dataclasses
 import importlib
+import importlib.util
 import json
 import logging
 import os
-import sys
 import threading
 import time
 from pathlib import Path
@@ -15,6 +15,7 @@ import pandas as pd
 
 from ..config import Config
 from ..errors import InputError
+from ..progress import FolderProgress, MapProgress
 from .partition import RunContext, partition_done, run_partition, tile_geometry, worker_bvh_builds
 from .storage import write_json
 
@@ -73,43 +74,23 @@ def make_client(cfg: Config, scheduler: str | None, n_workers: int | None):
     with dask.config.set(settings):     # the nannies hand this configuration to their workers
         cluster = LocalCluster(n_workers=n, threads_per_worker=cfg.dask.threads_per_worker or 1,
                                processes=True, memory_limit=cfg.dask.memory_limit,
-                               dashboard_address=":0", silence_logs=logging.ERROR)
+                               dashboard_address=dashboard_address(cfg.dask.dashboard_port),
+                               silence_logs=logging.ERROR)
     return Client(cluster), cluster
 
 
-class FleetView:
-    """Progress over partitions plus, per route, the partitions, trips and kWh done so far."""
+def dashboard_address(port: int | None) -> str:
+    """``:port`` when that port is free on this machine, else ``:0`` (any free port)."""
+    import socket
 
-    def __init__(self, total: int, stream=sys.stderr, every_s: float = 2.0, max_routes: int = 6):
-        self.total, self.done, self.stream, self.every_s = total, 0, stream, every_s
-        self.max_routes = max_routes
-        self.routes: dict[str, dict] = {}
-        self._last = 0.0
-        self.t0 = time.perf_counter()
-
-    def update(self, res: dict) -> None:
-        self.done += 1
-        for route, kwh in res.get("kwh_by_route", {}).items():
-            r = self.routes.setdefault(route, {"partitions": 0, "kwh": 0.0})
-            r["partitions"] += 1
-            r["kwh"] += kwh
-        now = time.perf_counter()
-        if now - self._last >= self.every_s or self.done == self.total:
-            self._last = now
-            self.draw()
-
-    def draw(self) -> None:
-        width = 30
-        filled = int(width * self.done / max(self.total, 1))
-        bar = "#" * filled + "-" * (width - filled)
-        top = sorted(self.routes.items(), key=lambda kv: -kv[1]["kwh"])[:self.max_routes]
-        routes = "  ".join(f"{k}: {v['partitions']}p {v['kwh']:,.0f} kWh" for k, v in top)
-        if len(self.routes) > self.max_routes:
-            routes += f"  (+{len(self.routes) - self.max_routes} routes)"
-        print(f"\r[{bar}] {self.done}/{self.total} partitions  "
-              f"{time.perf_counter() - self.t0:5.0f}s  {routes}", end="", file=self.stream, flush=True)
-        if self.done == self.total:
-            print(file=self.stream)
+    if port is None:
+        return ":0"
+    with socket.socket() as s:
+        try:
+            s.bind(("", port))
+        except OSError:
+            return ":0"
+    return f":{port}"
 
 
 def selected_network(cfg: Config) -> tuple[pd.DataFrame, tuple | None, list[str]]:
@@ -190,7 +171,8 @@ def run_simulation(cfg: Config, year: int, scheduler: str | None = None,
         ray_threads = cfg.dask.ray_threads or (
             max(1, (os.cpu_count() or 1) // max(1, n_workers_now)) if cluster is not None else 1)
         ctx = dataclasses.replace(ctx, ray_threads=ray_threads)
-        say(f"dask dashboard: {client.dashboard_link}")
+        say(f"dask dashboard: {client.dashboard_link}" if importlib.util.find_spec("bokeh")
+            else "dask dashboard: off (it needs bokeh: pip install 'vipvflow[app]')")
         say(f"{len(tiles)} tiles x {len(cfg.run.months)} months = {total} partitions, {len(todo)} to compute "
             f"({total - len(todo)} already done) with {n_workers_now} workers")
         warm.join()
@@ -212,7 +194,8 @@ def run_simulation(cfg: Config, year: int, scheduler: str | None = None,
             say("stopped before all partitions were computed; run the same command again to resume")
             return run_dir
         t_red = time.perf_counter()
-        summary = reduce_run(cfg, year, run_dir, say=say)
+        with FolderProgress("reduce", run_dir):
+            summary = reduce_run(cfg, year, run_dir, say=say)
         timings["reduce_s"] = time.perf_counter() - t_red
     finally:
         closer.join()
@@ -250,7 +233,7 @@ def _map(client, ctx: RunContext, todo: list[tuple[str, str]], every_s: float = 
     for tile, month in todo:
         futures.append(client.submit(run_partition, ctx, tile, month, geometry[tile],
                                      key=f"irradiance-{tile}-{month}"))
-    view = FleetView(len(futures))
+    view = MapProgress(len(futures))
     results = []
     done, last = [], time.perf_counter()
     # the finished partitions' summaries are fetched together about once a second: one
@@ -261,10 +244,11 @@ def _map(client, ctx: RunContext, todo: list[tuple[str, str]], every_s: float = 
         if time.perf_counter() - last >= every_s or n_done == len(futures):
             for res in client.gather(done):
                 results.append(res)
-                view.update(res)
+                view.add(res)
             for f in done:
                 f.release()
             done, last = [], time.perf_counter()
+    view.close()
     return results
 
 
