@@ -39,6 +39,8 @@ class Inputs(_Model):
     citygml: list[Path] = Field(default_factory=list)
     citygml_crs: str | None = None
     gtfs: Path | None = None
+    # IANA zone of the timetable for a feed without agency.txt (the feed's own wins)
+    gtfs_timezone: str | None = None
     cams: list[Path] = Field(default_factory=list)
 
 
@@ -164,12 +166,19 @@ class RunCfg(_Model):
 
     months: list[int] = Field(default_factory=lambda: list(range(1, 13)), min_length=1)
     routes: list[str] | None = None
+    # GTFS route_type values to simulate (3 bus, 0 tram, 2 rail, 11 trolleybus, extended
+    # 100..1799 such as 700 bus service); null: every route of the feed
+    route_types: list[int] | None = Field(None, min_length=1)
 
     @model_validator(mode="after")
     def _months(self):
         bad = [m for m in self.months if not 1 <= m <= 12]
         if bad:
             raise ValueError(f"months must be 1..12, got {bad}")
+        bad = [t for t in self.route_types or [] if not (0 <= t <= 12 or 100 <= t <= 1799)]
+        if bad:
+            raise ValueError(f"route_types must be GTFS route types (0..12 or extended "
+                             f"100..1799), got {bad}")
         self.__dict__["months"] = sorted(set(self.months))
         return self
 

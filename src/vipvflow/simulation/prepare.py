@@ -73,12 +73,22 @@ def ensure_ingested(cfg: Config, say=print) -> dict:
         report = ingest_city(city_files, data_dir, cfg.city, crs=cfg.inputs.citygml_crs)
         say("  " + report.summary())
         _stamp(stamp, city_fp)
-    gtfs_fp = _fingerprint([gtfs], {"trajectory": cfg.trajectory.model_dump(mode="json"), "city": city_fp})
+    gtfs_fp = _fingerprint([gtfs], {"trajectory": cfg.trajectory.model_dump(mode="json"), "city": city_fp,
+                                    "timezone": cfg.inputs.gtfs_timezone,
+                                    "route_types": cfg.run.route_types})
     stamp = data_dir / "gtfs" / ".inputs.json"
     if not _cached(stamp, gtfs_fp):
+        from ..commands.ingest_gtfs import findings
+
         say(f"ingesting GTFS feed {gtfs}")
-        report = ingest_gtfs(gtfs, data_dir, cfg.trajectory, crs=cfg.inputs.citygml_crs)
-        say("  " + _summary(report))
+        report = ingest_gtfs(gtfs, data_dir, cfg.trajectory, crs=cfg.inputs.citygml_crs,
+                             timezone=cfg.inputs.gtfs_timezone, route_types=cfg.run.route_types)
+        c = report["counts"]
+        say(f"  shapes {c['shapes']} ({c['shapes_built_from_stops']} built from stops), segments "
+            f"{c['segments']}, tiles {c['tiles']}, trips {c['trips']}, patterns {c['patterns']}, "
+            f"routes {c['routes']}; timezone {report['timezone']}, CRS {report['crs']}")
+        for line in findings(report):
+            say("  " + line)
         _stamp(stamp, gtfs_fp)
     cams_fp = _fingerprint(cams_files, {})
     stamp = data_dir / "radiation" / ".inputs.json"
