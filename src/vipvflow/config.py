@@ -183,6 +183,14 @@ class RunCfg(_Model):
         return self
 
 
+class RadiationCfg(_Model):
+    """How much missing radiation a run accepts."""
+
+    # a gap in the radiation data longer than this, while buses run, stops the run before the
+    # cluster starts; shorter gaps are interpolated and counted (min)
+    max_gap_minutes: float = Field(60.0, gt=0)
+
+
 class DbCfg(_Model):
     dsn: str | None = None
 
@@ -201,6 +209,7 @@ class Config(_Model):
     economics: EconomicsCfg = Field(default_factory=EconomicsCfg)
     climate: ClimateCfg = Field(default_factory=ClimateCfg)
     run: RunCfg = Field(default_factory=RunCfg)
+    radiation: RadiationCfg = Field(default_factory=RadiationCfg)
     dask: DaskCfg = Field(default_factory=DaskCfg)
     db: DbCfg = Field(default_factory=DbCfg)
 
