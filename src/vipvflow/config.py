@@ -58,8 +58,9 @@ class Albedo(_Model):
 
 
 class CityCfg(_Model):
-    tile_size_m: float = Field(500.0, gt=0)
-    buffer_m: float = Field(300.0, ge=0)
+    # bounds keep a run's tile and mesh count sane (a 1 mm tile would ask for GiBs of index)
+    tile_size_m: float = Field(500.0, ge=50, le=100_000)
+    buffer_m: float = Field(300.0, ge=0, le=5_000)
     albedo: Albedo = Field(default_factory=Albedo)
     planarity_tolerance_m: float = Field(0.10, gt=0)
     min_area_m2: float = Field(0.01, ge=0)
@@ -74,8 +75,8 @@ class CycleCfg(_Model):
 
 
 class TrajectoryCfg(_Model):
-    segment_length_m: float = Field(10.0, gt=0)
-    roof_height_m: float = Field(3.2, ge=0)
+    segment_length_m: float = Field(10.0, ge=0.5, le=1_000)
+    roof_height_m: float = Field(3.2, ge=0, le=10)
     default_elevation_m: float = 300.0
     timing: Literal["stop_times", "driving_cycle"] = "stop_times"
     cycle: CycleCfg = Field(default_factory=CycleCfg)
@@ -84,9 +85,9 @@ class TrajectoryCfg(_Model):
 class IrradianceCfg(_Model):
     diffuse_model: Literal["isotropic", "sky_view_factor"] = "isotropic"
     reflection: bool = True
-    reflection_rays: int = Field(64, ge=0)
-    svf_rays: int = Field(128, gt=0)
-    ray_length_m: float = Field(300.0, gt=0)
+    reflection_rays: int = Field(64, ge=0, le=65_536)
+    svf_rays: int = Field(128, gt=0, le=65_536)
+    ray_length_m: float = Field(300.0, gt=0, le=100_000)
     ray_offset_m: float = Field(0.05, ge=0)
     max_reflector_groups: int = Field(3, ge=0)
     reflector_points: int = Field(4, ge=1)
