@@ -15,7 +15,8 @@ from pathlib import Path
 from typing import Any, Literal
 
 import yaml
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+from pydantic import (BaseModel, ConfigDict, Field, ValidationError, field_validator,
+                      model_validator)
 
 from .errors import ConfigError
 
@@ -171,15 +172,19 @@ class RunCfg(_Model):
     # 100..1799 such as 700 bus service); null: every route of the feed
     route_types: list[int] | None = Field(None, min_length=1)
 
+    @field_validator("route_types")
+    @classmethod
+    def _route_types(cls, v):
+        bad = [t for t in v or [] if not (0 <= t <= 12 or 100 <= t <= 1799)]
+        if bad:
+            raise ValueError(f"not GTFS route types (0..12 or extended 100..1799): {bad}")
+        return v
+
     @model_validator(mode="after")
     def _months(self):
         bad = [m for m in self.months if not 1 <= m <= 12]
         if bad:
             raise ValueError(f"months must be 1..12, got {bad}")
-        bad = [t for t in self.route_types or [] if not (0 <= t <= 12 or 100 <= t <= 1799)]
-        if bad:
-            raise ValueError(f"route_types must be GTFS route types (0..12 or extended "
-                             f"100..1799), got {bad}")
         self.__dict__["months"] = sorted(set(self.months))
         return self
 

@@ -119,6 +119,11 @@ def _scan_header(path: Path) -> dict:
     if line.count(";") + 1 != len(info["columns"]):
         raise InputError(f"{path}: line {no}: {line.count(';') + 1} fields but the header "
                          f"(line {cols_line}) names {len(info['columns'])} columns")
+    last = _last_line(path)
+    if not last.startswith("#") and last.count(";") + 1 != len(info["columns"]):
+        raise InputError(f"{path}: last line: {last.count(';') + 1} fields but the header "
+                         f"(line {cols_line}) names {len(info['columns'])} columns (file "
+                         "truncated?)")
     if not re.match(r"^\d{4}-\d\d-\d\dT[\d:.]+/\d{4}-\d\d-\d\dT[\d:.]+$", line.split(";")[0]):
         raise InputError(f"{path}: line {no}: observation period {line.split(';')[0]!r} is "
                          "not 'start/end' in ISO 8601")
@@ -126,6 +131,15 @@ def _scan_header(path: Path) -> dict:
     info["time_reference"] = "TST" if ref.startswith("True solar") else "UT"
     info["time_step"] = pvlib.iotools.sodapro.SUMMATION_PERIOD_TO_TIME_STEP[period]
     return info
+
+
+def _last_line(path: Path, tail: int = 1 << 16) -> str:
+    """The last non-empty line of a text file, read from its end only."""
+    with open(path, "rb") as fh:
+        fh.seek(0, os.SEEK_END)
+        fh.seek(max(0, fh.tell() - tail))
+        lines = fh.read().decode("utf-8", errors="replace").rstrip("\r\n").splitlines()
+    return lines[-1] if lines else ""
 
 
 def tst_to_utc(t_tst: pd.DatetimeIndex, longitude: float) -> pd.DatetimeIndex:
