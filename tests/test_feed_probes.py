@@ -314,3 +314,118 @@ def test_year_and_config_refused_in_one_line(tmp_path):
                    str(conf), "city.tile_size_m", "greater than or equal to 50")
     conf.write_text(yaml.safe_dump({"trajectory": {"segment_length_m": 0.001}}))
     one_line_error(vipvflow("config", "--config", conf), "trajectory.segment_length_m")
+
+
+@pytest.fixture(scope="module")
+def ingested(tmp_path_factory, demo_small):
+    """The small demo (2024) ingested into a data dir of its own; a scenario YAML for June
+    with demo generation off (the session's demo inputs are never rewritten)."""
+    from conftest import write_small_config
+    from vipvflow.config import load_config
+    from vipvflow.simulation.prepare import ensure_ingested
+
+    root = tmp_path_factory.mktemp("probe_runs")
+    path = write_small_config(root, demo_small, months=(6,), name="probe")
+    conf = yaml.safe_load(path.read_text())
+    conf["demo"]["enabled"] = False
+    path.write_text(yaml.safe_dump(conf))
+    ensure_ingested(load_config(path), say=lambda *a: None)
+    return root, conf
+
+
+def _variant(ingested, tmp_path, cams=None, **changes) -> Path:
+    """A copy of the ingested scenario (data dir copied, so only changed inputs re-ingest)."""
+    import shutil
+
+    root, conf = ingested
+    conf = json.loads(json.dumps(conf))
+    shutil.copytree(root / "data", tmp_path / "data")
+    conf["data_dir"], conf["out_dir"] = str(tmp_path / "data"), str(tmp_path / "out")
+    if cams is not None:
+        conf["inputs"]["cams"] = [str(cams)]
+    for key, value in changes.items():
+        conf.setdefault(key, {}).update(value)
+    path = tmp_path / "scenario.yaml"
+    path.write_text(yaml.safe_dump(conf))
+    return path
+
+
+def _no_cluster(res) -> None:
+    assert "dask dashboard" not in res.stdout and "partitions" not in res.stdout, res.stdout
+
+
+def test_year_without_service_stops_before_the_cluster(ingested, tmp_path):
+    path = _variant(ingested, tmp_path)
+    res = vipvflow("simulate", "--config", path, "--year", "2023")
+    one_line_error(res, "the GTFS calendar has no service in 2023 (months [6])",
+                   "it runs from 2024-01-01 to 2024-12-31")
+    _no_cluster(res)
+    assert not (tmp_path / "out").exists()
+
+
+def test_unknown_routes_and_city_elsewhere_stop(ingested, tmp_path):
+    path = _variant(ingested, tmp_path, run={"routes": ["R-does-not-exist"]})
+    res = vipvflow("simulate", "--config", path, "--year", "2024")
+    one_line_error(res, "run.routes", "R-does-not-exist")
+    _no_cluster(res)
+    # a city model whose tiles lie elsewhere (the tiles renamed far away)
+    conf = yaml.safe_load(path.read_text())
+    conf["run"].pop("routes")
+    path.write_text(yaml.safe_dump(conf))
+    tiles = tmp_path / "data" / "city" / "tiles.json"
+    meta = json.loads(tiles.read_text())
+    meta["tiles"] = {f"E9{i:03d}N9999": v for i, v in enumerate(meta["tiles"].values())}
+    tiles.write_text(json.dumps(meta))
+    res = vipvflow("simulate", "--config", path, "--year", "2024")
+    one_line_error(res, "covers none of the routes")
+    _no_cluster(res)
+
+
+def _cams_lines_without(src: Path, dest: Path, drop) -> None:
+    """Copy a CAMS CSV leaving out the data rows whose period start satisfies *drop*."""
+    with open(src) as fin, open(dest, "w") as fout:
+        for line in fin:
+            if line.startswith("#") or not drop(line[:10]):
+                fout.write(line)
+
+
+def test_truncated_cams_stops_before_the_cluster(ingested, demo_small, tmp_path):
+    """A CAMS file ending 15 June: the June run stops naming the days without radiation."""
+    cams = tmp_path / "cams_until_15_june.csv"
+    _cams_lines_without(demo_small / "cams_radiation_demo.csv", cams, lambda d: d >= "2024-06-15")
+    res = vipvflow("simulate", "--config", _variant(ingested, tmp_path, cams=cams),
+                   "--year", "2024")
+    err = one_line_error(res, "covers 2024-01-01 00:00 to 2024-06-15 00:00 UTC",
+                         "2024-06-15 .. 2024-06-30", "without it")
+    _no_cluster(res)
+    assert "truncated" in err
+    # the ingest said so too: rows end ~200 days before the declared end
+    assert "days before the declared end" in res.stdout
+
+
+def test_day_missing_from_cams_stops_naming_the_gap(ingested, demo_small, tmp_path):
+    cams = tmp_path / "cams_without_10_june.csv"
+    _cams_lines_without(demo_small / "cams_radiation_demo.csv", cams, lambda d: d == "2024-06-10")
+    path = _variant(ingested, tmp_path, cams=cams)
+    res = vipvflow("simulate", "--config", path, "--year", "2024")
+    one_line_error(res, "gap of 1440 min from 2024-06-10 00:00 to 2024-06-11 00:00 UTC",
+                   "radiation.max_gap_minutes = 60")
+    _no_cluster(res)
+
+
+def test_totals_zero_or_undefined_stop(tmp_path):
+    """The reduce's last check: no PV energy or a NaN figure stops; strict JSON otherwise."""
+    from vipvflow.errors import InputError
+    from vipvflow.simulation.reduce import _check_totals
+
+    ok = {"passes": 10, "pv_kwh_allsky": 5.0, "fleet_demand_mwh": 1.0, "coverage": 0.1,
+          "irradiation_kwh_m2": {"total_unshaded": 3.0}}
+    _check_totals(ok, tmp_path)
+    with pytest.raises(InputError, match="pv_kwh_allsky is 0.0: no PV energy over 10 passes"):
+        _check_totals({**ok, "pv_kwh_allsky": 0.0}, tmp_path)
+    with pytest.raises(InputError, match="pv_kwh_allsky is nan"):
+        _check_totals({**ok, "pv_kwh_allsky": float("nan")}, tmp_path)
+    with pytest.raises(InputError, match=r"undefined figures in the summary: coverage, "
+                                         r"irradiation_kwh_m2.total_unshaded"):
+        _check_totals({**ok, "coverage": float("inf"),
+                       "irradiation_kwh_m2": {"total_unshaded": float("nan")}}, tmp_path)
