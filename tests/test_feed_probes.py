@@ -429,3 +429,29 @@ def test_totals_zero_or_undefined_stop(tmp_path):
                                          r"irradiation_kwh_m2.total_unshaded"):
         _check_totals({**ok, "coverage": float("inf"),
                        "irradiation_kwh_m2": {"total_unshaded": float("nan")}}, tmp_path)
+
+
+def test_short_radiation_gap_interpolated_and_counted(ingested, demo_small, tmp_path):
+    """30 minutes missing on 12 June at 10:00 UTC (buses run): under the 60 min limit, so
+    the run goes on with the gap interpolated and counted (preflight and summary)."""
+    from vipvflow.config import load_config
+    from vipvflow.simulation.prepare import ensure_ingested, preflight
+    from vipvflow.simulation.reduce import _radiation_gaps
+
+    cams = tmp_path / "cams_gap.csv"
+    _cams_lines_without(demo_small / "cams_radiation_demo.csv", cams, lambda d: False)
+    text = cams.read_text()
+    a = text.index("2024-06-12T10:00:00.0/")
+    b = text.index("2024-06-12T10:30:00.0/")
+    cams.write_text(text[:a] + text[b:])
+    cfg = load_config(_variant(ingested, tmp_path, cams=cams))
+    said = []
+    ensure_ingested(cfg, say=said.append)
+    assert any("1 gaps" in s for s in said)
+    check = preflight(cfg, 2024, say=said.append)
+    assert check["radiation_gaps_interpolated"] == 1
+    assert check["radiation_gap_minutes_interpolated"] == 30
+    assert check["service_days"] == 30
+    assert _radiation_gaps(Path(cfg.data_dir), 2024, [6]) == {
+        "radiation_gaps_interpolated": 1, "radiation_gap_minutes_interpolated": 30}
+    assert _radiation_gaps(Path(cfg.data_dir), 2024, [7])["radiation_gaps_interpolated"] == 0
