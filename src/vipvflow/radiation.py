@@ -202,13 +202,14 @@ def read_cams_file(path, clear_sky_margin=CLEAR_SKY_MARGIN) -> tuple[pd.DataFram
         end = pd.DatetimeIndex(pd.to_datetime(period.str[1], format="ISO8601"))
     except (ValueError, TypeError) as exc:
         raise InputError(f"{path}: column 'Observation period': not ISO 8601 start/end ({exc})") from None
+    # checked on the file's own clock: true solar time shifts each day by the equation of time
+    step = _STEPS_S.get(info["time_step"])
+    coverage = _check_periods(path, info, start, end, step)
     if info["time_reference"] == "TST":
         start, end = tst_to_utc(start, info["longitude"]), tst_to_utc(end, info["longitude"])
     else:
         start = start.tz_localize("UTC") if start.tz is None else start.tz_convert("UTC")
         end = end.tz_localize("UTC") if end.tz is None else end.tz_convert("UTC")
-    step = _STEPS_S.get(info["time_step"])
-    coverage = _check_periods(path, info, start, end, step)
     has_all = all(c in info["columns"] for c in _ALLSKY)
     out = pd.DataFrame({"t_start": start, "t_end": end})
     out["t_centre"] = out["t_start"] + (out["t_end"] - out["t_start"]) / 2
@@ -289,7 +290,8 @@ def _check_periods(path: Path, info: dict, start, end, step) -> dict:
             raise InputError(f"{path}: line {_line_of(info, i)}: observation period lasts "
                              f"{length[i] / 60:g} min but the header declares '{name}' "
                              f"({step / 60:g} min); {len(bad)} rows disagree")
-    t0 = start.tz_convert(None).to_numpy().astype("datetime64[s]").astype(np.int64)
+    naive = start.tz_convert(None) if start.tz is not None else start
+    t0 = naive.to_numpy().astype("datetime64[s]").astype(np.int64)
     if len(t0) > 1:
         d = np.diff(t0)
         back = np.flatnonzero(d <= 0)
@@ -316,6 +318,7 @@ def _check_periods(path: Path, info: dict, start, end, step) -> dict:
             raise InputError(f"{path}: line {info['lines'][key]}: {key[:-13]} "
                              f"{info[key]!r} is not an ISO 8601 date") from None
         declared = declared.tz_localize("UTC") if declared.tz is None else declared.tz_convert("UTC")
+        value = value.tz_localize("UTC") if value.tz is None else value.tz_convert("UTC")
         out[which] = str(declared)
         if info["time_reference"] == "UT":
             if which == "declared_end":
