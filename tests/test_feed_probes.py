@@ -111,6 +111,21 @@ GTFS_PROBES = {
                             ["no usable trip", "no later than they leave"], None),
     "arrival_times_only": (lambda: _tables(stop_times_txt=_arrival_only(vbb_like_tables())), [],
                            None, ["16 stop_times give only an arrival", "trips 4"]),
+    "stop_at_latitude_999": (lambda: _tables(stops_txt=vbb_like_tables()["stops.txt"].replace(
+        "52.5168,13.3822", "999,13.3822")), [], None,
+        ["1 stops served by trips have missing or impossible coordinates (e.g. S2); their 4 "
+         "stop_times dropped", "trips 4"]),
+    "stop_without_coordinates": (lambda: _tables(stops_txt=vbb_like_tables()["stops.txt"].replace(
+        "52.5168,13.3822", ",")), [], None, ["1 stops served by trips have missing"]),
+    "shape_point_at_infinity": (lambda: _tables(shapes_txt=vbb_like_tables(shapes=True)["shapes.txt"]
+                                                + "SH1,inf,13.39,9\n"), [], None,
+                                ["1 shape points have missing or impossible coordinates",
+                                 "trips 4"]),
+    "unreadable_time": (lambda: _tables(stop_times_txt=vbb_like_tables()["stop_times.txt"].replace(
+        "08:02:00", "8h02")), [], None, ["1 stop_times have times that are not H:MM:SS", "trips 4"]),
+    "calendar_iso_dates": (lambda: _tables(calendar_txt=vbb_like_tables()["calendar.txt"].replace(
+        "20240101", "2024-01-01")), [],
+        ["calendar.txt line 2: start_date '2024-01-01' is not a date YYYYMMDD"], None),
     "trips_without_routes": (lambda: _tables(trips_txt="route_id,service_id,trip_id\n"
                                              "RX,WD,T1\n"), [], ["no trip left"], None),
 }

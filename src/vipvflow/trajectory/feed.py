@@ -168,6 +168,8 @@ def read_feed(feed_path, dist_units: str | None = None, timezone: str | None = N
             gfeed.calendar_dates is None or gfeed.calendar_dates.empty):
         raise InputError(f"{path}: neither calendar.txt nor calendar_dates.txt has service dates")
     problems: list[str] = []
+    _check_dates(gfeed, path)
+    _clean_coordinates(gfeed, path, problems)
 
     tz = None
     if gfeed.agency is not None and "agency_timezone" in gfeed.agency:
@@ -236,6 +238,13 @@ def read_feed(feed_path, dist_units: str | None = None, timezone: str | None = N
     st = gfeed.stop_times.copy()
     st["arr_s"] = time_to_seconds(st["arrival_time"])
     st["dep_s"] = time_to_seconds(st["departure_time"])
+    unreadable = ((st["arrival_time"].notna() & st["arr_s"].isna())
+                  | (st["departure_time"].notna() & st["dep_s"].isna()))
+    if unreadable.any():
+        first = st.loc[unreadable].iloc[0]
+        problems.append(f"{int(unreadable.sum())} stop_times have times that are not H:MM:SS "
+                        f"(e.g. trip {first['trip_id']}: {first['arrival_time']!r}); "
+                        "interpolated along the trip like untimed stops")
     # a stop with only one of the two times: use it for both
     st["arr_s"] = st["arr_s"].fillna(st["dep_s"])
     st["dep_s"] = st["dep_s"].fillna(st["arr_s"])
@@ -262,6 +271,58 @@ def read_feed(feed_path, dist_units: str | None = None, timezone: str | None = N
                 calendar_dates=gfeed.calendar_dates, dist_units=gfeed.dist_units,
                 shapes_built_from_stops=n_built, frequency_trips=n_freq, problems=problems,
                 gk_feed=gfeed)
+
+
+def _check_dates(gfeed, path: Path) -> None:
+    """calendar.txt and calendar_dates.txt dates must be GTFS dates (YYYYMMDD)."""
+    for table, cols in (("calendar", ("start_date", "end_date")), ("calendar_dates", ("date",))):
+        frame = getattr(gfeed, table)
+        if frame is None or frame.empty:
+            continue
+        for col in cols:
+            if col not in frame:
+                raise InputError(f"{path}: {table}.txt has no {col} column")
+            text = frame[col].astype("string").str.strip()
+            bad = ~text.str.fullmatch(r"\d{8}").fillna(False)
+            if not bad.any():
+                parsed = pd.to_datetime(text, format="%Y%m%d", errors="coerce")
+                bad = parsed.isna()
+            if bad.any():
+                i = int(np.flatnonzero(bad.to_numpy())[0])
+                raise InputError(f"{path}: {table}.txt line {i + 2}: {col} {frame[col].iloc[i]!r} "
+                                 "is not a date YYYYMMDD")
+
+
+def _clean_coordinates(gfeed, path: Path, problems: list[str]) -> None:
+    """Stops and shape points with missing or impossible WGS84 coordinates are removed
+    (counted); stop_times at such stops go with them."""
+    def valid(lat, lon):
+        lat = pd.to_numeric(lat, errors="coerce").astype(float)
+        lon = pd.to_numeric(lon, errors="coerce").astype(float)
+        return (np.isfinite(lat) & np.isfinite(lon) & (lat.abs() <= 90) & (lon.abs() <= 180)
+                & ~((lat == 0) & (lon == 0)))
+
+    stops = gfeed.stops
+    ok = valid(stops["stop_lat"], stops["stop_lon"])
+    if not ok.all():
+        # stations and nodes without coordinates that no trip stops at go unremarked
+        used = gfeed.stop_times["stop_id"].isin(stops.loc[~ok, "stop_id"])
+        if used.any():
+            bad = sorted(set(gfeed.stop_times.loc[used, "stop_id"].astype(str)))
+            problems.append(f"{len(bad)} stops served by trips have missing or impossible "
+                            f"coordinates (e.g. {bad[0]}); their {int(used.sum())} stop_times "
+                            "dropped")
+        if not ok.any():
+            raise InputError(f"{path}: stops.txt: no stop has valid stop_lat/stop_lon")
+        gfeed.stops = stops[ok].reset_index(drop=True)
+        gfeed.stop_times = gfeed.stop_times[~used]
+    shapes = gfeed.shapes
+    if shapes is not None and not shapes.empty:
+        ok = valid(shapes["shape_pt_lat"], shapes["shape_pt_lon"])
+        if not ok.all():
+            problems.append(f"{int((~ok).sum())} shape points have missing or impossible "
+                            "coordinates; dropped")
+            gfeed.shapes = shapes[ok].reset_index(drop=True)
 
 
 def _usable_shapes(shapes: pd.DataFrame) -> set:
