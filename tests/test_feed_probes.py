@@ -324,6 +324,8 @@ def test_year_and_config_refused_in_one_line(tmp_path):
                                     "out_dir": str(tmp_path / "o")}))
     for year in ("99999", "-5"):
         one_line_error(vipvflow("simulate", "--config", conf, "--year", year), f"--year {year}")
+        one_line_error(vipvflow("demo-data", "--out", tmp_path / "demo", "--year", year),
+                       f"--year {year}")
     conf.write_text(yaml.safe_dump({"city": {"tile_size_m": 0.001}}))
     one_line_error(vipvflow("simulate", "--config", conf, "--year", "2024"),
                    str(conf), "city.tile_size_m", "greater than or equal to 50")

@@ -21,7 +21,9 @@ def register(sub):
 
 def run(args):
     from ..demo import generate_demo
+    from ..simulation.prepare import check_year
 
+    check_year(args.year)
     res = generate_demo(args.out, year=args.year, seed=args.seed, size=args.size)
     c = res["counts"]
     for kind, path in res["paths"].items():
