@@ -106,6 +106,8 @@ def ensure_ingested(cfg: Config, say=print) -> dict:
         for line in findings(report):
             say("  " + line)
         _stamp(stamp, gtfs_fp)
+    else:
+        _earlier(data_dir / "gtfs" / "feed.json", "problems", say)
     # the checks' version: data ingested before gaps were listed is read again
     cams_fp = _fingerprint(cams_files, {"checks": 2})
     stamp = data_dir / "radiation" / ".inputs.json"
@@ -117,16 +119,23 @@ def ensure_ingested(cfg: Config, say=print) -> dict:
         for line in findings(report):
             say("  " + line)
         _stamp(stamp, cams_fp)
+    else:
+        _earlier(data_dir / "radiation" / "ingest_report.json", "gaps", say)
     return {str(p): sha256(p) for p in [*city_files, gtfs, *cams_files]}
 
 
-def _summary(report) -> str:
-    if hasattr(report, "summary"):
-        return report.summary()
-    if isinstance(report, dict):
-        keys = [k for k, v in report.items() if isinstance(v, (int, float, str))][:8]
-        return ", ".join(f"{k}={report[k]}" for k in keys)
-    return str(report)
+def _earlier(report_path: Path, what: str, say) -> None:
+    """One line naming the findings of an ingest done by an earlier run (nothing if none)."""
+    try:
+        report = json.loads(report_path.read_text())
+    except (OSError, ValueError):
+        return
+    if what == "problems":
+        n = len(report.get("problems", []))
+    else:
+        n = sum(len(loc.get("gaps", [])) for loc in report.get("locations", []))
+    if n:
+        say(f"{report_path}: {n} {what} found when it was ingested (listed there)")
 
 
 #: the years a run may ask for: GTFS dates are YYYYMMDD and CAMS starts in 2004
