@@ -312,7 +312,7 @@ def ingest_gtfs(feed_path, data_dir, traj_cfg, crs=None, dist_units: str | None 
                         "made non-decreasing")
     if not keys:
         raise InputError(f"{feed.path}: no usable trip in the feed ("
-                         + "; ".join(problems[-4:] or ["no trip with two stops on a shape"]) + ")")
+                         + "; ".join(problems or ["no trip with two stops on a shape"]) + ")")
     if n_spread:
         problems.append(f"{n_spread} trips give consecutive stops the same time; those stops "
                         "were re-timed along distance between the stops whose times change")
