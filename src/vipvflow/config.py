@@ -295,7 +295,7 @@ def _format_errors(exc: ValidationError, files: list[tuple[Path, dict]], prefix:
         if err["type"] == "extra_forbidden":
             msg = "unknown key"
         lines.append(f"{origin}: key '{key}': {msg}")
-    return "\n".join(lines)
+    return "; ".join(lines)             # one line, however many keys are wrong
 
 
 def _catalog_entry(catalog: dict, name: str, overrides: dict, model, path: Path, key: str):
