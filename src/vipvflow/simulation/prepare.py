@@ -24,6 +24,15 @@ def _cached(stamp: Path, fp: dict) -> bool:
         return False
 
 
+#: written beside the demo inputs: the year, seed and size they were generated for
+DEMO_MARKER = "demo_generated.json"
+
+
+def mark_demo(folder, year: int, seed: int, size: str) -> None:
+    """Record what the demo inputs in *folder* were generated for (see :func:`ensure_demo`)."""
+    _stamp(Path(folder) / DEMO_MARKER, {"year": year, "seed": seed, "size": size})
+
+
 def _read_marker(path: Path) -> dict | None:
     try:
         return json.loads(path.read_text())
@@ -37,15 +46,17 @@ def _stamp(stamp: Path, fp: dict) -> None:
 
 
 def ensure_demo(cfg: Config, year: int, say=print) -> None:
-    """Generate the demo inputs when the scenario is the demo and they are missing or are
-    for another year."""
+    """Generate the demo inputs when the scenario is the demo and they are missing or were
+    made with another seed or size. Inputs made for another year are kept (said in one
+    line): the run then stops before its cluster naming the calendar's range, instead of
+    rewriting the demo under a finished run of that other year."""
     if not cfg.demo.enabled:
         return
     from ..demo import generate_demo
 
     inputs = [*cfg.inputs.citygml, cfg.inputs.gtfs, *cfg.inputs.cams]
     folder = Path(cfg.inputs.gtfs).parent
-    marker = folder / "demo_generated.json"
+    marker = folder / DEMO_MARKER
     want = {"year": year, "seed": cfg.demo.seed, "size": cfg.demo.size}
     if all(Path(p).exists() for p in inputs):
         if _cached(marker, want):
