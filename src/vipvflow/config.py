@@ -18,7 +18,8 @@ from pathlib import Path
 from typing import Any, Literal
 
 import yaml
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+from pydantic import (BaseModel, ConfigDict, Field, ValidationError, field_validator,
+                      model_validator)
 
 from .errors import ConfigError
 
@@ -61,6 +62,8 @@ class Inputs(_Model):
     citygml: list[Path] = Field(default_factory=list)
     citygml_crs: str | None = None
     gtfs: Path | None = None
+    # IANA zone of the timetable for a feed without agency.txt (the feed's own wins)
+    gtfs_timezone: str | None = None
     cams: list[Path] = Field(default_factory=list)
 
 
@@ -78,8 +81,9 @@ class Albedo(_Model):
 
 
 class CityCfg(_Model):
-    tile_size_m: float = Field(500.0, gt=0)
-    buffer_m: float = Field(300.0, ge=0)
+    # bounds keep a run's tile and mesh count sane (a 1 mm tile would ask for GiBs of index)
+    tile_size_m: float = Field(500.0, ge=50, le=100_000)
+    buffer_m: float = Field(300.0, ge=0, le=5_000)
     albedo: Albedo = Field(default_factory=Albedo)
     planarity_tolerance_m: float = Field(0.10, gt=0)
     min_area_m2: float = Field(0.01, ge=0)
@@ -94,8 +98,8 @@ class CycleCfg(_Model):
 
 
 class TrajectoryCfg(_Model):
-    segment_length_m: float = Field(10.0, gt=0)
-    roof_height_m: float = Field(3.2, ge=0)
+    segment_length_m: float = Field(10.0, ge=0.5, le=1_000)
+    roof_height_m: float = Field(3.2, ge=0, le=10)
     default_elevation_m: float = 300.0
     timing: Literal["stop_times", "driving_cycle"] = "stop_times"
     cycle: CycleCfg = Field(default_factory=CycleCfg)
@@ -104,9 +108,9 @@ class TrajectoryCfg(_Model):
 class IrradianceCfg(_Model):
     diffuse_model: Literal["isotropic", "sky_view_factor"] = "isotropic"
     reflection: bool = True
-    reflection_rays: int = Field(64, ge=0)
-    svf_rays: int = Field(128, gt=0)
-    ray_length_m: float = Field(300.0, gt=0)
+    reflection_rays: int = Field(64, ge=0, le=65_536)
+    svf_rays: int = Field(128, gt=0, le=65_536)
+    ray_length_m: float = Field(300.0, gt=0, le=100_000)
     ray_offset_m: float = Field(0.05, ge=0)
     max_reflector_groups: int = Field(3, ge=0)
     reflector_points: int = Field(4, ge=1)
@@ -188,6 +192,17 @@ class RunCfg(_Model):
 
     months: list[int] = Field(default_factory=lambda: list(range(1, 13)), min_length=1)
     routes: list[str] | None = None
+    # GTFS route_type values to simulate (3 bus, 0 tram, 2 rail, 11 trolleybus, extended
+    # 100..1799 such as 700 bus service); null: every route of the feed
+    route_types: list[int] | None = Field(None, min_length=1)
+
+    @field_validator("route_types")
+    @classmethod
+    def _route_types(cls, v):
+        bad = [t for t in v or [] if not (0 <= t <= 12 or 100 <= t <= 1799)]
+        if bad:
+            raise ValueError(f"not GTFS route types (0..12 or extended 100..1799): {bad}")
+        return v
 
     @model_validator(mode="after")
     def _months(self):
@@ -196,6 +211,14 @@ class RunCfg(_Model):
             raise ValueError(f"months must be 1..12, got {bad}")
         self.__dict__["months"] = sorted(set(self.months))
         return self
+
+
+class RadiationCfg(_Model):
+    """How much missing radiation a run accepts."""
+
+    # a gap in the radiation data longer than this, while buses run, stops the run before the
+    # cluster starts; shorter gaps are interpolated and counted (min)
+    max_gap_minutes: float = Field(60.0, gt=0)
 
 
 class DbCfg(_Model):
@@ -216,6 +239,7 @@ class Config(_Model):
     economics: EconomicsCfg = Field(default_factory=EconomicsCfg)
     climate: ClimateCfg = Field(default_factory=ClimateCfg)
     run: RunCfg = Field(default_factory=RunCfg)
+    radiation: RadiationCfg = Field(default_factory=RadiationCfg)
     dask: DaskCfg = Field(default_factory=DaskCfg)
     db: DbCfg = Field(default_factory=DbCfg)
 
@@ -295,7 +319,7 @@ def _format_errors(exc: ValidationError, files: list[tuple[Path, dict]], prefix:
         if err["type"] == "extra_forbidden":
             msg = "unknown key"
         lines.append(f"{origin}: key '{key}': {msg}")
-    return "\n".join(lines)
+    return "; ".join(lines)             # one line, however many keys are wrong
 
 
 def _catalog_entry(catalog: dict, name: str, overrides: dict, model, path: Path, key: str):

@@ -119,12 +119,27 @@ def _scan_header(path: Path) -> dict:
     if line.count(";") + 1 != len(info["columns"]):
         raise InputError(f"{path}: line {no}: {line.count(';') + 1} fields but the header "
                          f"(line {cols_line}) names {len(info['columns'])} columns")
+    last = _last_line(path)
+    if not last.startswith("#") and last.count(";") + 1 != len(info["columns"]):
+        raise InputError(f"{path}: last line: {last.count(';') + 1} fields but the header "
+                         f"(line {cols_line}) names {len(info['columns'])} columns (file "
+                         "truncated?)")
     if not re.match(r"^\d{4}-\d\d-\d\dT[\d:.]+/\d{4}-\d\d-\d\dT[\d:.]+$", line.split(";")[0]):
         raise InputError(f"{path}: line {no}: observation period {line.split(';')[0]!r} is "
                          "not 'start/end' in ISO 8601")
+    info["first_data_line"] = no
     info["time_reference"] = "TST" if ref.startswith("True solar") else "UT"
     info["time_step"] = pvlib.iotools.sodapro.SUMMATION_PERIOD_TO_TIME_STEP[period]
     return info
+
+
+def _last_line(path: Path, tail: int = 1 << 16) -> str:
+    """The last non-empty line of a text file, read from its end only."""
+    with open(path, "rb") as fh:
+        fh.seek(0, os.SEEK_END)
+        fh.seek(max(0, fh.tell() - tail))
+        lines = fh.read().decode("utf-8", errors="replace").rstrip("\r\n").splitlines()
+    return lines[-1] if lines else ""
 
 
 def tst_to_utc(t_tst: pd.DatetimeIndex, longitude: float) -> pd.DatetimeIndex:
@@ -187,6 +202,9 @@ def read_cams_file(path, clear_sky_margin=CLEAR_SKY_MARGIN) -> tuple[pd.DataFram
         end = pd.DatetimeIndex(pd.to_datetime(period.str[1], format="ISO8601"))
     except (ValueError, TypeError) as exc:
         raise InputError(f"{path}: column 'Observation period': not ISO 8601 start/end ({exc})") from None
+    # checked on the file's own clock: true solar time shifts each day by the equation of time
+    step = _STEPS_S.get(info["time_step"])
+    coverage = _check_periods(path, info, start, end, step)
     if info["time_reference"] == "TST":
         start, end = tst_to_utc(start, info["longitude"]), tst_to_utc(end, info["longitude"])
     else:
@@ -208,7 +226,6 @@ def read_cams_file(path, clear_sky_margin=CLEAR_SKY_MARGIN) -> tuple[pd.DataFram
     if bad_values and len(data) > 0:
         raise InputError(f"{path}: column(s) {', '.join(bad_values)} hold no numbers")
 
-    step = _STEPS_S.get(info["time_step"])
     if step is not None and len(out) > 1:
         out = _insert_gap_rows(out, step)
     flag = np.zeros(len(out), np.uint8)
@@ -234,6 +251,7 @@ def read_cams_file(path, clear_sky_margin=CLEAR_SKY_MARGIN) -> tuple[pd.DataFram
         if col in core:
             above_extra |= out[col].to_numpy() > dni_extra + 1.0
     flag[above_extra] |= FLAG_DNI_EXTRA
+    _check_plausible(path, info, out, core, dni_extra, neg)
     if not has_all:
         flag |= FLAG_NO_ALLSKY
     out["flag"] = flag
@@ -245,8 +263,99 @@ def read_cams_file(path, clear_sky_margin=CLEAR_SKY_MARGIN) -> tuple[pd.DataFram
             "ghi_above_clear": int(np.asarray(above_clear).sum()),
             "dni_above_extra": int(above_extra.sum()),
             "start": str(out["t_start"].iloc[0]) if len(out) else None,
-            "end": str(out["t_end"].iloc[-1]) if len(out) else None}
+            "end": str(out["t_end"].iloc[-1]) if len(out) else None, **coverage}
     return out, meta
+
+
+def _line_of(info: dict, row: int) -> int:
+    """File line of data row *row* (0-based; blank lines inside the data not counted)."""
+    return int(info["first_data_line"]) + int(row)
+
+
+def _check_periods(path: Path, info: dict, start, end, step) -> dict:
+    """Rows against the header: each row's period length, the spacing of rows, their order,
+    and the first/last row against the declared ``Date begin``/``Date end``.
+
+    A period or spacing that contradicts the declared summarization period, or rows out of
+    order, raise :class:`InputError` (values would be divided by the wrong duration); rows
+    ending before the declared end are reported (``rows_end_before_declared_s``)."""
+    if len(start) == 0:
+        return {}
+    name = info["Summarization (integration) period"]
+    if step is not None:
+        length = (end - start).total_seconds().to_numpy()
+        bad = np.flatnonzero(np.abs(length - step) > 1.0)
+        if len(bad):
+            i = int(bad[0])
+            raise InputError(f"{path}: line {_line_of(info, i)}: observation period lasts "
+                             f"{length[i] / 60:g} min but the header declares '{name}' "
+                             f"({step / 60:g} min); {len(bad)} rows disagree")
+    naive = start.tz_convert(None) if start.tz is not None else start
+    t0 = naive.to_numpy().astype("datetime64[s]").astype(np.int64)
+    if len(t0) > 1:
+        d = np.diff(t0)
+        back = np.flatnonzero(d <= 0)
+        if len(back):
+            i = int(back[0]) + 1
+            raise InputError(f"{path}: line {_line_of(info, i)}: observation period starts "
+                             f"{'before' if d[i - 1] < 0 else 'at'} the previous row's start "
+                             "(rows must be in time order without repeats)")
+        if step is not None:
+            off = np.flatnonzero(d % step != 0)
+            if len(off):
+                i = int(off[0]) + 1
+                raise InputError(f"{path}: line {_line_of(info, i)}: row starts "
+                                 f"{d[i - 1] / 60:g} min after the previous one, not a "
+                                 f"multiple of the declared {step / 60:g} min period")
+    out = {}
+    for key, which, value in (("Date begin (ISO 8601)", "declared_begin", start[0]),
+                              ("Date end (ISO 8601)", "declared_end", end[-1])):
+        if key not in info:
+            continue
+        try:
+            declared = pd.Timestamp(info[key])
+        except ValueError:
+            raise InputError(f"{path}: line {info['lines'][key]}: {key[:-13]} "
+                             f"{info[key]!r} is not an ISO 8601 date") from None
+        declared = declared.tz_localize("UTC") if declared.tz is None else declared.tz_convert("UTC")
+        value = value.tz_localize("UTC") if value.tz is None else value.tz_convert("UTC")
+        out[which] = str(declared)
+        if info["time_reference"] == "UT":
+            if which == "declared_end":
+                out["rows_end_before_declared_s"] = max(0.0, (declared - value).total_seconds())
+            else:
+                out["rows_begin_after_declared_s"] = max(0.0, (value - declared).total_seconds())
+    return out
+
+
+#: share of daylight rows above the physical limit or negative beyond which a file is
+#: refused rather than repaired (isolated bad values are flagged and interpolated)
+MAX_BAD_SHARE = 0.01
+
+
+def _check_plausible(path: Path, info: dict, out: pd.DataFrame, core, dni_extra, neg) -> None:
+    """Refuse values that cannot be mean irradiances over the declared period: above the
+    extraterrestrial normal irradiance (e.g. 15-minute sums under a 1-minute header) or
+    negative, in more than :data:`MAX_BAD_SHARE` of the daylight rows."""
+    limit = 1.1 * dni_extra + 1.0
+    cols = [c for c in ("ghi", "ghi_clear", "dni", "dni_clear", "toa") if c in core or c == "toa"]
+    vals = out[cols].to_numpy()
+    above = (vals > limit[:, None]).any(axis=1)
+    light = (np.nan_to_num(vals) > 0).any(axis=1)
+    allowed = max(10, MAX_BAD_SHARE * max(int(light.sum()), 1))
+    name = info["Summarization (integration) period"]
+    if above.sum() > allowed:
+        i = int(np.flatnonzero(above)[0])
+        worst = float(np.nanmax(vals[i]))
+        raise InputError(f"{path}: {int(above.sum())} rows exceed the extraterrestrial "
+                         f"irradiance (from {out['t_start'].iloc[i]:%Y-%m-%d %H:%M} UTC: "
+                         f"{worst:.0f} W/m2 > {limit[i]:.0f}): values do not fit the declared "
+                         f"period '{name}' (sums over a longer period?)")
+    if neg.sum() > allowed:
+        i = int(np.flatnonzero(neg)[0])
+        raise InputError(f"{path}: {int(neg.sum())} rows hold negative irradiance (first "
+                         f"{out['t_start'].iloc[i]:%Y-%m-%d %H:%M} UTC): not a CAMS "
+                         "radiation series")
 
 
 def _insert_gap_rows(frame: pd.DataFrame, step_s: int) -> pd.DataFrame:
@@ -299,13 +408,26 @@ def _to_minute_grid(frames: list[pd.DataFrame]) -> pd.DataFrame:
         if src in ("ghi",):
             good &= (flag_in & FLAG_GHI_CLEAR) == 0
         if not good.any():
-            out[col] = np.full(len(grid), np.nan, np.float32)
-            continue
+            raise InputError(f"radiation column {src}: no usable value (all missing, negative "
+                             "or above the physical limit)")
         out[col] = np.interp(grid, tc[good], v[good]).astype(np.float32)
     if not has_all:
         flag |= FLAG_NO_ALLSKY
     out["flag"] = flag
     return pd.DataFrame(out)
+
+
+def gap_runs(t_utc, flag) -> list[dict]:
+    """Runs of consecutive grid minutes without data (:data:`FLAG_GAP`), interpolated on the
+    grid: ``start_utc, end_utc`` (Unix s, minute edges) and ``minutes``."""
+    gap = (np.asarray(flag) & FLAG_GAP) > 0
+    if not gap.any():
+        return []
+    edges = np.diff(np.r_[0, gap.astype(np.int8), 0])
+    first, stop = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
+    t = np.asarray(t_utc, np.int64)
+    return [{"start_utc": int(t[a]) - _GRID_S // 2, "end_utc": int(t[b - 1]) + _GRID_S // 2,
+             "minutes": int(b - a)} for a, b in zip(first, stop)]
 
 
 def ingest_cams(paths, data_dir, clear_sky_margin=CLEAR_SKY_MARGIN) -> dict:
@@ -352,6 +474,7 @@ def ingest_cams(paths, data_dir, clear_sky_margin=CLEAR_SKY_MARGIN) -> dict:
                           "start_utc": int(grid["t_utc"].iloc[0]) - _GRID_S // 2,
                           "end_utc": int(grid["t_utc"].iloc[-1]) + _GRID_S // 2,
                           "flagged_minutes": int((grid["flag"] & ~np.uint8(FLAG_NO_ALLSKY) > 0).sum()),
+                          "gaps": gap_runs(grid["t_utc"].to_numpy(), grid["flag"].to_numpy()),
                           "all_sky_from_clear_sky": bool((grid["flag"] & FLAG_NO_ALLSKY).any())})
     table = pd.concat(parts, ignore_index=True)
     out_dir = Path(data_dir) / "radiation"

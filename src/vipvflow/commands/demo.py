@@ -26,8 +26,11 @@ def register(sub):
 def run(args):
     set_quiet(args.quiet)
     from ..demo import generate_demo
+    from ..simulation.prepare import check_year, mark_demo
 
+    check_year(args.year)
     res = generate_demo(args.out, year=args.year, seed=args.seed, size=args.size)
+    mark_demo(args.out, args.year, args.seed, args.size)
     c = res["counts"]
     for kind, path in res["paths"].items():
         size = path.stat().st_size

@@ -33,7 +33,32 @@ def run(args):
         print(f"{f['file']}: {f['rows']} rows, step {f['time_step']}, {f['time_reference']}; "
               f"gaps {f['gaps']}, negative {f['negative']}, GHI>1.1 TOA {f['ghi_above_toa']}, "
               f"GHI>clear {f['ghi_above_clear']}, DNI>extraterrestrial {f['dni_above_extra']}")
-    for loc in report["locations"]:
-        print(f"location {loc['lat']:.4f}, {loc['lon']:.4f}: {loc['minutes']} minutes, "
-              f"{loc['flagged_minutes']} flagged")
+    for line in findings(report):
+        print(line)
     return 0
+
+
+def findings(report: dict) -> list[str]:
+    """Per location: span, flagged minutes and gaps, and rows missing against the header
+    (also shown by ``simulate``)."""
+    import pandas as pd
+
+    def day(t):
+        return pd.Timestamp(t, unit="s", tz="UTC").strftime("%Y-%m-%d %H:%M")
+
+    lines = []
+    for f in report["files"]:
+        short = f.get("rows_end_before_declared_s", 0)
+        if short:
+            lines.append(f"{f['file']}: rows end {f['end']}, {short / 86400:.1f} days before the "
+                         f"declared end {f['declared_end']} (file truncated?)")
+    for loc in report["locations"]:
+        gaps = loc.get("gaps", [])
+        lines.append(f"location {loc['lat']:.4f}, {loc['lon']:.4f}: {day(loc['start_utc'])} to "
+                     f"{day(loc['end_utc'])} UTC, {loc['minutes']} minutes, "
+                     f"{loc['flagged_minutes']} flagged and interpolated, {len(gaps)} gaps")
+        longest = sorted(gaps, key=lambda g: -g["minutes"])[:3]
+        for g in longest:
+            lines.append(f"  gap {day(g['start_utc'])} to {day(g['end_utc'])} UTC "
+                         f"({g['minutes']} min)")
+    return lines

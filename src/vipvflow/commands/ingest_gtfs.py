@@ -17,6 +17,9 @@ def register(sub):
     p.add_argument("--config", default=None, help="scenario YAML (trajectory settings)")
     p.add_argument("--dist-units", default=None, choices=["m", "km", "mi", "ft"],
                    help="units of shape_dist_traveled (default: inferred and checked)")
+    p.add_argument("--timezone", default=None,
+                   help="IANA time zone of the timetable when the feed has no agency.txt "
+                        "(default: inputs.gtfs_timezone of --config)")
     p.set_defaults(func=run)
 
 
@@ -26,7 +29,9 @@ def run(args) -> int:
 
     cfg = load_config(args.config)
     report = ingest_gtfs(Path(args.feed), Path(args.data_dir), cfg.trajectory, crs=args.crs,
-                         dist_units=args.dist_units)
+                         dist_units=args.dist_units,
+                         timezone=args.timezone or cfg.inputs.gtfs_timezone,
+                         route_types=cfg.run.route_types)
     c = report["counts"]
     print(f"GTFS {args.feed} -> {Path(args.data_dir) / 'gtfs'}  ({report['seconds']} s)")
     print(f"  CRS {report['crs']} ({report['crs_source']}), timezone {report['timezone']}, "
@@ -34,10 +39,13 @@ def run(args) -> int:
     print(f"  shapes {c['shapes']}  segments {c['segments']}  tiles {c['tiles']}  "
           f"trips {c['trips']}  patterns {c['patterns']}  routes {c['routes']}  "
           f"({report['total_shape_length_km']} km of shapes)")
-    if report["problems"]:
-        print(f"  problems ({len(report['problems'])}):")
-        for line in report["problems"]:
-            print(f"    - {line}")
-    else:
-        print("  problems: none")
+    for line in findings(report):
+        print("  " + line)
     return 0
+
+
+def findings(report: dict) -> list[str]:
+    """The ingest's problems as printed lines (also shown by ``simulate``)."""
+    if not report["problems"]:
+        return ["problems: none"]
+    return [f"problems ({len(report['problems'])}):"] + [f"  - {p}" for p in report["problems"]]

@@ -24,24 +24,51 @@ def _cached(stamp: Path, fp: dict) -> bool:
         return False
 
 
+#: written beside the demo inputs: the year, seed and size they were generated for
+DEMO_MARKER = "demo_generated.json"
+
+
+def mark_demo(folder, year: int, seed: int, size: str) -> None:
+    """Record what the demo inputs in *folder* were generated for (see :func:`ensure_demo`)."""
+    _stamp(Path(folder) / DEMO_MARKER, {"year": year, "seed": seed, "size": size})
+
+
+def _read_marker(path: Path) -> dict | None:
+    try:
+        return json.loads(path.read_text())
+    except (OSError, ValueError):
+        return None
+
+
 def _stamp(stamp: Path, fp: dict) -> None:
     stamp.parent.mkdir(parents=True, exist_ok=True)
     stamp.write_text(json.dumps(fp, indent=1))
 
 
 def ensure_demo(cfg: Config, year: int, say=print) -> None:
-    """Generate the demo inputs when the scenario is the demo and they are missing or are
-    for another year."""
+    """Generate the demo inputs when the scenario is the demo and they are missing or were
+    made with another seed or size. Inputs made for another year are kept (said in one
+    line): the run then stops before its cluster naming the calendar's range, instead of
+    rewriting the demo under a finished run of that other year."""
     if not cfg.demo.enabled:
         return
     from ..demo import generate_demo
 
     inputs = [*cfg.inputs.citygml, cfg.inputs.gtfs, *cfg.inputs.cams]
     folder = Path(cfg.inputs.gtfs).parent
-    marker = folder / "demo_generated.json"
+    marker = folder / DEMO_MARKER
     want = {"year": year, "seed": cfg.demo.seed, "size": cfg.demo.size}
-    if all(Path(p).exists() for p in inputs) and _cached(marker, want):
-        return
+    if all(Path(p).exists() for p in inputs):
+        if _cached(marker, want):
+            return
+        made = _read_marker(marker)
+        if made and made.get("year") != year and {k: made.get(k) for k in ("seed", "size")} == {
+                "seed": cfg.demo.seed, "size": cfg.demo.size}:
+            # the demo of another year is kept: a run for a year its timetable does not
+            # serve stops with the calendar's range (make a new one with `demo-data --year`)
+            say(f"the demo inputs in {folder} are for {made['year']} (new ones: vipvflow "
+                f"demo-data --out {folder} --year {year})")
+            return
     say(f"generating the demo scenario ({cfg.demo.size}, seed {cfg.demo.seed}) for {year} in {folder}")
     generate_demo(folder, year=year, seed=cfg.demo.seed, size=cfg.demo.size)
     _stamp(marker, want)
@@ -73,27 +100,207 @@ def ensure_ingested(cfg: Config, say=print) -> dict:
         report = ingest_city(city_files, data_dir, cfg.city, crs=cfg.inputs.citygml_crs)
         say("  " + report.summary())
         _stamp(stamp, city_fp)
-    gtfs_fp = _fingerprint([gtfs], {"trajectory": cfg.trajectory.model_dump(mode="json"), "city": city_fp})
+    gtfs_fp = _fingerprint([gtfs], {"trajectory": cfg.trajectory.model_dump(mode="json"), "city": city_fp,
+                                    "timezone": cfg.inputs.gtfs_timezone,
+                                    "route_types": cfg.run.route_types})
     stamp = data_dir / "gtfs" / ".inputs.json"
     if not _cached(stamp, gtfs_fp):
+        from ..commands.ingest_gtfs import findings
+
         say(f"ingesting GTFS feed {gtfs}")
-        report = ingest_gtfs(gtfs, data_dir, cfg.trajectory, crs=cfg.inputs.citygml_crs)
-        say("  " + _summary(report))
+        report = ingest_gtfs(gtfs, data_dir, cfg.trajectory, crs=cfg.inputs.citygml_crs,
+                             timezone=cfg.inputs.gtfs_timezone, route_types=cfg.run.route_types)
+        c = report["counts"]
+        say(f"  shapes {c['shapes']} ({c['shapes_built_from_stops']} built from stops), segments "
+            f"{c['segments']}, tiles {c['tiles']}, trips {c['trips']}, patterns {c['patterns']}, "
+            f"routes {c['routes']}; timezone {report['timezone']}, CRS {report['crs']}")
+        for line in findings(report):
+            say("  " + line)
         _stamp(stamp, gtfs_fp)
-    cams_fp = _fingerprint(cams_files, {})
+    else:
+        _earlier(data_dir / "gtfs" / "feed.json", "problems", say)
+    # the checks' version: data ingested before gaps were listed is read again
+    cams_fp = _fingerprint(cams_files, {"checks": 2})
     stamp = data_dir / "radiation" / ".inputs.json"
     if not _cached(stamp, cams_fp):
         say(f"ingesting {len(cams_files)} CAMS file(s)")
+        from ..commands.ingest_cams import findings
+
         report = ingest_cams(cams_files, data_dir)
-        say("  " + _summary(report))
+        for line in findings(report):
+            say("  " + line)
         _stamp(stamp, cams_fp)
+    else:
+        _earlier(data_dir / "radiation" / "ingest_report.json", "gaps", say)
     return {str(p): sha256(p) for p in [*city_files, gtfs, *cams_files]}
 
 
-def _summary(report) -> str:
-    if hasattr(report, "summary"):
-        return report.summary()
-    if isinstance(report, dict):
-        keys = [k for k, v in report.items() if isinstance(v, (int, float, str))][:8]
-        return ", ".join(f"{k}={report[k]}" for k in keys)
-    return str(report)
+def _earlier(report_path: Path, what: str, say) -> None:
+    """One line naming the findings of an ingest done by an earlier run (nothing if none)."""
+    try:
+        report = json.loads(report_path.read_text())
+    except (OSError, ValueError):
+        return
+    if what == "problems":
+        n = len(report.get("problems", []))
+    else:
+        n = sum(len(loc.get("gaps", [])) for loc in report.get("locations", []))
+    if n:
+        say(f"{report_path}: {n} {what} found when it was ingested (listed there)")
+
+
+#: the years a run may ask for: GTFS dates are YYYYMMDD and CAMS starts in 2004
+YEAR_RANGE = (1900, 2100)
+
+
+def check_year(year) -> int:
+    """The run's year, or :class:`InputError` when it is not a plausible calendar year."""
+    lo, hi = YEAR_RANGE
+    if isinstance(year, bool) or not isinstance(year, int) or not lo <= year <= hi:
+        raise InputError(f"--year {year}: not a year a timetable and radiation data can cover "
+                         f"({lo}..{hi})")
+    return year
+
+
+def _day(t: float) -> str:
+    import pandas as pd
+
+    return pd.Timestamp(t, unit="s", tz="UTC").strftime("%Y-%m-%d %H:%M")
+
+
+def _date_list(dates) -> str:
+    """'2024-06-16 .. 2024-12-31 (199 days)' or the dates themselves when few."""
+    import pandas as pd
+
+    d = pd.DatetimeIndex(sorted(set(dates)))
+    if len(d) <= 3:
+        return ", ".join(x.strftime("%Y-%m-%d") for x in d)
+    return f"{d[0]:%Y-%m-%d} .. {d[-1]:%Y-%m-%d} ({len(d)} service days)"
+
+
+def preflight(cfg: Config, year: int, say=print) -> dict:
+    """Checks made on the ingested inputs before a cluster starts; each failure is one line.
+
+    - ``run.routes`` name routes of the feed;
+    - the GTFS calendar has service in the run's months of *year* (else its range is named);
+    - the city model covers at least part of the routes (same tiles);
+    - the radiation data cover every service day's trips (first departure to last arrival,
+      UTC) without a gap longer than ``radiation.max_gap_minutes``; shorter gaps within
+      those hours are counted (they were interpolated at ingest).
+
+    Returns
+    -------
+    dict
+        ``service_days``, ``radiation_gaps_interpolated``, ``radiation_gap_minutes_interpolated``.
+    """
+    import numpy as np
+    import pandas as pd
+
+    from ..trajectory.schedule import service_dates, service_day_origin_utc
+
+    check_year(year)
+    data_dir = Path(cfg.data_dir)
+    gdir = data_dir / "gtfs"
+    feed = json.loads((gdir / "feed.json").read_text())
+    trips = pd.read_parquet(gdir / "trips.parquet",
+                            columns=["trip_id", "route_id", "shape_id", "service_id", "pattern_id",
+                                     "start_s"])
+    routes = cfg.run.routes
+    if routes is not None:
+        unknown = sorted(set(routes) - set(trips["route_id"].astype(str)))
+        if unknown:
+            known = sorted(trips["route_id"].astype(str).unique())
+            raise InputError(f"{cfg._source}: run.routes: route_id(s) not in the feed: "
+                             f"{', '.join(unknown)} (the feed has {', '.join(known[:10])}"
+                             f"{' ...' if len(known) > 10 else ''})")
+        trips = trips[trips["route_id"].astype(str).isin(routes)]
+
+    # --- calendar
+    sd = service_dates(data_dir, year)
+    months = set(cfg.run.months)
+    sd = sd[sd["date"].dt.month.isin(months) & sd["service_id"].isin(set(trips["service_id"]))]
+    if sd.empty:
+        lo, hi = _calendar_range(gdir)
+        which = "" if len(months) == 12 else f" (months {sorted(months)})"
+        raise InputError(f"{gdir / 'calendar.parquet'}: the GTFS calendar has no service in "
+                         f"{year}{which}; it runs from {lo} to {hi}")
+
+    # --- city
+    tiles_json = data_dir / "city" / "tiles.json"
+    if tiles_json.exists():
+        city = json.loads(tiles_json.read_text())
+        seg = pd.read_parquet(gdir / "segments.parquet", columns=["tile", "shape_id"])
+        seg = seg[seg["shape_id"].isin(set(trips["shape_id"]))]
+        inside = seg["tile"].isin(set(city.get("tiles", {})))
+        if len(seg) and not inside.any():
+            raise InputError(f"{tiles_json}: the city model ({len(city.get('tiles', {}))} tiles "
+                             f"in {city.get('crs')}) covers none of the routes' {len(seg)} "
+                             f"segments (tiles {', '.join(sorted(seg['tile'].unique())[:3])} ...); "
+                             "is the city the one the feed serves, in the same CRS?")
+        if len(seg) and not inside.all():
+            say(f"  {100 * (1 - inside.mean()):.0f} % of the route segments lie outside the city "
+                "model's tiles (nothing shades them there)")
+
+    # --- radiation over every service day's hours on the road
+    pat = pd.read_parquet(gdir / "patterns.parquet", columns=["pattern_id", "t_offset_s", "dt_s"])
+    dur = (pat["t_offset_s"] + pat["dt_s"]).groupby(pat["pattern_id"]).max()
+    tr = trips.assign(end_s=trips["start_s"] + trips["pattern_id"].map(dur).fillna(0.0))
+    span = tr.groupby("service_id").agg(lo=("start_s", "min"), hi=("end_s", "max"))
+    days = sd.join(span, on="service_id").groupby("date").agg(lo=("lo", "min"), hi=("hi", "max"))
+    origin = service_day_origin_utc(days.index.to_numpy(), feed["timezone"])
+    lo, hi = origin + days["lo"].to_numpy(), origin + days["hi"].to_numpy()
+    report_path = data_dir / "radiation" / "ingest_report.json"
+    try:
+        rad = json.loads(report_path.read_text())
+    except (OSError, ValueError):
+        raise InputError(f"{report_path}: missing or unreadable; run 'vipvflow ingest cams'") from None
+    limit_min = cfg.radiation.max_gap_minutes
+    n_short = short_min = 0
+    for loc in rad["locations"]:
+        # lookups interpolate between minute centres: the data hold from the first centre to
+        # the last
+        first, last = loc["start_utc"] + 30, loc["end_utc"] - 30
+        missing = (lo < first) | (hi > last)
+        if missing.any():
+            raise InputError(
+                f"{report_path.parent / 'radiation.parquet'}: radiation at "
+                f"{loc['lat']:.4f}, {loc['lon']:.4f} covers {_day(loc['start_utc'])} to "
+                f"{_day(loc['end_utc'])} UTC; the buses run on "
+                f"{_date_list(days.index[missing])} without it (CAMS file truncated or for "
+                "another year?)")
+        for g in loc.get("gaps", []):
+            hit = (lo < g["end_utc"]) & (hi > g["start_utc"])
+            if not hit.any():
+                continue
+            if g["minutes"] > limit_min:
+                raise InputError(
+                    f"{report_path.parent / 'radiation.parquet'}: radiation at "
+                    f"{loc['lat']:.4f}, {loc['lon']:.4f} has a gap of {g['minutes']} min from "
+                    f"{_day(g['start_utc'])} to {_day(g['end_utc'])} UTC while buses run "
+                    f"(limit radiation.max_gap_minutes = {limit_min:g})")
+            n_short += 1
+            short_min += g["minutes"]
+    if n_short:
+        say(f"  radiation: {n_short} gaps ({short_min} min) within the buses' hours were "
+            "interpolated")
+    return {"service_days": int(len(days)), "radiation_gaps_interpolated": n_short,
+            "radiation_gap_minutes_interpolated": int(short_min)}
+
+
+def _calendar_range(gdir: Path) -> tuple[str, str]:
+    """First and last date of the feed's calendar.txt and calendar_dates.txt (ISO)."""
+    import pandas as pd
+
+    dates = []
+    cal = pd.read_parquet(gdir / "calendar.parquet")
+    if len(cal):
+        dates += [cal["start_date"].astype(str).min(), cal["end_date"].astype(str).max()]
+    cd = pd.read_parquet(gdir / "calendar_dates.parquet")
+    if len(cd):
+        added = cd[cd["exception_type"].astype(int) == 1]["date"].astype(str)
+        if len(added):
+            dates += [added.min(), added.max()]
+    if not dates:
+        return "(no dates)", "(no dates)"
+    iso = [f"{d[:4]}-{d[4:6]}-{d[6:8]}" for d in (min(dates), max(dates))]
+    return iso[0], iso[1]

@@ -120,6 +120,48 @@ def trip_consumption(cfg: Config, data_dir: Path, year: int, pattern_ids, vecto_
     return pd.DataFrame(rows)
 
 
+def _radiation_gaps(data_dir: Path, year: int, months) -> dict:
+    """Gaps in the radiation data within the run's months (interpolated at ingest)."""
+    import json
+
+    try:
+        rad = json.loads((data_dir / "radiation" / "ingest_report.json").read_text())
+    except (OSError, ValueError):
+        return {}
+    spans = [(pd.Timestamp(year, m, 1, tz="UTC").timestamp(),
+              (pd.Timestamp(year, m, 1, tz="UTC") + pd.offsets.MonthBegin(1)).timestamp())
+             for m in months]
+    hit = [g for loc in rad.get("locations", []) for g in loc.get("gaps", [])
+           if any(g["start_utc"] < b and g["end_utc"] > a for a, b in spans)]
+    return {"radiation_gaps_interpolated": len(hit),
+            "radiation_gap_minutes_interpolated": int(sum(g["minutes"] for g in hit))}
+
+
+def _check_totals(summary: dict, run_dir: Path) -> None:
+    """A run whose energy or irradiation totals are zero or undefined stops with a reason,
+    and summary.json is strict JSON: any other undefined figure is named, not written as NaN."""
+    import json
+
+    def bad(v):
+        return isinstance(v, float) and not np.isfinite(v)
+
+    irr = summary.get("irradiation_kwh_m2", {})
+    for key, why in (("pv_kwh_allsky", "no PV energy"),
+                     ("fleet_demand_mwh", "no consumption")):
+        v = summary.get(key)
+        if v is None or bad(v) or v <= 0:
+            raise InputError(f"{run_dir}: the run's {key} is {v}: {why} over {summary['passes']} "
+                             f"passes (unshaded irradiation {irr.get('total_unshaded')} kWh/m2); "
+                             "check the radiation values and the trips' stop times")
+    flat = {**{k: v for k, v in summary.items() if not isinstance(v, dict)},
+            **{f"irradiation_kwh_m2.{k}": v for k, v in irr.items()}}
+    undefined = sorted(k for k, v in flat.items() if bad(v))
+    if undefined:
+        raise InputError(f"{run_dir}: undefined figures in the summary: {', '.join(undefined)} "
+                         "(a total they divide by is zero)")
+    json.dumps(summary, allow_nan=False, default=str)
+
+
 def reduce_run(cfg: Config, year: int, run_dir: Path, say=print) -> dict:
     """Write trip_energy, segments, segment_month, route_month, block_day, monthly, hourly
     outputs, ``summary.json`` and ``report.html``; return the summary."""
@@ -251,6 +293,8 @@ def reduce_run(cfg: Config, year: int, run_dir: Path, say=print) -> dict:
         **eco,
         **annual.per_bus_figures(tot, n_buses, annualise, hours_per_bus, data_dir, year),
     }
+    summary.update(_radiation_gaps(data_dir, year, cfg.run.months))
+    _check_totals(summary, run_dir)
     write_json(summary, run_dir / "summary.json")
     write_report(run_dir, summary, monthly, smg, hp, rm, cfg=cfg, segments=segments)
     return summary

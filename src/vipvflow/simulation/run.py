@@ -130,13 +130,15 @@ def run_simulation(cfg: Config, year: int, scheduler: str | None = None,
     An interrupted run resumes: finished partitions (written atomically) are not recomputed.
     *max_partitions* stops after that many new partitions (for tests of resuming).
     """
-    from .prepare import ensure_demo, ensure_ingested
+    from .prepare import check_year, ensure_demo, ensure_ingested, preflight
     from .reduce import reduce_run
 
     t_start = time.perf_counter()
     timings: dict[str, float] = {}
+    check_year(year)
     ensure_demo(cfg, year, say=say)
     checksums = ensure_ingested(cfg, say=say)
+    preflight(cfg, year, say=say)
     timings["prepare_s"] = time.perf_counter() - t_start
 
     data_dir = Path(cfg.data_dir)

@@ -62,7 +62,72 @@ class Feed:
     gk_feed: object = None        # the gtfs-kit Feed after expansion, for cross-checks
 
 
-def read_feed(feed_path, dist_units: str | None = None) -> Feed:
+#: longest line accepted in a GTFS table (bytes); real feeds stay far below 10 kB a line
+MAX_LINE_BYTES = 1 << 20
+
+#: GTFS route types: the basic ones and the extended (Google "Extended GTFS Route Types")
+#: range 100..1799
+BASIC_ROUTE_TYPES = {0: "tram", 1: "subway", 2: "rail", 3: "bus", 4: "ferry", 5: "cable tram",
+                     6: "aerial lift", 7: "funicular", 11: "trolleybus", 12: "monorail"}
+
+
+def check_tables(path: Path, max_line: int = MAX_LINE_BYTES) -> None:
+    """Stream every ``.txt`` table of a GTFS zip or folder once, before pandas reads it.
+
+    A corrupt or truncated zip, a member that does not inflate, or a line longer than
+    *max_line* bytes (a table that is not CSV, which pandas would try to hold whole) raises
+    :class:`InputError` naming the file, member and line; memory stays at one chunk.
+    """
+    import zipfile
+    import zlib
+
+    chunk = min(1 << 20, max_line)
+
+    def scan(fh, name: str) -> None:
+        since_nl, lines = 0, 0          # bytes since the last newline, newlines seen
+        while block := fh.read(chunk):
+            last = block.rfind(b"\n")
+            if last < 0:
+                since_nl += len(block)
+            else:
+                # lines inside a chunk are shorter than the chunk (<= the limit); only the
+                # line running across chunk boundaries can grow past it
+                since_nl += block.find(b"\n")
+                if since_nl <= max_line:
+                    lines += block.count(b"\n")
+                    since_nl = len(block) - last - 1
+            if since_nl > max_line:
+                raise InputError(f"{path}: {name} line {lines + 1} is longer than "
+                                 f"{max_line // 1024} kB: not a GTFS table")
+
+    if path.is_dir():
+        for member in sorted(path.glob("*.txt")):
+            with open(member, "rb") as fh:
+                scan(fh, member.name)
+        return
+    try:
+        with zipfile.ZipFile(path) as zf:
+            for info in zf.infolist():
+                if info.is_dir() or not info.filename.endswith(".txt"):
+                    continue
+                with zf.open(info) as fh:
+                    scan(fh, info.filename)
+    except (zipfile.BadZipFile, zlib.error, EOFError, OSError, NotImplementedError) as exc:
+        raise InputError(f"{path}: not a readable GTFS zip ({type(exc).__name__}: {exc})") from None
+
+
+def _check_timezone(name: str, where: str) -> str:
+    from zoneinfo import ZoneInfo, ZoneInfoNotFoundError
+
+    try:
+        ZoneInfo(str(name))
+    except (ZoneInfoNotFoundError, ValueError):
+        raise InputError(f"{where}: {name!r} is not an IANA time zone (e.g. Europe/Berlin)") from None
+    return str(name)
+
+
+def read_feed(feed_path, dist_units: str | None = None, timezone: str | None = None,
+              route_types=None) -> Feed:
     """Read a GTFS zip or folder with gtfs-kit and prepare it.
 
     Parameters
@@ -72,6 +137,12 @@ def read_feed(feed_path, dist_units: str | None = None) -> Feed:
     dist_units : str, optional
         Units of ``shape_dist_traveled`` (``m``, ``km``, ``mi``, ``ft``); inferred by
         gtfs-kit when omitted (the trajectory stage checks them against the geometry).
+    timezone : str, optional
+        IANA zone of the timetable when the feed has no agency.txt (or no timezone in
+        it); the feed's own ``agency_timezone`` wins when present.
+    route_types : iterable of int, optional
+        GTFS ``route_type`` values to keep (basic 0..12 or extended 100..1799); all when
+        omitted. Trips of other types are dropped and counted.
 
     Raises
     ------
@@ -83,6 +154,7 @@ def read_feed(feed_path, dist_units: str | None = None) -> Feed:
     path = Path(feed_path)
     if not path.exists():
         raise InputError(f"{path}: GTFS feed not found")
+    check_tables(path)
     try:
         gfeed = gk.read_feed(path, dist_units=dist_units) if dist_units else _read_infer(gk, path)
     except InputError:
@@ -96,6 +168,8 @@ def read_feed(feed_path, dist_units: str | None = None) -> Feed:
             gfeed.calendar_dates is None or gfeed.calendar_dates.empty):
         raise InputError(f"{path}: neither calendar.txt nor calendar_dates.txt has service dates")
     problems: list[str] = []
+    _check_dates(gfeed, path)
+    _clean_coordinates(gfeed, path, problems)
 
     tz = None
     if gfeed.agency is not None and "agency_timezone" in gfeed.agency:
@@ -103,27 +177,55 @@ def read_feed(feed_path, dist_units: str | None = None) -> Feed:
         if len(zones) > 1:
             problems.append(f"agency.txt has several timezones {list(zones)}; using {zones[0]}")
         tz = str(zones[0]) if len(zones) else None
-    if tz is None:
-        raise InputError(f"{path}: agency.txt has no agency_timezone")
+    if tz is not None:
+        tz = _check_timezone(tz, f"{path}: agency.txt agency_timezone")
+    elif timezone:
+        tz = _check_timezone(timezone, "--timezone")
+        what = "agency.txt is missing" if gfeed.agency is None else "agency.txt has no agency_timezone"
+        problems.append(f"{what}; timezone {tz} as given")
+    elif gfeed.agency is None:
+        raise InputError(f"{path}: agency.txt is missing, so the timetable's time zone is unknown; "
+                         "pass --timezone (or inputs.gtfs_timezone), e.g. Europe/Berlin")
+    else:
+        raise InputError(f"{path}: agency.txt has no agency_timezone; pass --timezone "
+                         "(or inputs.gtfs_timezone), e.g. Europe/Berlin")
 
+    gfeed = _select_routes(gfeed, path, route_types, problems)
+    _fill_single_times(gfeed, path, problems)
     n_freq = 0
     if gfeed.frequencies is not None and not gfeed.frequencies.empty:
         n_before = len(gfeed.trips)
+        fr = gfeed.frequencies
+        exact = (pd.to_numeric(fr["exact_times"], errors="coerce").fillna(0).astype(int)
+                 if "exact_times" in fr else pd.Series(0, index=fr.index))
         gfeed = gk.expand_frequencies(gfeed)
         n_freq = len(gfeed.trips) - n_before
+        if (exact == 0).any():
+            problems.append(f"{int((exact == 0).sum())} frequencies.txt rows are headway-based "
+                            "(exact_times 0): departures placed at start_time + n x headway")
     trips = gfeed.trips
     if "shape_id" not in trips:
         trips = trips.assign(shape_id=pd.Series(pd.NA, index=trips.index, dtype="string"))
         gfeed.trips = trips
+    named = trips["shape_id"].notna()
     if gfeed.shapes is not None and not gfeed.shapes.empty:
-        known = set(gfeed.shapes["shape_id"])
-        unknown = trips["shape_id"].notna() & ~trips["shape_id"].isin(known)
+        good = _usable_shapes(gfeed.shapes)
+        unknown = named & ~trips["shape_id"].isin(good)
+        n_single = int((named & trips["shape_id"].isin(set(gfeed.shapes["shape_id"]) - good)).sum())
         if unknown.any():
             problems.append(f"{int(unknown.sum())} trips reference a shape_id missing from "
-                            "shapes.txt; shapes built from their stops")
+                            f"shapes.txt or with fewer than two distinct points ({n_single}); "
+                            "shapes built from their stops")
             gfeed.trips.loc[unknown, "shape_id"] = pd.NA
+            gfeed.shapes = gfeed.shapes[gfeed.shapes["shape_id"].isin(good)]
+            if gfeed.shapes.empty:
+                gfeed.shapes = None
     else:
         gfeed.shapes = None
+        if named.any():
+            problems.append(f"{int(named.sum())} trips name a shape_id but the feed has no "
+                            "shapes.txt; shapes built from their stops")
+            gfeed.trips.loc[named, "shape_id"] = pd.NA
     n_missing = int(gfeed.trips["shape_id"].isna().sum())
     n_built = 0
     if n_missing:
@@ -136,6 +238,13 @@ def read_feed(feed_path, dist_units: str | None = None) -> Feed:
     st = gfeed.stop_times.copy()
     st["arr_s"] = time_to_seconds(st["arrival_time"])
     st["dep_s"] = time_to_seconds(st["departure_time"])
+    unreadable = ((st["arrival_time"].notna() & st["arr_s"].isna())
+                  | (st["departure_time"].notna() & st["dep_s"].isna()))
+    if unreadable.any():
+        first = st.loc[unreadable].iloc[0]
+        problems.append(f"{int(unreadable.sum())} stop_times have times that are not H:MM:SS "
+                        f"(e.g. trip {first['trip_id']}: {first['arrival_time']!r}); "
+                        "interpolated along the trip like untimed stops")
     # a stop with only one of the two times: use it for both
     st["arr_s"] = st["arr_s"].fillna(st["dep_s"])
     st["dep_s"] = st["dep_s"].fillna(st["arr_s"])
@@ -162,6 +271,120 @@ def read_feed(feed_path, dist_units: str | None = None) -> Feed:
                 calendar_dates=gfeed.calendar_dates, dist_units=gfeed.dist_units,
                 shapes_built_from_stops=n_built, frequency_trips=n_freq, problems=problems,
                 gk_feed=gfeed)
+
+
+def _check_dates(gfeed, path: Path) -> None:
+    """calendar.txt and calendar_dates.txt dates must be GTFS dates (YYYYMMDD)."""
+    for table, cols in (("calendar", ("start_date", "end_date")), ("calendar_dates", ("date",))):
+        frame = getattr(gfeed, table)
+        if frame is None or frame.empty:
+            continue
+        for col in cols:
+            if col not in frame:
+                raise InputError(f"{path}: {table}.txt has no {col} column")
+            text = frame[col].astype("string").str.strip()
+            bad = ~text.str.fullmatch(r"\d{8}").fillna(False)
+            if not bad.any():
+                parsed = pd.to_datetime(text, format="%Y%m%d", errors="coerce")
+                bad = parsed.isna()
+            if bad.any():
+                i = int(np.flatnonzero(bad.to_numpy())[0])
+                raise InputError(f"{path}: {table}.txt line {i + 2}: {col} {frame[col].iloc[i]!r} "
+                                 "is not a date YYYYMMDD")
+
+
+def _clean_coordinates(gfeed, path: Path, problems: list[str]) -> None:
+    """Stops and shape points with missing or impossible WGS84 coordinates are removed
+    (counted); stop_times at such stops go with them."""
+    def valid(lat, lon):
+        lat = pd.to_numeric(lat, errors="coerce").astype(float)
+        lon = pd.to_numeric(lon, errors="coerce").astype(float)
+        return (np.isfinite(lat) & np.isfinite(lon) & (lat.abs() <= 90) & (lon.abs() <= 180)
+                & ~((lat == 0) & (lon == 0)))
+
+    stops = gfeed.stops
+    ok = valid(stops["stop_lat"], stops["stop_lon"])
+    if not ok.all():
+        # stations and nodes without coordinates that no trip stops at go unremarked
+        used = gfeed.stop_times["stop_id"].isin(stops.loc[~ok, "stop_id"])
+        if used.any():
+            bad = sorted(set(gfeed.stop_times.loc[used, "stop_id"].astype(str)))
+            problems.append(f"{len(bad)} stops served by trips have missing or impossible "
+                            f"coordinates (e.g. {bad[0]}); their {int(used.sum())} stop_times "
+                            "dropped")
+        if not ok.any():
+            raise InputError(f"{path}: stops.txt: no stop has valid stop_lat/stop_lon")
+        gfeed.stops = stops[ok].reset_index(drop=True)
+        gfeed.stop_times = gfeed.stop_times[~used]
+    shapes = gfeed.shapes
+    if shapes is not None and not shapes.empty:
+        ok = valid(shapes["shape_pt_lat"], shapes["shape_pt_lon"])
+        if not ok.all():
+            problems.append(f"{int((~ok).sum())} shape points have missing or impossible "
+                            "coordinates; dropped")
+            gfeed.shapes = shapes[ok].reset_index(drop=True)
+
+
+def _usable_shapes(shapes: pd.DataFrame) -> set:
+    """shape_ids with at least two distinct points."""
+    pts = shapes.dropna(subset=["shape_pt_lat", "shape_pt_lon"]).drop_duplicates(
+        ["shape_id", "shape_pt_lat", "shape_pt_lon"])
+    n = pts.groupby("shape_id").size()
+    return set(n.index[n >= 2])
+
+
+def _select_routes(gfeed, path: Path, route_types, problems: list[str]):
+    """Drop trips of unknown routes and, when *route_types* is given, of other route types."""
+    routes, trips = gfeed.routes, gfeed.trips
+    if routes is None or routes.empty:
+        raise InputError(f"{path}: routes.txt missing or empty")
+    unknown = ~trips["route_id"].isin(routes["route_id"])
+    if unknown.any():
+        names = sorted(trips.loc[unknown, "route_id"].astype(str).unique())
+        problems.append(f"{int(unknown.sum())} trips name a route_id missing from routes.txt "
+                        f"({', '.join(names[:5])}{' ...' if len(names) > 5 else ''}); dropped")
+        trips = trips[~unknown]
+    if route_types is not None:
+        wanted = {int(t) for t in route_types}
+        rtype = pd.to_numeric(routes["route_type"], errors="coerce")
+        keep_routes = set(routes.loc[rtype.isin(wanted), "route_id"])
+        other = ~trips["route_id"].isin(keep_routes)
+        if other.all():
+            present = sorted(int(t) for t in rtype.dropna().unique())
+            raise InputError(f"{path}: no trip has a route_type in run.route_types "
+                             f"{sorted(wanted)}; the feed has {present}")
+        if other.any():
+            problems.append(f"{int(other.sum())} trips of route types outside run.route_types "
+                            f"{sorted(wanted)}; dropped")
+            trips = trips[~other]
+    if trips.empty:
+        raise InputError(f"{path}: no trip left: every trip names a route_id missing from "
+                         "routes.txt")
+    gfeed.trips = trips.reset_index(drop=True)
+    gfeed.stop_times = gfeed.stop_times[gfeed.stop_times["trip_id"].isin(gfeed.trips["trip_id"])]
+    if gfeed.frequencies is not None and not gfeed.frequencies.empty:
+        gfeed.frequencies = gfeed.frequencies[
+            gfeed.frequencies["trip_id"].isin(gfeed.trips["trip_id"])]
+    return gfeed
+
+
+def _fill_single_times(gfeed, path: Path, problems: list[str]) -> None:
+    """stop_times with only an arrival or only a departure time (a column or a value
+    missing): the one given is used for both."""
+    st = gfeed.stop_times.copy()
+    for col in ("arrival_time", "departure_time"):
+        if col not in st:
+            st[col] = pd.Series(pd.NA, index=st.index, dtype="string")
+    if st["arrival_time"].isna().all() and st["departure_time"].isna().all():
+        raise InputError(f"{path}: stop_times.txt has no arrival_time or "
+                         "departure_time values")
+    one = st["arrival_time"].isna() ^ st["departure_time"].isna()
+    if one.any():
+        problems.append(f"{int(one.sum())} stop_times give only an arrival or only a departure "
+                        "time; used for both")
+        st["arrival_time"] = st["arrival_time"].fillna(st["departure_time"])
+        st["departure_time"] = st["departure_time"].fillna(st["arrival_time"])
+    gfeed.stop_times = st
 
 
 def _read_infer(gk, path: Path):

@@ -164,7 +164,17 @@ def spread_repeated_times(d, arr, dep):
     return arr, dep, len(inner)
 
 
-def ingest_gtfs(feed_path, data_dir, traj_cfg, crs=None, dist_units: str | None = None) -> dict:
+def _route_type_counts(routes: pd.DataFrame, trips: pd.DataFrame) -> dict:
+    """Trips kept per GTFS route_type (as a string key: JSON)."""
+    if "route_type" not in routes:
+        return {}
+    rt = routes[["route_id", "route_type"]].astype({"route_id": str})
+    n = trips[["route_id"]].merge(rt, on="route_id", how="left")["route_type"]
+    return {str(k): int(v) for k, v in n.value_counts(dropna=False).sort_index().items()}
+
+
+def ingest_gtfs(feed_path, data_dir, traj_cfg, crs=None, dist_units: str | None = None,
+                timezone: str | None = None, route_types=None) -> dict:
     """Read a GTFS feed and write the trajectory stage files under ``data_dir/gtfs/``.
 
     Parameters
@@ -181,6 +191,10 @@ def ingest_gtfs(feed_path, data_dir, traj_cfg, crs=None, dist_units: str | None 
         local UTM zone.
     dist_units : str, optional
         Units of ``shape_dist_traveled`` when known (checked against the geometry anyway).
+    timezone : str, optional
+        IANA zone of the timetable for a feed without agency.txt (see :func:`read_feed`).
+    route_types : list of int, optional
+        GTFS route types to keep (``run.route_types``); all when omitted.
 
     Returns
     -------
@@ -192,7 +206,7 @@ def ingest_gtfs(feed_path, data_dir, traj_cfg, crs=None, dist_units: str | None 
     t_start = time.perf_counter()
     data_dir = Path(data_dir)
     out = data_dir / "gtfs"
-    feed = read_feed(feed_path, dist_units=dist_units)
+    feed = read_feed(feed_path, dist_units=dist_units, timezone=timezone, route_types=route_types)
     problems = list(feed.problems)
     crs_obj, tile_size, crs_source = _choose_crs(feed, data_dir, crs)
     if not crs_obj.is_projected:
@@ -203,7 +217,7 @@ def ingest_gtfs(feed_path, data_dir, traj_cfg, crs=None, dist_units: str | None 
     trips = feed.trips.copy()
     used = set(trips["shape_id"].astype(str))
     shape_xy = project_shapes(feed.shapes[feed.shapes["shape_id"].astype(str).isin(used)], to_xy)
-    degenerate = [s for s, p in shape_xy.items() if len(p) < 2]
+    degenerate = [s for s, p in shape_xy.items() if len(p) < 2 or not np.isfinite(p).all()]
     if degenerate:
         problems.append(f"{len(degenerate)} shapes have fewer than two distinct points; their "
                         "trips are dropped")
@@ -234,6 +248,7 @@ def ingest_gtfs(feed_path, data_dir, traj_cfg, crs=None, dist_units: str | None 
     arr_all, dep_all = st["arr_s"].to_numpy(float), st["dep_s"].to_numpy(float)
     projected: dict = {}
     n_projected = n_feed = n_nonmono = n_short = n_untimed = n_spread = 0
+    n_backwards = n_still = 0
     keys, rows = {}, []
     trip_pattern, trip_start = {}, {}
     pattern_stops, pattern_shape = [], []
@@ -262,11 +277,15 @@ def ingest_gtfs(feed_path, data_dir, traj_cfg, crs=None, dist_units: str | None 
         start = dep[0]
         arr, dep = arr - start, dep - start
         arr[0] = 0.0                      # the trip begins at its first departure
+        if d[-1] > d[0] and arr[-1] <= 0:
+            # it ends no later than it starts: no timing can be made of it
+            n_still += 1
+            continue
         if np.any(np.diff(np.column_stack([arr, dep]).ravel()) < 0):
-            # times going backwards: keep the trip, make times non-decreasing, report
+            # times going backwards inside the trip: keep it, make times non-decreasing
             seq = np.maximum.accumulate(np.column_stack([arr, dep]).ravel())
             arr, dep = seq[0::2], seq[1::2]
-            problems.append(f"trip {trip}: stop times decrease along the trip; made monotone")
+            n_backwards += 1
         arr2, dep2, _ = spread_repeated_times(d, arr, dep)
         if not (np.array_equal(arr2, arr) and np.array_equal(dep2, dep)):
             n_spread += 1
@@ -285,6 +304,15 @@ def ingest_gtfs(feed_path, data_dir, traj_cfg, crs=None, dist_units: str | None 
         problems.append(f"{n_short} trips have fewer than two stop times; dropped")
     if n_untimed:
         problems.append(f"{n_untimed} trips have too few timed stops; dropped")
+    if n_still:
+        problems.append(f"{n_still} trips arrive at their last stop no later than they leave "
+                        "the first (stop times backwards or all equal); dropped")
+    if n_backwards:
+        problems.append(f"{n_backwards} trips have stop times that decrease along the trip; "
+                        "made non-decreasing")
+    if not keys:
+        raise InputError(f"{feed.path}: no usable trip in the feed ("
+                         + "; ".join(problems or ["no trip with two stops on a shape"]) + ")")
     if n_spread:
         problems.append(f"{n_spread} trips give consecutive stops the same time; those stops "
                         "were re-timed along distance between the stops whose times change")
@@ -389,6 +417,7 @@ def ingest_gtfs(feed_path, data_dir, traj_cfg, crs=None, dist_units: str | None 
             "stops": int(st["stop_id"].nunique()),
             "frequency_trips": int(feed.frequency_trips),
             "shapes_built_from_stops": int(feed.shapes_built_from_stops),
+            "route_types": _route_type_counts(feed.routes, trips_out),
             "trips_with_feed_distances": n_feed,
             "trips_with_projected_stops": n_projected,
         },
