@@ -79,23 +79,7 @@ AUTO_ROUTE_ABOVE = 20_000
 _REF = re.compile(r"\[@gml:id='(?P<id>[^']+)'\].*\[gen:name='(?P<attr>[^']+)'\]")
 _BATCH_ROWS = 65_536
 
-# qualified tags, computed once
-T = {name: q(name) for name in (
-    "core:CityModel", "core:cityObjectMember", "core:genericAttribute", "core:dynamizer",
-    "core:lod0MultiCurve", "core:relatedTo", "core:CityObjectRelation", "core:relationType",
-    "gml:name", "gml:boundedBy", "gml:Envelope", "gml:lowerCorner", "gml:upperCorner",
-    "gml:MultiCurve", "gml:curveMember", "gml:LineString", "gml:posList",
-    "gen:DoubleAttribute", "gen:IntAttribute", "gen:StringAttribute", "gen:name", "gen:value",
-    "gen:GenericLogicalSpace", "gen:GenericThematicSurface",
-    "tran:Road", "tran:trafficSpace", "tran:TrafficSpace", "tran:granularity",
-    "dyn:Dynamizer", "dyn:attributeRef", "dyn:startTime", "dyn:endTime", "dyn:dynamicData",
-    "dyn:GenericTimeseries", "dyn:TabulatedFileTimeseries", "dyn:firstTimestamp",
-    "dyn:lastTimestamp", "dyn:observationProperty", "dyn:uom", "dyn:valueType",
-    "dyn:timeValuePair", "dyn:TimeValuePair", "dyn:timestamp", "dyn:doubleValue",
-    "dyn:fileLocation", "dyn:fileType", "dyn:mimeType", "dyn:numberOfHeaderLines",
-    "dyn:fieldSeparator", "dyn:decimalSymbol", "dyn:idColumnName", "dyn:idValue",
-    "dyn:timeColumnName", "dyn:valueColumnName")}
-_SE = etree.SubElement
+T = {name: q(name) for name in ("core:CityModel", "core:cityObjectMember", "tran:Road", "gml:name")}
 
 
 def _num(v: float) -> str:
@@ -320,11 +304,11 @@ class _Geometries:
             except StopIteration:
                 break
             ids = b.column("segment_id").to_numpy()
+            for k in [k for k in self._buf if k < segment_id]:      # not selected: drop
+                del self._buf[k]
             self._buf.update(zip(ids.tolist(), _wkb_coords(b.column("geometry").to_pylist())))
             if len(ids):
                 self._last = max(self._last, int(ids.max()))
-        for k in [k for k in self._buf if k < segment_id]:
-            del self._buf[k]
         coords = self._buf.pop(segment_id, None)
         if coords is None:
             raise InputError(f"segments.parquet: segment {segment_id} of segment_month.parquet "
@@ -333,60 +317,63 @@ class _Geometries:
 
 
 def _segment_records(run: RunData, sel: Selection) -> Iterator[SegmentRecord]:
-    """Each selected segment with its monthly values, in segment id order, streamed."""
+    """Each selected segment with its monthly values, in segment id order, streamed in record
+    batches (a segment's rows may straddle two batches: the last id of a batch waits for the
+    next one)."""
+    import pyarrow as pa
+    import pyarrow.compute as pc
+
     cols = ["segment_id", "shape_id", "route_short_name", "direction_id", "month", *SEGMENT_SERIES]
-    pf = pq.ParquetFile(run.segment_month_path)
     geoms = _Geometries(run.segments_path)
-    months = set(sel.months)
-    carry = None
-    last_id = -1
-    n = 0
-
-    def frames():
-        for b in pf.iter_batches(_BATCH_ROWS, columns=cols):
-            yield b.to_pandas()
-
-    source = frames()
-    if not _sorted_by_segment(run.segment_month_path):
+    months = pa.array(sel.months)
+    routes = pa.array(sel.routes) if sel.routes is not None else None
+    if _sorted_by_segment(run.segment_month_path):
+        source = (pa.Table.from_batches([b]) for b in
+                  pq.ParquetFile(run.segment_month_path).iter_batches(_BATCH_ROWS, columns=cols))
+    else:
         log.info("%s is not in segment order: read whole and sorted", run.segment_month_path)
-        whole = pd.read_parquet(run.segment_month_path, columns=cols)
-        source = iter([whole.sort_values(["segment_id", "month"], kind="stable")])
-    for df in itertools.chain(source, [None]):
-        if df is None:
+        source = iter([pq.read_table(run.segment_month_path, columns=cols)
+                       .sort_by([("segment_id", "ascending"), ("month", "ascending")])])
+    carry, last_id, n = None, -1, 0
+    for table in itertools.chain(source, [None]):
+        if table is None:
             if carry is None:
                 break
-            df, carry = carry, None
-            done = df
+            done, carry = carry, None
         else:
             if carry is not None:
-                df = pd.concat([carry, df], ignore_index=True)
-            ids = df["segment_id"].to_numpy()
-            tail = ids == ids[-1] if len(ids) else np.zeros(0, bool)
-            carry, done = df[tail], df[~tail]
-        if done.empty:
+                table = pa.concat_tables([carry, table])
+            ids = table.column("segment_id").to_numpy()
+            if not len(ids):
+                continue
+            tail = int(np.searchsorted(ids, ids[-1]))       # ids ascending: the last id's rows
+            carry, done = table.slice(tail), table.slice(0, tail)
+        keep = pc.is_in(done.column("month"), value_set=months)
+        if routes is not None:
+            keep = pc.and_(keep, pc.is_in(pc.cast(done.column("route_short_name"), pa.string()),
+                                          value_set=routes))
+        done = done.filter(keep)
+        if not done.num_rows:
             continue
-        done = done[done["month"].isin(months)]
-        if sel.routes is not None:
-            done = done[done["route_short_name"].astype(str).isin(sel.routes)]
-        if done.empty:
-            continue
-        done = done.sort_values(["segment_id", "month"], kind="stable")
-        ids = done["segment_id"].to_numpy(np.int64)
+        ids = done.column("segment_id").to_numpy()
+        month_col = done.column("month").to_numpy(zero_copy_only=False).astype(str)
+        order = np.lexsort((month_col, ids))
+        ids, month_col = ids[order], month_col[order]
+        values = np.column_stack([done.column(c).to_numpy(zero_copy_only=False) for c in SEGMENT_SERIES]
+                                 ).astype(np.float64)[order]
+        shape_col = done.column("shape_id").to_numpy(zero_copy_only=False)[order]
+        route_col = done.column("route_short_name").to_numpy(zero_copy_only=False)[order]
+        dir_col = done.column("direction_id").to_numpy(zero_copy_only=False)[order]
         starts = np.flatnonzero(np.r_[True, ids[1:] != ids[:-1]])
         ends = np.r_[starts[1:], len(ids)]
-        values = done[list(SEGMENT_SERIES)].to_numpy(np.float64)
-        month_col = done["month"].to_numpy()
-        shape_col = done["shape_id"].astype(str).to_numpy()
-        route_col = done["route_short_name"].astype(str).to_numpy()
-        dir_col = done["direction_id"].to_numpy()
-        for a, b in zip(starts, ends):
+        for a, b in zip(starts.tolist(), ends.tolist()):
             sid = int(ids[a])
             if sid <= last_id:
                 raise InputError(f"{run.segment_month_path}: segment {sid} appears twice")
             last_id = sid
             sel.note(sid)
-            yield SegmentRecord(sid, shape_col[a], route_col[a], int(dir_col[a]), geoms.take(sid),
-                                list(month_col[a:b]), values[a:b])
+            yield SegmentRecord(sid, str(shape_col[a]), str(route_col[a]), int(dir_col[a]), geoms.take(sid),
+                                month_col[a:b].tolist(), values[a:b])
             n += 1
             if sel.max_segments is not None and n >= sel.max_segments:
                 return
@@ -406,16 +393,30 @@ def _sorted_by_segment(path: Path) -> bool:
 
 
 # ----------------------------------------------------------------------------- XML pieces
-def _text(parent, tag: str, text: str):
-    el = _SE(parent, T[tag])
-    el.text = text
-    return el
+# City objects are written as text (one chunk per city object, indented, one element a line),
+# parsed by libxml2 into an element and handed to the xmlfile stream: much faster than
+# building each of the ~60 elements of a Dynamizer with SubElement, and the parse checks
+# that every chunk is well-formed.
+_DECL = {ns: " ".join(f'xmlns:{p}="{NSMAP[p]}"' for p in ns) for ns in (
+    ("core", "dyn", "gen", "tran", "gml"), ("core", "dyn", "gen", "tran", "gml", "xlink"))}
 
 
-def _generic(parent, kind: str, name: str, value: str) -> None:
-    attr = _SE(_SE(parent, T["core:genericAttribute"]), T[f"gen:{kind}"])
-    _SE(attr, T["gen:name"]).text = name
-    _SE(attr, T["gen:value"]).text = value
+def _esc(text) -> str:
+    return (str(text).replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;")
+            .replace('"', "&quot;"))
+
+
+def _chunk(text: str) -> etree._Element:
+    return etree.fromstring(text, _PARSER)
+
+
+_PARSER = etree.XMLParser(remove_blank_text=False, huge_tree=True)
+
+
+def _generic(out: list, ind: str, kind: str, name: str, value: str) -> None:
+    out.append(f"{ind}<core:genericAttribute>\n{ind}  <gen:{kind}>\n{ind}    <gen:name>{_esc(name)}</gen:name>\n"
+               f"{ind}    <gen:value>{_esc(value)}</gen:value>\n{ind}  </gen:{kind}>\n"
+               f"{ind}</core:genericAttribute>\n")
 
 
 class _Tabulated:
@@ -443,50 +444,46 @@ class _Tabulated:
             self.tmp.unlink(missing_ok=True)
 
 
-def _dynamizer(parent, s: Series, table: _Tabulated | None) -> None:
-    dyn = _SE(_SE(parent, T["core:dynamizer"]), T["dyn:Dynamizer"], {GML_ID: s.dynamizer_id})
-    _text(dyn, "gml:name", f"{s.attribute} of {s.object_id}")
-    _text(dyn, "dyn:attributeRef", attribute_ref(s.object_tag, s.object_id, s.attribute))
-    _text(dyn, "dyn:startTime", s.start)
-    _text(dyn, "dyn:endTime", s.end)
-    data = _SE(dyn, T["dyn:dynamicData"])
-    kind = "dyn:GenericTimeseries" if table is None else "dyn:TabulatedFileTimeseries"
-    ts = _SE(data, T[kind], {GML_ID: s.dynamizer_id + "_ts"})
-    _text(ts, "dyn:firstTimestamp", s.timestamps[0])
-    _text(ts, "dyn:lastTimestamp", s.timestamps[-1])
-    _text(ts, "dyn:observationProperty", s.observation)
-    _text(ts, "dyn:uom", s.uom)
+def _dynamizer(out: list, ind: str, s: Series, table: _Tabulated | None) -> None:
+    """``core:dynamizer`` / ``dyn:Dynamizer`` with its time series (schema order)."""
+    i2, i3, i4, i5 = ind + "  ", ind + "    ", ind + "      ", ind + "        "
+    kind = "GenericTimeseries" if table is None else "TabulatedFileTimeseries"
+    out.append(
+        f'{ind}<core:dynamizer>\n{i2}<dyn:Dynamizer gml:id="{s.dynamizer_id}">\n'
+        f"{i3}<gml:name>{_esc(s.attribute)} of {s.object_id}</gml:name>\n"
+        f"{i3}<dyn:attributeRef>{_esc(attribute_ref(s.object_tag, s.object_id, s.attribute))}</dyn:attributeRef>\n"
+        f"{i3}<dyn:startTime>{s.start}</dyn:startTime>\n{i3}<dyn:endTime>{s.end}</dyn:endTime>\n"
+        f'{i3}<dyn:dynamicData>\n{i4}<dyn:{kind} gml:id="{s.dynamizer_id}_ts">\n'
+        f"{i5}<dyn:firstTimestamp>{s.timestamps[0]}</dyn:firstTimestamp>\n"
+        f"{i5}<dyn:lastTimestamp>{s.timestamps[-1]}</dyn:lastTimestamp>\n"
+        f"{i5}<dyn:observationProperty>{_esc(s.observation)}</dyn:observationProperty>\n"
+        f"{i5}<dyn:uom>{_esc(s.uom)}</dyn:uom>\n")
     if table is None:
-        _text(ts, "dyn:valueType", "double")
-        tvp_tag, pair_tag = T["dyn:timeValuePair"], T["dyn:TimeValuePair"]
-        stamp_tag, value_tag = T["dyn:timestamp"], T["dyn:doubleValue"]
-        for t, v in zip(s.timestamps, s.values):
-            pair = _SE(_SE(ts, tvp_tag), pair_tag)
-            _SE(pair, stamp_tag).text = t
-            _SE(pair, value_tag).text = _num(v)
-        return
-    key = table.add(s)
-    _text(ts, "dyn:fileLocation", table.path.name)
-    _text(ts, "dyn:fileType", "csv")
-    _text(ts, "dyn:mimeType", "text/csv")
-    _text(ts, "dyn:valueType", "double")
-    _text(ts, "dyn:numberOfHeaderLines", "1")
-    _text(ts, "dyn:fieldSeparator", ",")
-    _text(ts, "dyn:decimalSymbol", ".")
-    _text(ts, "dyn:idColumnName", "series")
-    _text(ts, "dyn:idValue", key)
-    _text(ts, "dyn:timeColumnName", "timestamp")
-    _text(ts, "dyn:valueColumnName", "value")
+        out.append(f"{i5}<dyn:valueType>double</dyn:valueType>\n")
+        out.extend(f"{i5}<dyn:timeValuePair><dyn:TimeValuePair><dyn:timestamp>{t}</dyn:timestamp>"
+                   f"<dyn:doubleValue>{_num(v)}</dyn:doubleValue></dyn:TimeValuePair></dyn:timeValuePair>\n"
+                   for t, v in zip(s.timestamps, s.values))
+    else:
+        key = table.add(s)
+        out.append(
+            f"{i5}<dyn:fileLocation>{_esc(table.path.name)}</dyn:fileLocation>\n"
+            f"{i5}<dyn:fileType>csv</dyn:fileType>\n{i5}<dyn:mimeType>text/csv</dyn:mimeType>\n"
+            f"{i5}<dyn:valueType>double</dyn:valueType>\n"
+            f"{i5}<dyn:numberOfHeaderLines>1</dyn:numberOfHeaderLines>\n"
+            f"{i5}<dyn:fieldSeparator>,</dyn:fieldSeparator>\n{i5}<dyn:decimalSymbol>.</dyn:decimalSymbol>\n"
+            f"{i5}<dyn:idColumnName>series</dyn:idColumnName>\n{i5}<dyn:idValue>{_esc(key)}</dyn:idValue>\n"
+            f"{i5}<dyn:timeColumnName>timestamp</dyn:timeColumnName>\n"
+            f"{i5}<dyn:valueColumnName>value</dyn:valueColumnName>\n")
+    out.append(f"{i4}</dyn:{kind}>\n{i3}</dyn:dynamicData>\n{i2}</dyn:Dynamizer>\n{ind}</core:dynamizer>\n")
 
 
-def _multi_curve(parent, lines: list[np.ndarray], srs: str | None, gid: str) -> None:
-    attrib = {GML_ID: gid + "_mc"}
-    if srs:
-        attrib.update(srsName=srs, srsDimension="3")
-    mc = _SE(_SE(parent, T["core:lod0MultiCurve"]), T["gml:MultiCurve"], attrib)
+def _multi_curve(out: list, ind: str, lines: list[np.ndarray], srs: str | None, gid: str) -> None:
+    crs = f' srsName="{_esc(srs)}" srsDimension="3"' if srs else ""
+    out.append(f'{ind}<core:lod0MultiCurve>\n{ind}  <gml:MultiCurve gml:id="{gid}_mc"{crs}>\n')
     for k, coords in enumerate(lines):
-        ls = _SE(_SE(mc, T["gml:curveMember"]), T["gml:LineString"], {GML_ID: f"{gid}_ls{k}"})
-        _SE(ls, T["gml:posList"]).text = " ".join(map(_num, coords.ravel()))
+        out.append(f'{ind}    <gml:curveMember><gml:LineString gml:id="{gid}_ls{k}"><gml:posList>'
+                   f'{" ".join(map(_num, coords.ravel()))}</gml:posList></gml:LineString></gml:curveMember>\n')
+    out.append(f"{ind}  </gml:MultiCurve>\n{ind}</core:lod0MultiCurve>\n")
 
 
 def _space_series(oid: str, months: list[str], values: np.ndarray, series: dict, clock: _Months) -> list[Series]:
@@ -495,27 +492,45 @@ def _space_series(oid: str, months: list[str], values: np.ndarray, series: dict,
             for j, (a, (obs, uom)) in enumerate(series.items())]
 
 
-def _traffic_space(parent, oid: str, name: str, ints: dict, strings: dict, series: list[Series],
-                   lines: list[np.ndarray], srs: str | None, table, counts: dict) -> etree._Element:
-    ts = _SE(parent, T["tran:TrafficSpace"], {GML_ID: oid})
-    _text(ts, "gml:name", name)
+def _traffic_space(out: list, ind: str, oid: str, name: str, ints: dict, strings: dict,
+                   series: list[Series], lines: list[np.ndarray], srs: str | None, table, counts: dict) -> None:
+    """``tran:trafficSpace`` / ``tran:TrafficSpace`` (schema order: city object, space, own)."""
+    i2 = ind + "  "
+    out.append(f'{ind}<tran:trafficSpace>\n{i2}<tran:TrafficSpace gml:id="{oid}">\n'
+               f"{i2}  <gml:name>{_esc(name)}</gml:name>\n")
+    i3 = i2 + "  "
     for k, v in strings.items():
-        _generic(ts, "StringAttribute", k, v)
+        _generic(out, i3, "StringAttribute", k, v)
     for k, v in ints.items():
-        _generic(ts, "IntAttribute", k, str(int(v)))
+        _generic(out, i3, "IntAttribute", k, str(int(v)))
     for s in series:
-        _generic(ts, "DoubleAttribute", s.attribute, _num(s.values.sum()))
+        _generic(out, i3, "DoubleAttribute", s.attribute, _num(s.values.sum()))
     for s in series:
-        _dynamizer(ts, s, table)
+        _dynamizer(out, i3, s, table)
     counts["dynamizers"] += len(series)
-    _multi_curve(ts, lines, srs, oid)
-    _text(ts, "tran:granularity", "lane")
-    return ts
+    _multi_curve(out, i3, lines, srs, oid)
+    out.append(f"{i3}<tran:granularity>lane</tran:granularity>\n{i2}</tran:TrafficSpace>\n{ind}</tran:trafficSpace>")
+
+
+def _with_decl(text: str, decl: str) -> str:
+    """Declare the namespaces on the chunk's first element."""
+    i = _FIRST_TAG.match(text).end()
+    return text[:i] + " " + decl + text[i:]
+
+
+_FIRST_TAG = re.compile(r"\s*<[^\s>/]+")
 
 
 # ----------------------------------------------------------------------------- members
 #: a member writer: writes one core:cityObjectMember into an open xmlfile
 MemberWriter = Callable[[etree.xmlfile], None]
+_CHUNK = _DECL[("core", "dyn", "gen", "tran", "gml")]
+_CHUNK_X = _DECL[("core", "dyn", "gen", "tran", "gml", "xlink")]
+
+
+def _member(body: list[str]) -> etree._Element:
+    """A complete ``core:cityObjectMember`` chunk from the lines of its city object."""
+    return _chunk(f"<core:cityObjectMember {_CHUNK_X}>\n{''.join(body)}</core:cityObjectMember>")
 
 
 def _segment_members(run: RunData, sel: Selection, table, counts: dict) -> Iterator[MemberWriter]:
@@ -527,21 +542,20 @@ def _segment_members(run: RunData, sel: Selection, table, counts: dict) -> Itera
             first = next(group)
             with xf.element(T["core:cityObjectMember"], nsmap=_MEMBER_NSMAP):
                 with xf.element(T["tran:Road"], {GML_ID: f"{PREFIX}road_{xml_id(shape_id)}"}):
-                    head = etree.Element(T["gml:name"], nsmap=_GML_NSMAP)
-                    head.text = f"bus roof path of shape {shape_id} (route {first.route}, direction {first.direction})"
-                    xf.write("\n", head)
+                    xf.write("\n", _chunk(f"<gml:name {_CHUNK}>bus roof path of shape {_esc(shape_id)} "
+                                           f"(route {_esc(first.route)}, direction {first.direction})</gml:name>"))
                     for k, v in (("shape_id", shape_id), ("route", first.route)):
-                        holder = etree.Element("x", nsmap=_CHUNK_NSMAP)
-                        _generic(holder, "StringAttribute", k, v)
-                        xf.write("\n", holder[0])
+                        out: list[str] = []
+                        _generic(out, "", "StringAttribute", k, v)
+                        xf.write("\n", _chunk(_with_decl("".join(out).rstrip(), _CHUNK)))
                     for rec in itertools.chain([first], group):
-                        prop = etree.Element(T["tran:trafficSpace"], nsmap=_CHUNK_NSMAP)
+                        out = []
                         oid = f"{PREFIX}seg_{rec.segment_id}"
-                        _traffic_space(prop, oid, f"segment {rec.segment_id} of shape {shape_id}",
+                        _traffic_space(out, "", oid, f"segment {rec.segment_id} of shape {shape_id}",
                                        {"segment_id": rec.segment_id}, {},
                                        _space_series(oid, rec.months, rec.values, SEGMENT_SERIES, clock),
                                        [rec.coords], srs, table, counts)
-                        xf.write("\n", prop, pretty_print=True)
+                        xf.write("\n", _chunk(_with_decl("".join(out), _CHUNK)))
                         counts["segments"] += 1
                     xf.write("\n")
         yield write
@@ -587,9 +601,8 @@ def _route_members(run: RunData, sel: Selection, table, counts: dict) -> Iterato
     for route in sorted({k[0] for k in sums}):
         def write(xf, route=route):
             rid = f"{PREFIX}route_{xml_id(route)}"
-            road = etree.Element(T["tran:Road"], {GML_ID: rid})
-            _text(road, "gml:name", f"bus roof paths of route {route}")
-            _generic(road, "StringAttribute", "route", route)
+            out = [f'<tran:Road gml:id="{rid}">\n  <gml:name>bus roof paths of route {_esc(route)}</gml:name>\n']
+            _generic(out, "  ", "StringAttribute", "route", route)
             for (r, direction) in sorted(k for k in sums if k[0] == route):
                 acc = sums[(r, direction)]
                 months = sorted(acc)
@@ -597,17 +610,16 @@ def _route_members(run: RunData, sel: Selection, table, counts: dict) -> Iterato
                 oid = f"{rid}_dir{direction}"
                 shapes = pieces[(r, direction)]
                 lines = [line for s in sorted(shapes) for line in _join_lines(shapes[s])]
-                _traffic_space(_SE(road, T["tran:trafficSpace"]), oid,
-                               f"route {route} direction {direction}",
+                _traffic_space(out, "  ", oid, f"route {route} direction {direction}",
                                {"direction_id": direction, "segments": n_seg[(r, direction)]},
                                {"route": route, "shapes": " ".join(sorted(shapes))},
                                _space_series(oid, months, values, ROUTE_SERIES, clock), lines, srs, table,
                                counts)
+                out.append("\n")
                 counts["route_directions"] += 1
                 counts["segments"] += n_seg[(r, direction)]
-            member = etree.Element(T["core:cityObjectMember"], nsmap=_MEMBER_NSMAP)
-            member.append(road)
-            xf.write(member, pretty_print=True)
+            out.append("</tran:Road>\n")
+            xf.write(_member(out))
         yield write
 
 
@@ -626,16 +638,16 @@ def _network_member(run: RunData, sel: Selection, table, counts: dict) -> Member
               for a, (obs, uom) in NETWORK_SERIES.items() if a in hp]
 
     def write(xf):
-        member = etree.Element(T["core:cityObjectMember"], nsmap=_MEMBER_NSMAP)
-        net = _SE(member, T["gen:GenericLogicalSpace"], {GML_ID: oid})
-        _text(net, "gml:name", "bus network of the run (hourly pattern, all segments)")
+        out = [f'<gen:GenericLogicalSpace gml:id="{oid}">\n'
+               "  <gml:name>bus network of the run (hourly pattern, all segments)</gml:name>\n"]
         for s in series:
-            _generic(net, "DoubleAttribute", s.attribute, _num(np.nanmean(s.values)))
+            _generic(out, "  ", "DoubleAttribute", s.attribute, _num(np.nanmean(s.values)))
         for s in series:
-            _dynamizer(net, s, table)
+            _dynamizer(out, "  ", s, table)
+        out.append("</gen:GenericLogicalSpace>\n")
         counts["dynamizers"] += len(series)
         counts["network"] += 1
-        xf.write(member, pretty_print=True)
+        xf.write(_member(out))
     return write
 
 
@@ -647,36 +659,35 @@ def _surface_members(run: RunData, sel: Selection, table, counts: dict) -> Itera
         def write(xf, surface_id=surface_id, building_id=building_id, stype=stype, g=g):
             g = g.sort_values("month")
             oid = f"{PREFIX}refl_{xml_id(surface_id)}"
-            member = etree.Element(T["core:cityObjectMember"], nsmap=_MEMBER_NSMAP)
-            surf = _SE(member, T["gen:GenericThematicSurface"], {GML_ID: oid})
-            _text(surf, "gml:name", f"reflection onto the routes by {stype} surface {surface_id}")
+            out = [f'<gen:GenericThematicSurface gml:id="{oid}">\n'
+                   f"  <gml:name>reflection onto the routes by {_esc(stype)} surface {_esc(surface_id)}</gml:name>\n"]
             if isinstance(building_id, str):
-                rel = _SE(_SE(surf, T["core:relatedTo"]), T["core:CityObjectRelation"],
-                          {GML_ID: oid + "_rel"})
-                _text(rel, "core:relationType", "reflectsLightOntoRoutesFrom")
-                _SE(rel, T["core:relatedTo"], {q("xlink:href"): f"#{building_id}"})
+                out.append(f'  <core:relatedTo>\n    <core:CityObjectRelation gml:id="{oid}_rel">\n'
+                           "      <core:relationType>reflectsLightOntoRoutesFrom</core:relationType>\n"
+                           f'      <core:relatedTo xlink:href="#{_esc(building_id)}"/>\n'
+                           "    </core:CityObjectRelation>\n  </core:relatedTo>\n")
             months = list(g["month"])
             stamps = [clock.start(m) for m in months]
             obs, uom = SURFACE_SERIES["pv_kwh_reflected"]
             s = Series(oid, "gen:GenericThematicSurface", "pv_kwh_reflected", obs, uom, stamps,
                        g["pv_kwh_reflected"].to_numpy(np.float64), stamps[0], clock.end(months[-1]))
-            _generic(surf, "StringAttribute", "surface_id", str(surface_id))
+            _generic(out, "  ", "StringAttribute", "surface_id", str(surface_id))
             if isinstance(building_id, str):
-                _generic(surf, "StringAttribute", "building_id", building_id)
-            _generic(surf, "StringAttribute", "surface_type", str(stype))
-            _generic(surf, "IntAttribute", "segments", str(int(g["segments"].max())))
-            _generic(surf, "DoubleAttribute", s.attribute, _num(s.values.sum()))
-            _dynamizer(surf, s, table)
+                _generic(out, "  ", "StringAttribute", "building_id", building_id)
+            _generic(out, "  ", "StringAttribute", "surface_type", str(stype))
+            _generic(out, "  ", "IntAttribute", "segments", str(int(g["segments"].max())))
+            _generic(out, "  ", "DoubleAttribute", s.attribute, _num(s.values.sum()))
+            _dynamizer(out, "  ", s, table)
+            out.append("</gen:GenericThematicSurface>\n")
             counts["dynamizers"] += 1
             counts["surfaces"] += 1
-            xf.write(member, pretty_print=True)
+            xf.write(_member(out))
         yield write
 
 
 #: namespaces declared on each element written into the stream (xmlfile does not reuse the
 #: declarations of the enclosing elements it has open)
 _MEMBER_NSMAP = {k: v for k, v in NSMAP.items() if k != "xsi"}
-_CHUNK_NSMAP = {k: NSMAP[k] for k in ("core", "dyn", "gen", "tran", "gml")}
 _GML_NSMAP = {"gml": NSMAP["gml"]}
 
 
@@ -770,8 +781,9 @@ def _tile_reflected(run: RunData, tile: str, months: list[str]) -> pd.DataFrame:
     for m in months:
         f = run.run_dir / "parts" / "segment_month" / f"tile={tile}" / f"month={m}.parquet"
         if f.exists():
-            d = pd.read_parquet(f, columns=["segment_id", "pv_kwh_reflected"])
-            frames.append(d.assign(month=m))
+            d = pq.read_table(f, columns=["segment_id", "pv_kwh_reflected"])
+            frames.append(pd.DataFrame({"segment_id": d.column(0).to_numpy(), "month": m,
+                                        "pv_kwh_reflected": d.column(1).to_numpy()}))
     if not frames:
         return pd.DataFrame({"segment_id": pd.Series(dtype=np.int64), "month": pd.Series(dtype=object),
                              "pv_kwh_reflected": pd.Series(dtype=np.float64)})
@@ -779,11 +791,15 @@ def _tile_reflected(run: RunData, tile: str, months: list[str]) -> pd.DataFrame:
 
 
 def _building_ids(data_dir: Path, wanted: set) -> dict:
+    import pyarrow as pa
+    import pyarrow.compute as pc
+
+    value_set = pa.array(sorted(map(str, wanted)), pa.string())
     out = {}
     for f in sorted((data_dir / "city" / "surfaces").glob("tile=*/*.parquet")):
-        s = pd.read_parquet(f, columns=["surface_id", "building_id"])
-        s = s[s["surface_id"].isin(wanted)]
-        out.update(zip(s["surface_id"], s["building_id"]))
+        t = pq.read_table(f, columns=["surface_id", "building_id"])
+        t = t.filter(pc.is_in(pc.cast(t.column("surface_id"), pa.string()), value_set=value_set))
+        out.update(zip(t.column("surface_id").to_pylist(), t.column("building_id").to_pylist()))
     return out
 
 
@@ -879,14 +895,11 @@ def _envelope(run: RunData) -> etree._Element | None:
             lo, hi = np.minimum(lo, a.min(0)), np.maximum(hi, a.max(0))
     if not np.isfinite(lo).all():
         return None
-    bb = etree.Element(T["gml:boundedBy"], nsmap=_GML_NSMAP)
-    attrib = {"srsDimension": "3"}
-    if run.srs_name:
-        attrib["srsName"] = run.srs_name
-    env = _SE(bb, T["gml:Envelope"], attrib)
-    _text(env, "gml:lowerCorner", " ".join(map(_num, lo)))
-    _text(env, "gml:upperCorner", " ".join(map(_num, hi)))
-    return bb
+    crs = f' srsName="{_esc(run.srs_name)}"' if run.srs_name else ""
+    return _chunk(f'<gml:boundedBy xmlns:gml="{NSMAP["gml"]}">\n  <gml:Envelope srsDimension="3"{crs}>\n'
+                  f'    <gml:lowerCorner>{" ".join(map(_num, lo))}</gml:lowerCorner>\n'
+                  f'    <gml:upperCorner>{" ".join(map(_num, hi))}</gml:upperCorner>\n'
+                  "  </gml:Envelope>\n</gml:boundedBy>")
 
 
 def _write_standalone(path: Path, run: RunData, sel: Selection, members: Iterator[MemberWriter]) -> None:
