@@ -823,7 +823,8 @@ def choose_aggregate(run: RunData, sel: Selection, aggregate: str | None) -> str
 
 def write_dynamizers(run_dir: str | Path, out: str | Path, encoding: str = "inline",
                      embed: str | Path | None = None, max_segments: int | None = None,
-                     aggregate: str | None = "segment", routes=None, months=None) -> dict:
+                     aggregate: str | None = "segment", routes=None, months=None,
+                     reflectors: bool | None = None) -> dict:
     """Write the run's results as a CityGML 3.0 file with Dynamizers, streamed.
 
     Parameters
@@ -839,6 +840,8 @@ def write_dynamizers(run_dir: str | Path, out: str | Path, encoding: str = "inli
         direction), or None: segment up to ``AUTO_ROUTE_ABOVE`` segments, route above
     routes : route short names to export (default all)
     months : months to export, ``6`` or ``"2024-06"`` (default all of the run)
+    reflectors : write the reflecting building surfaces (default: with ``"segment"`` only; a
+        network's reflecting surfaces outnumber its route directions by far)
 
     Returns
     -------
@@ -866,7 +869,8 @@ def write_dynamizers(run_dir: str | Path, out: str | Path, encoding: str = "inli
         net = _network_member(run, sel, table, counts)
         if net is not None:
             yield net
-        yield from _surface_members(run, sel, table, counts)
+        if reflectors if reflectors is not None else aggregate == "segment":
+            yield from _surface_members(run, sel, table, counts)
 
     ok = False
     try:
