@@ -201,9 +201,22 @@ def load_run(run_dir: str | Path) -> RunData:
         vertical = vertical_epsg(first_srs_name(Path(f))) if Path(f).is_file() else None
         break
     sm = pq.read_table(run_dir / "segment_month.parquet", columns=["month", "route_short_name"])
-    months = sorted(set(sm.column("month").unique().to_pylist()))
+    months = sorted(set(_month_strings(sm.column("month")).unique().to_pylist()))
     routes = sorted({str(r) for r in sm.column("route_short_name").unique().to_pylist() if r is not None})
     return RunData(run_dir, data_dir, manifest, tz, epsg, vertical, months, routes)
+
+
+def _month_strings(col):
+    """A ``month`` column as ``YYYY-MM`` strings (runs write it as a date, the first day of the
+    month; older runs as ``YYYY-MM`` text)."""
+    import pyarrow as pa
+    import pyarrow.compute as pc
+
+    if pa.types.is_string(col.type) or pa.types.is_large_string(col.type):
+        return pc.utf8_slice_codeunits(col, 0, 7)
+    if pa.types.is_dictionary(col.type):
+        return _month_strings(pc.cast(col, pa.string()))
+    return pc.strftime(col, format="%Y-%m")
 
 
 def _geoparquet_epsg(meta: dict) -> int | None:
@@ -348,6 +361,7 @@ def _segment_records(run: RunData, sel: Selection) -> Iterator[SegmentRecord]:
                 continue
             tail = int(np.searchsorted(ids, ids[-1]))       # ids ascending: the last id's rows
             carry, done = table.slice(tail), table.slice(0, tail)
+        done = done.set_column(done.schema.get_field_index("month"), "month", _month_strings(done.column("month")))
         keep = pc.is_in(done.column("month"), value_set=months)
         if routes is not None:
             keep = pc.and_(keep, pc.is_in(pc.cast(done.column("route_short_name"), pa.string()),
@@ -625,6 +639,7 @@ def _route_members(run: RunData, sel: Selection, table, counts: dict) -> Iterato
 
 def _network_member(run: RunData, sel: Selection, table, counts: dict) -> MemberWriter | None:
     hp = pd.read_parquet(run.run_dir / "hourly_pattern.parquet")
+    hp["month"] = hp["month"].astype(str).str.slice(0, 7)
     hp = hp[hp["month"].isin(sel.months)].sort_values(["month", "hour"])
     if hp.empty:
         return None
