@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import html
 import logging
+from functools import lru_cache
 
 import numpy as np
 import pandas as pd
@@ -39,6 +40,35 @@ def _default_date(model: TripModel, route_id, direction_id) -> str:
         if len(model.departures(route_id, direction_id, d)):
             return pd.Timestamp(d).strftime("%Y-%m-%d")
     return f"{model.year}-{months[0]:02d}-15"
+
+
+@lru_cache(maxsize=4)
+def _footprints(data_dir: str, tiles: tuple, bounds: tuple) -> tuple[list, list]:
+    from ..city.footprints import building_footprints
+
+    rings = building_footprints(data_dir, tiles=tiles, bounds=bounds)
+    return [r[:, 0].tolist() for r in rings], [r[:, 1].tolist() for r in rings]
+
+
+def _crs_name(model: TripModel) -> str:
+    """The city's CRS as the ingest recorded it (``EPSG:2169``), or 'projected'."""
+    import json
+
+    try:
+        return str(json.loads((model.data_dir / "city" / "tiles.json").read_text())["crs"])
+    except (OSError, KeyError, ValueError):
+        return "projected"
+
+
+def _footprint_patches(model: TripModel, margin_m: float = 200.0) -> tuple[list, list]:
+    """x and y lists of the building footprints around the run's routes (the map's
+    background, from the city model of the run's data directory: no map service)."""
+    g = model.geometry
+    x = np.concatenate([g["x"].to_numpy(), g["x_end"].to_numpy()])
+    y = np.concatenate([g["y"].to_numpy(), g["y_end"].to_numpy()])
+    bounds = (float(x.min()) - margin_m, float(y.min()) - margin_m,
+              float(x.max()) + margin_m, float(y.max()) + margin_m)
+    return _footprints(str(model.data_dir), tuple(sorted(g["tile"].dropna().unique())), bounds)
 
 
 def numbers_html(res, fleet: dict | None = None) -> str:
@@ -138,9 +168,11 @@ def build_document(model: TripModel, doc) -> None:
 
     mapper = LinearColorMapper(palette=Viridis256, low=0, high=1)
     f_map = figure(title="Route, coloured by PV energy per segment (Wh)", match_aspect=True,
-                   height=420, width=560, x_axis_label="x (m, projected)", y_axis_label="y (m)",
+                   height=420, width=560, x_axis_label=f"easting (m), {_crs_name(model)}", y_axis_label="northing (m)",
                    tools="pan,wheel_zoom,box_zoom,reset,save")
-    f_map.segment("x", "y", "x_end", "y_end", source=src_bg, color="#cccccc", line_width=2)
+    bx, by = _footprint_patches(model)
+    f_map.patches(bx, by, fill_color="#dedede", line_color="#b4b4b4", line_width=0.5)
+    f_map.segment("x", "y", "x_end", "y_end", source=src_bg, color="#9e9e9e", line_width=2)
     seg_r = f_map.segment("x", "y", "x_end", "y_end", source=src_seg, line_width=6,
                           color={"field": "energy_wh", "transform": mapper})
     f_map.add_layout(ColorBar(color_mapper=mapper, title="Wh"), "right")

@@ -429,7 +429,8 @@ class TripModel:
         agg = rm.groupby("month", sort=True)[["trips", "pv_kwh", "pv_kwh_clear", "pv_kwh_unshaded",
                                               "pv_kwh_clear_unshaded", "pv_kwh_direct",
                                               "pv_kwh_diffuse", "consumption_kwh"]].sum()
-        out = pd.DataFrame({"month": agg.index.astype(str), "trips": agg["trips"].to_numpy(),
+        # the file's months are dates (first day); the app shows them as YYYY-MM
+        out = pd.DataFrame({"month": agg.index.astype(str).str.slice(0, 7), "trips": agg["trips"].to_numpy(),
                             "allsky": agg["pv_kwh"].to_numpy() * f,
                             "clearsky": agg["pv_kwh_clear"].to_numpy() * f,
                             "allsky_unshaded": agg["pv_kwh_unshaded"].to_numpy() * f,

@@ -23,6 +23,7 @@ from __future__ import annotations
 import gzip
 import re
 import zipfile
+import zlib
 from collections import Counter
 from contextlib import contextmanager
 from dataclasses import dataclass, field
@@ -50,6 +51,9 @@ THEMATIC = {
 INTERIOR = {"InteriorWallSurface", "CeilingSurface", "FloorSurface"}
 
 _MEMBERS = ("{*}cityObjectMember", "{*}featureMember", "{*}Envelope")
+#: CityGML versions read; a namespace naming another version is refused
+VERSIONS = ("1.0", "2.0", "3.0")
+_CITYGML_NS = re.compile(r"opengis\.net/citygml/(?:[A-Za-z]+/)?(\d+\.\d+)")
 _LOD_SURF = re.compile(r"^lod([0-4])(MultiSurface|Solid|Geometry|CompositeSurface|MultiSolid)$")
 _POLYGONAL = {"Polygon", "Triangle", "PolygonPatch", "Rectangle"}
 
@@ -90,6 +94,13 @@ class Feature:
     n_parts: int = 0
     thematic: Counter = field(default_factory=Counter)   # thematic surfaces per type
     problems: Counter = field(default_factory=Counter)   # unreadable bits, per reason
+    skips: list = field(default_factory=list)            # (surface type or None, reason) per unreadable polygon
+    lods: set = field(default_factory=set)               # LoDs the geometry was taken from
+
+    @property
+    def lod_used(self) -> str:
+        """``"lod2"``, ``"lod1"``, ``"lod1+lod2"`` (parts of different LoDs) or ``"none"``."""
+        return "+".join(f"lod{k}" for k in sorted(self.lods)) or "none"
 
 
 class CityGMLReader:
@@ -116,6 +127,7 @@ class CityGMLReader:
         self.gml: str | None = None
         self.ignored: Counter = Counter()
         self._anon = 0
+        self._seen_ns: set = set()
 
     def __iter__(self) -> Iterator[Feature]:
         ctx = etree.iterparse(self.source, events=("end",), tag=_MEMBERS, huge_tree=True,
@@ -127,12 +139,11 @@ class CityGMLReader:
                     if self.srs_name is None and elem.get("srsName"):
                         self.srs_name = elem.get("srsName")
                     continue
-                if self.version is None:
-                    m = re.search(r"citygml/(\d\.\d)", etree.QName(elem).namespace or "")
-                    self.version = m.group(1) if m else None
+                self._check_version(elem)
                 for child in elem:
                     if not isinstance(child.tag, str):
                         continue
+                    self._check_version(child)
                     feature = self._feature(child)
                     if feature is not None:
                         yield feature
@@ -145,8 +156,28 @@ class CityGMLReader:
         except etree.XMLSyntaxError as exc:
             line = exc.lineno if exc.lineno else "?"
             raise InputError(f"{self.label}: line {line}: not well-formed XML: {exc.msg}") from None
+        except (EOFError, zlib.error, zipfile.BadZipFile, OSError) as exc:
+            # raised while reading a .gz / .zip member: corrupt or truncated archive
+            kind = "zlib.error" if isinstance(exc, zlib.error) else type(exc).__name__
+            raise InputError(f"{self.label}: corrupt or truncated file ({kind}: {exc})") from None
         finally:
             del ctx
+
+    def _check_version(self, el) -> None:
+        """Note the CityGML version of *el*'s namespace; refuse versions not read."""
+        ns = etree.QName(el).namespace or ""
+        if ns in self._seen_ns:
+            return
+        self._seen_ns.add(ns)
+        m = _CITYGML_NS.search(ns)
+        if not m:
+            return
+        if m.group(1) not in VERSIONS:
+            raise InputError(f"{self.label}: line {el.sourceline}: CityGML version {m.group(1)} "
+                             f"(namespace {ns}) is not supported; vipvflow reads CityGML "
+                             f"{', '.join(VERSIONS)}")
+        if self.version is None:
+            self.version = m.group(1)
 
     # -- features -----------------------------------------------------------------
     def _feature(self, el) -> Feature | None:
@@ -196,20 +227,25 @@ class CityGMLReader:
                     if geom is None:
                         feature.problems["surface_without_geometry"] += 1
                         continue
+                    feature.lods.add(_lod_of(geom))
                     sid = gml_id(surf)
                     polys = list(_polygons(geom, index, feature.problems))
                     for k, (poly, rev) in enumerate(polys):
-                        rings = _rings(poly, feature.problems)
+                        rings, why = _rings(poly)
                         if rings is None:
+                            feature.skips.append((stype, why))
                             continue
                         this_id = None if sid is None else (sid if len(polys) == 1 else f"{sid}_{k}")
                         feature.surfaces.append(RawSurface(rings, stype, cls, this_id, rev))
             if n_thematic == 0:
                 geom = _fallback_geometry(obj)
                 if geom is not None:
+                    feature.lods.add(_lod_of(geom))
                     for poly, rev in _polygons(geom, index, feature.problems):
-                        rings = _rings(poly, feature.problems)
-                        if rings is not None:
+                        rings, why = _rings(poly)
+                        if rings is None:
+                            feature.skips.append((None, why))
+                        else:
                             feature.surfaces.append(
                                 RawSurface(rings, None, local(geom), gml_id(poly), rev))
         return feature
@@ -219,8 +255,10 @@ class CityGMLReader:
         feature = Feature(kind, fid)
         index = _LazyIndex(el)
         for poly, rev in _polygons(el, index, feature.problems, skip_implicit=True):
-            rings = _rings(poly, feature.problems)
-            if rings is not None:
+            rings, why = _rings(poly)
+            if rings is None:
+                feature.skips.append((stype, why))
+            else:
                 feature.surfaces.append(RawSurface(rings, stype, cls, None, rev))
         return feature
 
@@ -253,6 +291,11 @@ def _best_lod(surf):
         if lod in found:
             return found[lod]
     return None
+
+
+def _lod_of(geom) -> int:
+    """The LoD digit of a geometry property (``lod1Solid`` -> 1)."""
+    return int(_LOD_SURF.match(local(geom)).group(1))
 
 
 def _fallback_geometry(obj):
@@ -348,31 +391,29 @@ def _ring_coords(ring) -> np.ndarray | None:
     return arr
 
 
-def _rings(poly, problems: Counter) -> list | None:
-    """Exterior and interior rings of a polygon element as (n, 3) arrays."""
+def _rings(poly) -> tuple[list | None, str | None]:
+    """(exterior and interior rings of a polygon element as (n, 3) arrays, None) or
+    (None, the reason it cannot be read)."""
     rings = []
     for child in poly:
         name = local(child)
         if name in ("exterior", "outerBoundaryIs", "interior", "innerBoundaryIs"):
             ring_el = next((r for r in child if local(r) == "LinearRing"), None)
             if ring_el is None:
-                problems["unsupported_ring"] += 1
-                return None
+                return None, "unsupported_ring"
             try:
                 coords = _ring_coords(ring_el)
             except ValueError:
                 coords = None
             if coords is None:
-                problems["unreadable_coordinates"] += 1
-                return None
+                return None, "unreadable_coordinates"
             if name in ("exterior", "outerBoundaryIs"):
                 rings.insert(0, coords)
             else:
                 rings.append(coords)
     if not rings:
-        problems["polygon_without_exterior"] += 1
-        return None
-    return rings
+        return None, "polygon_without_exterior"
+    return rings, None
 
 
 @contextmanager
@@ -381,14 +422,29 @@ def open_sources(path: Path):
     path = Path(path)
     if not path.exists():
         raise InputError(f"{path}: file not found")
+    if path.is_dir():
+        raise InputError(f"{path}: is a directory, not a CityGML file")
+    if path.stat().st_size == 0:
+        raise InputError(f"{path}: empty file")
     if path.suffix.lower() == ".zip":
-        with zipfile.ZipFile(path) as zf:
+        try:
+            zf = zipfile.ZipFile(path)
+        except (zipfile.BadZipFile, OSError, EOFError) as exc:
+            raise InputError(f"{path}: corrupt or truncated zip file ({exc})") from None
+        with zf:
             names = [n for n in zf.namelist()
                      if n.lower().endswith((".gml", ".xml", ".citygml")) and not n.endswith("/")]
             if not names:
                 raise InputError(f"{path}: zip holds no .gml or .xml file")
             yield [(f"{path}!{n}", (lambda n=n: zf.open(n))) for n in names]
     elif path.suffix.lower() == ".gz":
-        yield [(str(path), lambda: gzip.open(path, "rb"))]
+        yield [(str(path), lambda: _readable(path, gzip.open))]
     else:
-        yield [(str(path), lambda: open(path, "rb"))]
+        yield [(str(path), lambda: _readable(path, open))]
+
+
+def _readable(path: Path, opener):
+    try:
+        return opener(path, "rb")
+    except OSError as exc:
+        raise InputError(f"{path}: cannot be read ({exc.strerror or exc})") from None

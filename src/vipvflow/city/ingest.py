@@ -11,6 +11,18 @@ Two passes with bounded memory:
    (own surfaces) and ``city/meshes/<T>.npz`` (own + buffer surfaces), both atomically.
 
 Peak memory is set by the chunk size and the largest tile, not by the size of the city.
+
+The data dir's ``city/`` changes as a whole: everything is written into
+``<data_dir>/.city-ingest-<pid>/`` and swapped in only when the ingest succeeded (an input
+error, Ctrl-C or a kill leaves the previous ``city/`` as it was).  Folders left by a killed
+ingest (``.city-ingest-<pid>``, the older ``city/.ingest-spool-<pid>``) are removed by the
+next ingest once their process is gone.
+
+Coordinates: each file's axis order and CRS are settled on its first building
+(:class:`~vipvflow.city.crs.SourceCRS`); without ``--crs`` a projected file keeps its CRS and a
+geographic one (PLATEAU's EPSG:6697) is put into its local UTM zone.  Polygons with a
+non-finite coordinate, a vertex outside the CRS's area of use or an absurd area are skipped and
+counted by reason.
 """
 from __future__ import annotations
 
@@ -30,12 +42,18 @@ from ..errors import InputError
 from ..mesh import SURFACE_CODE, SURFACE_TYPES, TileMesh
 from ..tiles import tile_bounds, tile_index, tile_name
 from .citygml import CityGMLReader, open_sources
-from .crs import is_projected, normalise_crs, parse_srs_name, transform_xyz
+from .crs import (SourceCRS, horizontal, inside, is_projected, local_utm, normalise_crs,
+                  parse_srs_name, transform_xyz)
 from .geometry import Skip, classify_normal, prepare_polygon
 
 log = logging.getLogger(__name__)
 
 CHUNK_SURFACES = 20_000
+
+#: a building polygon larger than this (m2, 2 km x 2 km) is a broken coordinate, not a roof
+MAX_SURFACE_AREA_M2 = 4e6
+#: reasons of skipped polygons that come from the coordinates rather than the shape
+BAD_COORDINATES = ("non_finite_coordinates", "outside_crs_area", "absurd_area")
 
 
 @dataclass
@@ -44,8 +62,11 @@ class IngestReport:
 
     files: list = field(default_factory=list)
     crs: str | None = None
+    crs_source: str = ""                                   # why this CRS (file, --crs, local UTM zone)
     file_crs: dict = field(default_factory=dict)
+    axis_order: dict = field(default_factory=dict)         # per file: how coordinates were read
     buildings: int = 0
+    buildings_by_lod: dict = field(default_factory=dict)   # LoD the geometry was taken from
     building_parts: int = 0
     terrain_features: int = 0
     vegetation_features: int = 0
@@ -72,12 +93,18 @@ class IngestReport:
         return int(sum(self.skipped.values()))
 
     def summary(self) -> str:
-        """One line: files, CRS, buildings, surfaces per type, skips, tiles, speed."""
+        """One line: files, CRS, buildings by LoD, surfaces per type, skips, tiles, speed."""
         types = ", ".join(f"{k} {v}" for k, v in sorted(self.surfaces.items()))
         skips = ", ".join(f"{k} {v}" for k, v in sorted(self.skipped.items())) or "none"
-        rate = self.n_surfaces / self.elapsed_s if self.elapsed_s > 0 else float("nan")
-        return (f"{len(self.files)} file(s) in {self.crs}: {self.buildings} buildings, "
-                f"{self.n_surfaces} surfaces ({types}), skipped {self.n_skipped} ({skips}), "
+        lods = ", ".join(f"{k} {v}" for k, v in sorted(self.buildings_by_lod.items()))
+        rate = self.n_surfaces / self.elapsed_s if self.elapsed_s > 0 else 0.0
+        crs = f"{self.crs} ({self.crs_source})" if self.crs_source else f"{self.crs}"
+        problems = ""
+        if self.problems:
+            problems = ", other problems " + ", ".join(
+                f"{k} {v}" for k, v in sorted(self.problems.items()))
+        return (f"{len(self.files)} file(s) in {crs}: {self.buildings} buildings ({lods or 'none'}), "
+                f"{self.n_surfaces} surfaces ({types}), skipped {self.n_skipped} ({skips}){problems}, "
                 f"{self.tiles} tiles, {self.triangles} mesh triangles, "
                 f"{self.elapsed_s:.1f} s ({rate:,.0f} surfaces/s)")
 
@@ -286,7 +313,7 @@ def _write_tile(name: str, spool: Path, city_dir: Path, cfg: CityCfg, crs: str) 
 
 
 def ingest_city(paths, data_dir, city_cfg: CityCfg | None = None, crs: str | None = None,
-                chunk_surfaces: int = CHUNK_SURFACES) -> IngestReport:
+                chunk_surfaces: int = CHUNK_SURFACES, axis_order: str = "auto") -> IngestReport:
     """Read CityGML files into tiled surfaces, tile meshes and a terrain model.
 
     Parameters
@@ -294,14 +321,20 @@ def ingest_city(paths, data_dir, city_cfg: CityCfg | None = None, crs: str | Non
     paths : path or list of paths
         CityGML files (``.gml``, ``.xml``, ``.gml.gz``, or ``.zip`` holding GML files).
     data_dir : path
-        Scenario data dir; outputs go to ``<data_dir>/city/`` (docs/contracts.md).
+        Scenario data dir; outputs go to ``<data_dir>/city/`` (docs/contracts.md), which is
+        replaced as a whole only when the ingest succeeds.
     city_cfg : CityCfg, optional
         Tile size (m), buffer (m), albedo per type, planarity tolerance (m), min area (m2).
     crs : str, optional
-        Output CRS (``EPSG:xxxx``) and the CRS assumed for files without ``srsName``.
-        Default: the first file's CRS.
+        Output CRS (``EPSG:xxxx``, projected) and the CRS assumed for files without
+        ``srsName``.  Default: the first file's CRS when projected, else (geographic, e.g.
+        PLATEAU's EPSG:6697) the local UTM zone of its first building.
     chunk_surfaces : int
         Surfaces held in memory before they are spooled to disk.
+    axis_order : str
+        ``auto`` (default): each file's axis order from its CRS and data (docs/city.md);
+        ``epsg``: the EPSG order (latitude / northing first where EPSG says so); ``xy``:
+        easting / longitude first.
 
     Returns
     -------
@@ -311,28 +344,37 @@ def ingest_city(paths, data_dir, city_cfg: CityCfg | None = None, crs: str | Non
     Raises
     ------
     InputError
-        Missing or broken file (with line number), unknown or missing CRS.
+        Missing, broken or truncated file (with line number), unknown CityGML version,
+        unknown or missing CRS, a file with no city objects or no usable polygon.  The data
+        dir's ``city/`` is left as it was.
     """
     t0 = time.perf_counter()
     cfg = city_cfg or CityCfg()
     if isinstance(paths, (str, os.PathLike)):
         paths = [paths]
     paths = [Path(p) for p in paths]
-    city_dir = Path(data_dir) / "city"
-    city_dir.mkdir(parents=True, exist_ok=True)
-    target = normalise_crs(crs) if crs else None
+    for path in paths:
+        if not path.exists():
+            raise InputError(f"{path}: file not found")
+    target = horizontal(normalise_crs(crs)) if crs else None
     if target and not is_projected(target):
         raise InputError(f"--crs {crs}: tiles need a projected CRS in metres, not {target}")
+    data_dir = Path(data_dir)
+    data_dir.mkdir(parents=True, exist_ok=True)
+    remove_stale_ingests(data_dir)
+    final_dir = data_dir / "city"
+    city_dir = data_dir / f".city-ingest-{os.getpid()}"
+    if city_dir.exists():
+        shutil.rmtree(city_dir)
+    city_dir.mkdir()
     albedo = cfg.albedo.model_dump()
-    report = IngestReport()
-    skipped, repaired, problems, ignored = Counter(), Counter(), Counter(), Counter()
-    written, thematic, area = Counter(), Counter(), Counter()
-    spool = city_dir / f".ingest-spool-{os.getpid()}"
-    if spool.exists():
-        shutil.rmtree(spool)
-    spool.mkdir()
-    acc = _Accumulator(spool, cfg, chunk_surfaces)
+    report = IngestReport(crs_source="--crs" if target else "")
+    counts = _Counts()
+    ignored = Counter()
+    spool = city_dir / ".spool"
     try:
+        spool.mkdir()
+        acc = _Accumulator(spool, cfg, chunk_surfaces)
         for path in paths:
             with open_sources(path) as sources:
                 for label, opener in sources:
@@ -341,15 +383,15 @@ def ingest_city(paths, data_dir, city_cfg: CityCfg | None = None, crs: str | Non
                         reader = CityGMLReader(fh, label)
                         src = None
                         for feature in reader:
-                            if src is None:
-                                src, target = _resolve_crs(reader, label, target, crs)
-                                report.file_crs[label] = src
-                            _add_feature(feature, acc, src, target, cfg, albedo, written,
-                                         thematic, area, skipped, repaired)
-                            problems.update(feature.problems)
+                            if src is None and _has_coordinates(feature):
+                                src, target = _resolve_crs(reader, label, feature, target, report,
+                                                           axis_order)
+                            _add_feature(feature, acc, src, target, cfg, albedo, counts)
+                            counts.problems.update(feature.problems)
                             if feature.kind == "building":
                                 report.buildings += 1
                                 report.building_parts += feature.n_parts
+                                counts.lods[feature.lod_used] += 1
                             elif feature.kind == "terrain":
                                 report.terrain_features += 1
                             else:
@@ -360,81 +402,223 @@ def ingest_city(paths, data_dir, city_cfg: CityCfg | None = None, crs: str | Non
                     log.info("read %s", label)
         acc.flush()
         report.crs = target
+        _check_not_empty(report, counts, ignored, final_dir)
         tiles = {}
         for name in sorted(acc.own_tiles):
             tiles[name] = _write_tile(name, spool, city_dir, cfg, target)
-        _remove_stale(city_dir, set(tiles))
         terrain_tris = _write_terrain(city_dir, acc, target)
+        shutil.rmtree(spool)
+        _atomic_json(city_dir / "tiles.json", {
+            "crs": target, "tile_size_m": cfg.tile_size_m, "buffer_m": cfg.buffer_m,
+            "tiles": tiles})
+        report.surfaces = dict(counts.written)
+        report.thematic_surfaces = dict(counts.thematic)
+        report.area_m2 = {k: round(v, 3) for k, v in counts.area.items()}
+        report.skipped = dict(counts.skipped)
+        report.skipped_by_type = dict(counts.skipped_by_type)
+        report.repaired = dict(counts.repaired)
+        report.problems, report.ignored_features = dict(counts.problems), dict(ignored)
+        report.buildings_by_lod = dict(counts.lods)
+        report.tiles = len(tiles)
+        report.triangles = int(sum(t["n_triangles"] for t in tiles.values()))
+        report.terrain_triangles = terrain_tris
+        report.elapsed_s = round(time.perf_counter() - t0, 3)
+        report.report_path = str(final_dir / "ingest_report.json")
+        _atomic_json(city_dir / "ingest_report.json", json.loads(report.to_json()))
+        _swap_in(city_dir, final_dir)
     finally:
-        shutil.rmtree(spool, ignore_errors=True)
-    _atomic_json(city_dir / "tiles.json", {
-        "crs": target, "tile_size_m": cfg.tile_size_m, "buffer_m": cfg.buffer_m, "tiles": tiles})
-    report.surfaces = dict(written)
-    report.thematic_surfaces = dict(thematic)
-    report.area_m2 = {k: round(v, 3) for k, v in area.items()}
-    report.skipped = {k: v for k, v in skipped.items() if not isinstance(k, tuple)}
-    report.skipped_by_type = {k[1]: v for k, v in skipped.items() if isinstance(k, tuple)}
-    report.repaired = dict(repaired)
-    report.problems, report.ignored_features = dict(problems), dict(ignored)
-    report.tiles = len(tiles)
-    report.triangles = int(sum(t["n_triangles"] for t in tiles.values()))
-    report.terrain_triangles = terrain_tris
-    report.elapsed_s = round(time.perf_counter() - t0, 3)
-    report.report_path = str(city_dir / "ingest_report.json")
-    _atomic_json(city_dir / "ingest_report.json", json.loads(report.to_json()))
+        shutil.rmtree(city_dir, ignore_errors=True)
     return report
 
 
-def _resolve_crs(reader: CityGMLReader, label: str, target: str | None, option: str | None):
-    """(CRS of this file, output CRS) once the reader has met its first feature."""
+@dataclass
+class _Counts:
+    written: Counter = field(default_factory=Counter)
+    thematic: Counter = field(default_factory=Counter)
+    area: Counter = field(default_factory=Counter)
+    skipped: Counter = field(default_factory=Counter)
+    skipped_by_type: Counter = field(default_factory=Counter)
+    repaired: Counter = field(default_factory=Counter)
+    problems: Counter = field(default_factory=Counter)
+    lods: Counter = field(default_factory=Counter)
+
+    def skip(self, reason: str, stype: str | None) -> None:
+        self.skipped[reason] += 1
+        if stype is not None:
+            self.skipped_by_type[stype] += 1
+
+
+def _has_coordinates(feature) -> bool:
+    return any(len(r) for s in feature.surfaces for r in s.rings)
+
+
+def _resolve_crs(reader: CityGMLReader, label: str, feature, target: str | None,
+                 report: IngestReport, axis_order: str = "auto"):
+    """(how this file's coordinates are read, output CRS), settled on its first feature."""
     if reader.srs_name:
-        src = parse_srs_name(reader.srs_name)
+        name = parse_srs_name(reader.srs_name)
     elif target:
-        src = target
+        name = target
     else:
         raise InputError(f"{label}: the file names no CRS (no srsName); pass --crs EPSG:xxxx")
+    sample = np.concatenate([r for s in feature.surfaces for r in s.rings])[:, :2]
+    src = SourceCRS.decide(name, sample, axis_order)
+    report.file_crs[label] = src.crs
+    report.axis_order[label] = src.axis_order
     if target is None:
-        if not is_projected(src):
-            raise InputError(f"{label}: CRS {src} is not projected (metres); pass --crs EPSG:xxxx")
-        target = src
+        if is_projected(src.crs):
+            target, why = src.crs, "the file's CRS"
+        else:
+            lonlat = src.read(np.column_stack([sample, np.zeros(len(sample))]))[:, :2]
+            lonlat = lonlat[inside(lonlat, src.bounds)]
+            if not len(lonlat):
+                raise InputError(f"{label}: feature {feature.feature_id}: no coordinate inside "
+                                 f"the area of use of {src.crs}; pass --crs EPSG:xxxx")
+            lon, lat = np.median(lonlat, axis=0)
+            target = local_utm(src.crs, float(lon), float(lat))
+            why = f"local UTM zone for geographic {src.crs}"
+        report.crs_source = why
+        log.info("city CRS %s (%s); coordinates of %s read as %s", target, why, label,
+                 src.axis_order)
+    else:
+        log.info("coordinates of %s (%s) read as %s", label, src.crs, src.axis_order)
     return src, target
 
 
-def _add_feature(feature, acc: _Accumulator, src: str, target: str, cfg: CityCfg, albedo: dict,
-                 written: Counter, thematic: Counter, area: Counter, skipped: Counter,
-                 repaired: Counter) -> None:
-    thematic.update(feature.thematic)
+def _add_feature(feature, acc: _Accumulator, src: SourceCRS | None, target: str, cfg: CityCfg,
+                 albedo: dict, counts: _Counts) -> None:
+    counts.thematic.update(feature.thematic)
+    for stype, reason in feature.skips:
+        counts.skip(reason, stype)
     surfaces = feature.surfaces
     if not surfaces:
         return
-    if src != target:
-        sizes = [len(r) for s in surfaces for r in s.rings]
-        xyz = transform_xyz(np.concatenate([r for s in surfaces for r in s.rings]), src, target)
-        parts = iter(np.split(xyz, np.cumsum(sizes)[:-1]))
-        for s in surfaces:
-            s.rings = [next(parts) for _ in s.rings]
-    counters = Counter()
+    sizes = [len(r) for s in surfaces for r in s.rings]
+    raw = np.concatenate([r for s in surfaces for r in s.rings])
+    finite = np.isfinite(raw).all(axis=1)
+    xyz = src.read(raw)
+    ok = finite & inside(xyz, src.bounds)
+    if src.crs != target:
+        with np.errstate(all="ignore"):
+            xyz = transform_xyz(np.where(ok[:, None], xyz, 0.0), src.crs, target)
+        ok &= np.isfinite(xyz).all(axis=1)
+    bounds = np.cumsum([0] + sizes)
+    k = 0
+    prepared = []
     for s in surfaces:
-        rings = [r[::-1] for r in s.rings] if s.reversed else s.rings
+        rings = []
+        reason = None
+        for _ in s.rings:
+            a, b = bounds[k], bounds[k + 1]
+            k += 1
+            if reason is None and not finite[a:b].all():
+                reason = "non_finite_coordinates"
+            elif reason is None and not ok[a:b].all():
+                reason = "outside_crs_area"
+            rings.append(xyz[a:b])
+        prepared.append((s, rings, reason))
+    counters = Counter()
+    for s, rings, reason in prepared:
         stype = s.surface_type
-        try:
-            prep = prepare_polygon(rings, cfg.planarity_tolerance_m, cfg.min_area_m2)
-        except Skip as skip:
-            skipped[skip.reason] += 1
+        if reason is not None:
+            counts.skip(reason, stype)
             if stype is not None:
                 counters[stype] += 1
-                skipped[("type", stype)] += 1
             continue
-        repaired.update(set(prep.repairs))
+        if s.reversed:
+            rings = [r[::-1] for r in rings]
+        try:
+            prep = prepare_polygon(rings, cfg.planarity_tolerance_m, cfg.min_area_m2)
+            if feature.kind == "building" and prep.area > MAX_SURFACE_AREA_M2:
+                raise Skip("absurd_area", f"{prep.area:.3g} m2")
+        except Skip as skip:
+            counts.skip(skip.reason, stype)
+            if stype is not None:
+                counters[stype] += 1
+            continue
+        counts.repaired.update(set(prep.repairs))
         if stype is None:
             stype = str(classify_normal(prep.normal[2]))
         sid = s.surface_id
         if sid is None:
             sid = f"{feature.feature_id}_{stype}_{counters[stype]}"
         counters[stype] += 1
-        written[stype] += 1
-        area[stype] += prep.area
+        counts.written[stype] += 1
+        counts.area[stype] += prep.area
         acc.add(prep, sid, feature.feature_id, stype, s.citygml_class, albedo[stype])
+
+
+def _check_not_empty(report: IngestReport, counts: _Counts, ignored: Counter,
+                     final_dir: Path) -> None:
+    """Refuse an ingest that would replace the city with nothing."""
+    files = ", ".join(report.files)
+    kept = f"{final_dir} left as it was"
+    if report.buildings + report.terrain_features + report.vegetation_features == 0:
+        other = ", ".join(f"{v} {k}" for k, v in ignored.most_common(5))
+        found = f" (found only: {other})" if other else ""
+        raise InputError(f"{files}: no CityGML building, terrain or vegetation object{found}; {kept}")
+    if not counts.written:
+        why = ", ".join(f"{k} {v}" for k, v in counts.skipped.most_common()) or "no geometry"
+        raise InputError(f"{files}: {report.buildings} buildings but no usable polygon "
+                         f"(skipped: {why}); {kept}")
+
+
+def _swap_in(new: Path, final: Path) -> None:
+    """Replace directory *final* by *new* (two renames; :func:`remove_stale_ingests` repairs
+    a kill between them)."""
+    old = final.with_name(f".city-old-{os.getpid()}")
+    if final.exists():
+        if old.exists():
+            shutil.rmtree(old)
+        final.rename(old)
+    new.rename(final)
+    shutil.rmtree(old, ignore_errors=True)
+
+
+def _pid_alive(pid: int) -> bool:
+    if pid == os.getpid():
+        return True
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True
+
+
+def _stale(path: Path, prefix: str) -> bool:
+    tail = path.name[len(prefix):]
+    return tail.isdigit() and not _pid_alive(int(tail))
+
+
+def remove_stale_ingests(data_dir: Path) -> list[Path]:
+    """Remove what killed city ingests left in *data_dir*; return the paths removed.
+
+    ``.city-ingest-<pid>`` (an unfinished new city) and ``city/.ingest-spool-<pid>`` (spools of
+    older versions) go when their process is gone; ``.city-old-<pid>`` (the previous city,
+    when the kill came between the two renames of the swap) is put back if ``city/`` is
+    missing, else removed.
+    """
+    data_dir = Path(data_dir)
+    removed = []
+    final = data_dir / "city"
+    for p in sorted(data_dir.glob(".city-old-*")):
+        if _stale(p, ".city-old-"):
+            if not final.exists():
+                p.rename(final)
+                log.warning("restored %s from an interrupted ingest", final)
+                continue
+            shutil.rmtree(p, ignore_errors=True)
+            removed.append(p)
+    for p in [*data_dir.glob(".city-ingest-*"), *final.glob(".ingest-spool-*")]:
+        prefix = ".city-ingest-" if p.name.startswith(".city-ingest-") else ".ingest-spool-"
+        if p.is_dir() and _stale(p, prefix):
+            shutil.rmtree(p, ignore_errors=True)
+            removed.append(p)
+    for p in removed:
+        log.info("removed %s left by a killed ingest", p)
+    return removed
 
 
 def _write_terrain(city_dir: Path, acc: _Accumulator, crs: str | None) -> int:
@@ -453,16 +637,6 @@ def _write_terrain(city_dir: Path, acc: _Accumulator, crs: str | None) -> int:
              crs=np.str_(crs or ""))
     tmp.replace(out)
     return int(len(triangles))
-
-
-def _remove_stale(city_dir: Path, keep: set) -> None:
-    """Delete tiles of an earlier ingest that this one did not write."""
-    for d in (city_dir / "surfaces").glob("tile=*"):
-        if d.name[len("tile="):] not in keep:
-            shutil.rmtree(d, ignore_errors=True)
-    for f in (city_dir / "meshes").glob("*.npz"):
-        if f.stem not in keep:
-            f.unlink()
 
 
 def _atomic_json(path: Path, data) -> None:

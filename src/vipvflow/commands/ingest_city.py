@@ -18,7 +18,13 @@ def register(sub):
     p.add_argument("--data-dir", type=Path, default=None,
                    help="scenario data dir (default: data_dir of the config)")
     p.add_argument("--crs", default=None,
-                   help="output CRS, also assumed for files without srsName (e.g. EPSG:2169)")
+                   help="output CRS (projected), also assumed for files without srsName (e.g. "
+                        "EPSG:2169); default: the file's CRS, or its local UTM zone when geographic")
+    p.add_argument("--axis-order", choices=["auto", "epsg", "xy"], default="auto",
+                   help="coordinate order in the files: auto (default: the CRS's EPSG order for "
+                        "geographic CRSs; for projected ones the order that fits the CRS's area "
+                        "of use, easting first when both do), epsg (always the EPSG order), "
+                        "xy (always easting/longitude first)")
     p.add_argument("--config", "-c", default=None, help="scenario YAML (tile size, buffer, albedo)")
     p.set_defaults(func=run)
 
@@ -32,7 +38,7 @@ def run(args):
         raise InputError("no CityGML file given (pass FILE... or set inputs.citygml in --config)")
     data_dir = args.data_dir or cfg.data_dir
     crs = args.crs or cfg.inputs.citygml_crs
-    report = ingest_city(files, data_dir, cfg.city, crs=crs)
+    report = ingest_city(files, data_dir, cfg.city, crs=crs, axis_order=args.axis_order)
     print(report.summary())
     print(f"report: {report.report_path}")
     return 0

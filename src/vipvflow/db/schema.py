@@ -95,7 +95,7 @@ SEGMENTS = Table(
 
 SEGMENT_MONTH = Table(
     "segment_month", "segment_month.parquet", ("tile", "segment_id", "month"), [
-        ("tile", "text"), ("segment_id", "bigint"), ("month", "text"), ("shape_id", "text"),
+        ("tile", "text"), ("segment_id", "bigint"), ("month", "date"), ("shape_id", "text"),
         ("route_short_name", "text"), ("direction_id", "integer"), ("n_passes", "bigint"),
         *_cols(_PV, _F), *_cols(_H, _F), ("seconds", _F),
         ("shading_loss", _F), ("shading_loss_clear", _F),
@@ -104,7 +104,7 @@ SEGMENT_MONTH = Table(
 
 TRIP_ENERGY = Table(
     "trip_energy", "trip_energy.parquet", ("route_id", "trip_id", "service_date"), [
-        ("route_id", "text"), ("trip_id", "text"), ("service_date", "date"), ("month", "text"),
+        ("route_id", "text"), ("trip_id", "text"), ("service_date", "date"), ("month", "date"),
         ("route_short_name", "text"), ("direction_id", "integer"), ("shape_id", "text"),
         ("service_id", "text"), ("block_id", "text"), ("pattern_id", "bigint"), ("start_s", _F),
         ("seconds", _F), *_cols(_PV, _F),
@@ -114,7 +114,7 @@ TRIP_ENERGY = Table(
 
 ROUTE_MONTH = Table(
     "route_month", "route_month.parquet", ("route_id", "direction_id", "month"), [
-        ("route_id", "text"), ("direction_id", "integer"), ("month", "text"),
+        ("route_id", "text"), ("direction_id", "integer"), ("month", "date"),
         ("route_short_name", "text"), ("trips", "bigint"), ("seconds", _F), *_cols(_PV, _F),
         ("consumption_kwh", _F), ("coverage", _F), ("shading_loss", _F),
     ], partition_by="month", distribute_by="route_id", colocate_with="trip_energy")
@@ -127,7 +127,7 @@ BLOCK_DAY = Table(
 
 FLEET_MONTH = Table(
     "fleet_month", "monthly.parquet", ("month",), [
-        ("month", "text"), ("trips", "bigint"),
+        ("month", "date"), ("trips", "bigint"),
         *_cols(["pv_kwh", "pv_kwh_clear", "pv_kwh_unshaded", "pv_kwh_clear_unshaded",
                 "consumption_kwh", "avoided_charging_cycles", "kwh_per_kwp_allsky",
                 "kwh_per_kwp_clearsky"], _F),
@@ -135,7 +135,7 @@ FLEET_MONTH = Table(
 
 HOURLY_PATTERN = Table(
     "hourly_pattern", "hourly_pattern.parquet", ("month", "hour"), [
-        ("month", "text"), ("hour", "smallint"), *_cols(_H, _F), ("seconds", _F),
+        ("month", "date"), ("hour", "smallint"), *_cols(_H, _F), ("seconds", _F),
         *_cols(["g_" + h[2:] for h in _H], _F),
     ])
 

@@ -124,6 +124,7 @@ def reduce_run(cfg: Config, year: int, run_dir: Path, say=print) -> dict:
     """Write trip_energy, segments, segment_month, route_month, block_day, monthly, hourly
     outputs, ``summary.json`` and ``report.html``; return the summary."""
     from .. import economics
+    from . import annual
     from .report import write_report
 
     data_dir = Path(cfg.data_dir)
@@ -142,15 +143,11 @@ def reduce_run(cfg: Config, year: int, run_dir: Path, say=print) -> dict:
     trip["coverage"] = trip["pv_kwh"] / trip["consumption_kwh"]
     write_parquet(trip, run_dir / "trip_energy.parquet")
 
-    # --- segments with their geometry factors
+    # --- segments (their geometry factors and year: after the segment-months)
     segments = gpd.read_parquet(data_dir / "gtfs" / "segments.parquet")
     segments = segments[segments["shape_id"].isin(trip["shape_id"].unique())]
     geo = _part_table(run_dir, "geometry", "tile=*.parquet")
-    if geo is not None:
-        geo = geo.to_pandas()
-        keep = [c for c in geo.columns if c == "segment_id" or geo[c].dtype.kind in "fiub"]
-        segments = segments.merge(geo[keep], on="segment_id", how="left")
-    write_parquet(segments, run_dir / "segments.parquet")
+    geo = geo.to_pandas() if geo is not None else None
 
     # --- segment-month (GeoParquet for maps)
     sm = _read_parts(run_dir, "segment_month")
@@ -165,6 +162,12 @@ def reduce_run(cfg: Config, year: int, run_dir: Path, say=print) -> dict:
     smg = gpd.GeoDataFrame(smg.merge(shape_route, on="shape_id", how="left"),
                            geometry="geometry", crs=segments.crs)
     write_parquet(smg, run_dir / "segment_month.parquet")
+    hours_per_bus = annual.service_hours_per_bus(
+        float(trip["seconds"].sum()), int(trip.groupby("service_date")["block_id"].nunique().max()),
+        12.0 / len(cfg.run.months))
+    segments = annual.segment_year(segments.merge(shape_route, on="shape_id", how="left"), geo, sm,
+                                   cfg.pv_system().kwp, hours_per_bus)
+    write_parquet(segments, run_dir / "segments.parquet")
 
     # --- route-direction-month
     agg = {c: "sum" for c in kwh_cols + ["consumption_kwh"]}
@@ -246,7 +249,8 @@ def reduce_run(cfg: Config, year: int, run_dir: Path, say=print) -> dict:
         "unshaded_to_ghi_clearsky": float(tot["h_total_clear_unshaded"] / tot["h_ghi_clear"]),
         "reflected_share": float(tot["h_reflected"] / tot["h_total"]),
         **eco,
+        **annual.per_bus_figures(tot, n_buses, annualise, hours_per_bus, data_dir, year),
     }
     write_json(summary, run_dir / "summary.json")
-    write_report(run_dir, summary, monthly, smg, hp, rm)
+    write_report(run_dir, summary, monthly, smg, hp, rm, cfg=cfg, segments=segments)
     return summary

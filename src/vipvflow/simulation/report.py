@@ -1,4 +1,10 @@
-"""``report.html``: the run's figures (PNG, also in ``figures/``) and its summary table."""
+"""``report.html``: the run's summary table, how to read it, its inputs and CRS, and its figures
+(PNG, also in ``figures/``).
+
+The maps show each segment's year (:mod:`vipvflow.simulation.annual`) over the building
+footprints of the city model (:func:`vipvflow.city.footprints.building_footprints`): the
+whole network, and a close-up of the street canyons (where the roofs see least sky).
+"""
 from __future__ import annotations
 
 import base64
@@ -12,7 +18,17 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
-from matplotlib.collections import LineCollection  # noqa: E402
+from matplotlib.collections import LineCollection, PolyCollection  # noqa: E402
+from matplotlib.patches import Rectangle  # noqa: E402
+
+from .dictionary import SUMMARY  # noqa: E402
+
+#: colour limits of the maps: these percentiles of the segments' values (a few segments with
+#: a stop or a tunnel-like canyon would otherwise flatten the rest)
+MAP_PERCENTILES = (2.0, 98.0)
+
+#: side of the close-up map (m)
+CLOSE_UP_M = 1200.0
 
 
 def _save(fig, run_dir: Path, name: str) -> str:
@@ -26,59 +42,109 @@ def _save(fig, run_dir: Path, name: str) -> str:
     return base64.b64encode(data).decode()
 
 
+def _months(values) -> pd.DatetimeIndex:
+    """Months given as ``YYYY-MM`` strings or dates, as timestamps of their first day."""
+    return pd.DatetimeIndex(pd.to_datetime(pd.Series(values).astype(str).str.slice(0, 7), format="%Y-%m"))
+
+
 def fig_monthly(monthly: pd.DataFrame, summary: dict):
     fig, ax = plt.subplots(figsize=(8, 4))
     x = np.arange(len(monthly))
-    kwp_bus = summary["kwp_per_bus"] * summary["buses"]
-    ax.bar(x - 0.2, monthly["pv_kwh_clear"] / kwp_bus, 0.4, label="clear-sky", color="#f4b400")
-    ax.bar(x + 0.2, monthly["pv_kwh"] / kwp_bus, 0.4, label="all-sky", color="#4285f4")
-    ax.plot(x - 0.2, monthly["pv_kwh_clear_unshaded"] / kwp_bus, "k_", ms=14, label="without buildings")
-    ax.plot(x + 0.2, monthly["pv_kwh_unshaded"] / kwp_bus, "k_", ms=14)
-    ax.set_xticks(x, [m[5:] for m in monthly["month"]])
-    ax.set_xlabel("month")
-    ax.set_ylabel("kWh per kWp per bus")
-    ax.set_title("Monthly PV yield; the gap to the black marks is the shading loss")
-    ax.legend()
+    kwp = summary["kwp_per_bus"] * summary["buses"]
+    ax.bar(x - 0.2, monthly["pv_kwh_clear"] / kwp, 0.4, label="clear-sky", color="#f4b400")
+    ax.bar(x + 0.2, monthly["pv_kwh"] / kwp, 0.4, label="all-sky", color="#4285f4")
+    ax.plot(x - 0.2, monthly["pv_kwh_clear_unshaded"] / kwp, "k_", ms=14, label="without buildings")
+    ax.plot(x + 0.2, monthly["pv_kwh_unshaded"] / kwp, "k_", ms=14)
+    ax.set_xticks(x, _months(monthly["month"]).strftime("%b"))
+    ax.set_ylabel("PV energy (kWh per installed kWp)")
+    ax.set_title("Monthly PV yield of the fleet; the gap to the black marks is the shading loss")
+    ax.legend(loc="upper left", fontsize=8)
     return fig
 
 
-def fig_map(smg, column: str, label: str, cmap: str):
-    annual = smg.groupby("segment_id").agg(
-        geometry=("geometry", "first"), h_total=("h_total", "sum"),
-        h_direct=("h_direct", "sum"), h_diffuse=("h_diffuse", "sum"),
-        h_total_unshaded=("h_total_unshaded", "sum"), n_passes=("n_passes", "sum"),
-        pv_kwh=("pv_kwh", "sum"))
-    annual["shading_loss"] = 1 - (annual["h_direct"] + annual["h_diffuse"]) / annual["h_total_unshaded"].where(
-        annual["h_total_unshaded"] > 0)
-    annual["yield_wh_per_pass"] = 1000 * annual["pv_kwh"] / annual["n_passes"].where(annual["n_passes"] > 0)
-    lines = [np.asarray(g.coords)[:, :2] for g in annual["geometry"]]
-    fig, ax = plt.subplots(figsize=(7, 6))
-    lc = LineCollection(lines, array=annual[column].to_numpy(), cmap=cmap, linewidths=2.5)
-    ax.add_collection(lc)
-    ax.autoscale()
-    ax.set_aspect("equal")
-    ax.set_xlabel("x (m)")
-    ax.set_ylabel("y (m)")
-    fig.colorbar(lc, ax=ax, label=label)
+def _segment_lines(segments) -> list[np.ndarray]:
+    return [np.asarray(g.coords)[:, :2] for g in segments.geometry]
+
+
+def _robust_limits(values: np.ndarray) -> tuple[float, float]:
+    v = values[np.isfinite(values)]
+    if not len(v):
+        return 0.0, 1.0
+    lo, hi = np.percentile(v, MAP_PERCENTILES)
+    return (float(lo), float(hi)) if hi > lo else (float(lo) - 0.5, float(lo) + 0.5)
+
+
+def close_up_window(segments, side_m: float = CLOSE_UP_M) -> tuple[float, float, float, float]:
+    """(xmin, ymin, xmax, ymax) of a square of *side_m* around the street canyons: the
+    middle of the 5 % of segments whose roofs see the least sky (``svf``), or of the most
+    shaded ones when the run has no sky view factors."""
+    import shapely
+
+    mid = shapely.get_coordinates(shapely.line_interpolate_point(
+        np.asarray(segments.geometry.values), 0.5, normalized=True))
+    key = segments["svf"] if "svf" in segments and segments["svf"].notna().any() else -segments["shading_loss"]
+    key = key.fillna(key.max()).to_numpy()
+    n = max(1, int(0.05 * len(key)))
+    cx, cy = np.median(mid[np.argsort(key, kind="stable")[:n]], axis=0)
+    h = side_m / 2
+    return cx - h, cy - h, cx + h, cy + h
+
+
+def fig_map(segments, column: str, label: str, cmap: str, title: str, footprints=(), crs_label: str = "",
+            scale: float = 1.0):
+    """The segments coloured by *column* (x *scale*) over the building footprints: the whole
+    network and a close-up of the canyons, colour limits at :data:`MAP_PERCENTILES`."""
+    values = segments[column].to_numpy(np.float64) * scale
+    vmin, vmax = _robust_limits(values)
+    lines = _segment_lines(segments)
+    window = close_up_window(segments)
+    fig, axes = plt.subplots(1, 2, figsize=(13, 5.2), gridspec_kw={"width_ratios": [1.6, 1]},
+                             layout="constrained")
+    for ax, zoom in zip(axes, (False, True)):
+        if len(footprints):
+            ax.add_collection(PolyCollection(footprints, facecolors="#d4d4d4", edgecolors="#a8a8a8",
+                                             linewidths=0.3, zorder=1))
+        lc = LineCollection(lines, array=values, cmap=cmap, linewidths=4.0 if zoom else 1.8,
+                            zorder=2, capstyle="butt")
+        lc.set_clim(vmin, vmax)
+        ax.add_collection(lc)
+        ax.set_aspect("equal")
+        ax.ticklabel_format(useOffset=False, style="plain")
+        ax.tick_params(labelsize=8)
+        if zoom:
+            ax.set_xlim(window[0], window[2])
+            ax.set_ylim(window[1], window[3])
+            ax.set_title("close-up: the street canyons (least sky seen)", fontsize=10)
+        else:
+            xy = np.concatenate(lines)
+            pad = 0.03 * max(np.ptp(xy[:, 0]), np.ptp(xy[:, 1]))
+            ax.set_xlim(xy[:, 0].min() - pad, xy[:, 0].max() + pad)
+            ax.set_ylim(xy[:, 1].min() - pad, xy[:, 1].max() + pad)
+            ax.add_patch(Rectangle(window[:2], window[2] - window[0], window[3] - window[1], fill=False,
+                                   edgecolor="#d62728", linewidth=1.2, zorder=3))
+            ax.set_title("the simulated network (red: close-up)", fontsize=10)
+        ax.set_xlabel(f"easting (m), {crs_label}" if crs_label else "easting (m)", fontsize=9)
+        ax.set_ylabel("northing (m)", fontsize=9)
+    fig.colorbar(lc, ax=axes, label=label, extend="both", shrink=0.8)
+    fig.suptitle(title)
     return fig
 
 
 def fig_cycles(monthly: pd.DataFrame):
     fig, ax = plt.subplots(figsize=(8, 3.5))
-    ax.bar([m[5:] for m in monthly["month"]], monthly["avoided_charging_cycles"], color="#0f9d58")
-    ax.set_xlabel("month")
+    ax.bar(_months(monthly["month"]).strftime("%b"), monthly["avoided_charging_cycles"], color="#0f9d58")
     ax.set_ylabel("avoided charging cycles (fleet)")
     ax.set_title("Charging cycles avoided by PV (usable SoC window)")
     return fig
 
 
 def fig_hourly(hp: pd.DataFrame):
+    hp = hp.assign(month=_months(hp["month"]))
     grid = hp.pivot_table(index="hour", columns="month", values="g_total", aggfunc="sum")
     fig, ax = plt.subplots(figsize=(8, 4.5))
     im = ax.imshow(grid.to_numpy(), aspect="auto", origin="lower", cmap="inferno",
                    extent=[0.5, grid.shape[1] + 0.5, grid.index.min() - 0.5, grid.index.max() + 0.5])
-    ax.set_xticks(range(1, grid.shape[1] + 1), [m[5:] for m in grid.columns])
-    ax.set_xlabel("month")
+    ax.set_xticks(range(1, grid.shape[1] + 1), pd.DatetimeIndex(grid.columns).strftime("%b"))
     ax.set_ylabel("local hour")
     fig.colorbar(im, ax=ax, label="mean roof irradiance in service (W/m²)")
     ax.set_title("Daily irradiance pattern by hour and month (all-sky)")
@@ -103,33 +169,187 @@ def fig_routes(rm: pd.DataFrame):
     return fig
 
 
-def write_report(run_dir: Path, summary: dict, monthly, smg, hp, rm) -> Path:
+# ---------------------------------------------------------------------------- the table
+#: rows of the summary table: (section, key, label, unit, decimals, percent)
+_ROWS = [
+    ("Fleet and network", "routes", "routes", "", 0, False),
+    ("Fleet and network", "buses", "buses (most vehicle blocks on one day)", "", 0, False),
+    ("Fleet and network", "trips", "trips simulated", "", 0, False),
+    ("Fleet and network", "segments", "road segments", "", 0, False),
+    ("Fleet and network", "passes", "segment passes evaluated", "", 0, False),
+    ("Fleet and network", "service_hours_per_bus_year", "service time per bus", "h/year", 0, False),
+    ("PV yield", "kwp_per_bus", "PV installed per bus", "kWp", 2, False),
+    ("PV yield", "kwh_per_kwp_allsky", "specific yield, all-sky", "kWh/kWp per year", 0, False),
+    ("PV yield", "kwh_per_kwp_clearsky", "specific yield, clear-sky", "kWh/kWp per year", 0, False),
+    ("PV yield", "pv_kwh_allsky", "PV energy of the fleet, all-sky", "kWh (simulated months)", 0, False),
+    ("PV yield", "pv_kwh_clearsky", "the same under a cloudless sky", "kWh (simulated months)", 0, False),
+    ("PV yield", "pv_kwh_allsky_unshaded", "the same, all-sky, without buildings", "kWh (simulated months)", 0, False),
+    ("Buildings", "shading_loss_allsky", "shading loss, all-sky", "%", 1, True),
+    ("Buildings", "shading_loss_clearsky", "shading loss, clear-sky", "%", 1, True),
+    ("Buildings", "reflection_gain_allsky", "gain from reflections, all-sky", "%", 1, True),
+    ("Buildings", "net_building_effect_allsky", "net effect of the buildings, all-sky", "%", 1, True),
+    ("Light", "site_ghi_kwh_m2_year", "global horizontal irradiation of the site", "kWh/m² per year", 0, False),
+    ("Light", "ghi_in_service_kwh_m2_per_bus", "of which while a bus is in service", "kWh/m² per year", 0, False),
+    ("Light", "roof_irradiation_unshaded_kwh_m2_per_bus", "on a bus roof, without buildings",
+     "kWh/m² per year", 0, False),
+    ("Light", "roof_irradiation_kwh_m2_per_bus", "on a bus roof, with buildings", "kWh/m² per year", 0, False),
+    ("Energy and cost", "fleet_demand_mwh", "battery energy the fleet uses", "MWh per year", 0, False),
+    ("Energy and cost", "coverage", "share of it the roofs supply", "%", 2, True),
+    ("Energy and cost", "avoided_charging_cycles_fleet", "charging cycles avoided, fleet", "per year", 0, False),
+    ("Energy and cost", "avoided_charging_cycles_per_bus", "charging cycles avoided per bus", "per year", 1, False),
+    ("Energy and cost", "system_cost_eur_per_bus", "PV system cost per bus", "EUR", 0, False),
+    ("Energy and cost", "payback_years", "simple payback", "years", 1, False),
+    ("Model", "pv_mode", "PV model", "", 0, False),
+    ("Model", "diffuse_model", "sky diffuse model", "", 0, False),
+    ("Model", "annualised_from_months", "yearly figures scaled from fewer months", "", 0, False),
+]
+
+
+def _fmt(v, decimals: int | None = None, percent: bool = False) -> str:
+    """A value for people: thousands separators, % for fractions, *decimals* after the
+    point (``None``: 0 from 100 up, 2 from 1, 3 below)."""
+    if v is None:
+        return "n/a"
+    if isinstance(v, (bool, np.bool_)):
+        return "yes" if v else "no"
+    if not isinstance(v, (int, float, np.integer, np.floating)):
+        return str(v)
+    if not np.isfinite(v):
+        return "n/a"
+    if decimals is None:
+        size = abs(100 * v if percent else v)
+        decimals = 0 if size >= 100 else 2 if size >= 1 else 3
+    if percent:
+        return f"{100 * v:,.{decimals}f}"
+    if isinstance(v, (int, np.integer)):
+        return f"{v:,d}"
+    return f"{v:,.{decimals}f}"
+
+
+def summary_table(summary: dict) -> str:
+    """The summary as an HTML table by section (value, unit; the meaning on hover); keys
+    not in the curated rows are listed under "More" with the data dictionary's unit."""
+    rows, section, shown = [], None, set()
+    for sec, key, label, unit, decimals, percent in _ROWS:
+        if key not in summary:
+            continue
+        shown.add(key)
+        if sec != section:
+            rows.append(f"<tr><th colspan='3' class='sec'>{html.escape(sec)}</th></tr>")
+            section = sec
+        meaning = SUMMARY[key].meaning if key in SUMMARY else ""
+        rows.append(f"<tr title='{html.escape(meaning)}'><td>{html.escape(label)}</td>"
+                    f"<td class='num'>{html.escape(_fmt(summary[key], decimals, percent))}</td>"
+                    f"<td>{html.escape(unit)}</td></tr>")
+    more = [k for k, v in summary.items() if k not in shown and not isinstance(v, (dict, list))
+            and k not in ("scenario", "year")]
+    if more:
+        rows.append("<tr><th colspan='3' class='sec'>More (see docs/outputs.md)</th></tr>")
+        for k in more:
+            entry = SUMMARY.get(k)
+            unit = entry.unit if entry else ""
+            pct = unit == "fraction"
+            rows.append(f"<tr title='{html.escape(entry.meaning if entry else '')}'><td><code>{html.escape(k)}</code></td>"
+                        f"<td class='num'>{html.escape(_fmt(summary[k], None, pct))}</td>"
+                        f"<td>{'%' if pct else html.escape(unit)}</td></tr>")
+    return f"<table class='summary'>{''.join(rows)}</table>"
+
+
+def _how_to_read(summary: dict) -> str:
+    s = summary
+    pct = lambda k: _fmt(s.get(k), 1, True)  # noqa: E731
+    return (
+        "<p>Every bus of the timetable carries the same PV roof. For each short road segment "
+        "(10 m by default) a bus passes, vipvflow computes the sun and sky light on the roof from CAMS radiation, with the "
+        "3D city model's buildings casting shadows, hiding sky and reflecting light, and turns it "
+        "into PV energy. <b>Specific yield</b> is the PV energy per installed kWp in a year: "
+        f"{_fmt(s.get('kwh_per_kwp_allsky'), 0)} kWh/kWp here under the real (all-sky) weather, "
+        f"{_fmt(s.get('kwh_per_kwp_clearsky'), 0)} under a cloudless sky. A bus roof receives "
+        "light only while the bus is in service, and partly in the streets' shade, so it collects "
+        "less than a fixed panel at the site would. The <b>shading loss</b> "
+        f"({pct('shading_loss_allsky')} %) is the direct and sky light the buildings take away; the "
+        f"light they reflect onto the roof is counted apart ({pct('reflection_gain_allsky')} %). "
+        "Yearly figures are per bus or per kWp; totals marked \"simulated months\" are sums over "
+        "the run. On the maps each segment shows the year of a bus that spent all its service "
+        "hours in that segment's light, so a street's colour does not depend on how many buses "
+        "use it or how long they stop there. Every column of the output files is explained, with "
+        "its unit, in <code>docs/outputs.md</code> and in the files' own metadata.</p>")
+
+
+def _inputs_table(cfg, crs_label: str, tiles: int | None) -> str:
+    rows = []
+    if cfg is not None:
+        inp = cfg.inputs
+        rows += [("scenario", cfg.scenario), ("configuration", getattr(cfg, "_source", "")),
+                 ("CityGML", ", ".join(str(p) for p in inp.citygml) or "-"),
+                 ("GTFS feed", str(inp.gtfs) if inp.gtfs else "-"),
+                 ("CAMS radiation", ", ".join(str(p) for p in inp.cams) or "-"),
+                 ("data directory", str(cfg.data_dir)),
+                 ("routes", ", ".join(cfg.run.routes) if cfg.run.routes else "all")]
+    rows.append(("coordinate reference system", crs_label or "unknown"))
+    if tiles:
+        rows.append(("city tiles crossed", f"{tiles:,d}"))
+    body = "".join(f"<tr><td>{html.escape(k)}</td><td><code>{html.escape(str(v))}</code></td></tr>"
+                   for k, v in rows)
+    return f"<table class='inputs'>{body}</table>"
+
+
+def crs_label(crs) -> str:
+    """``EPSG:2169 (LUREF / Luxembourg TM)`` for a pyproj CRS; '' for None."""
+    if crs is None:
+        return ""
+    epsg = crs.to_epsg()
+    return f"EPSG:{epsg} ({crs.name})" if epsg else crs.name
+
+
+def write_report(run_dir: Path, summary: dict, monthly, smg, hp, rm, cfg=None, segments=None) -> Path:
+    """Write ``report.html`` and ``figures/*.png``.
+
+    *segments*: the run's ``segments.parquet`` frame (each segment's year); read from
+    *run_dir* when not given. *cfg*: the run's configuration (inputs, data directory for
+    the building footprints)."""
+    import geopandas as gpd
+
+    from ..city.footprints import building_footprints
+
+    if segments is None:
+        segments = gpd.read_parquet(run_dir / "segments.parquet")
+    segments = segments[segments["n_passes"].fillna(0) > 0] if "n_passes" in segments else segments
+    crs = crs_label(segments.crs)
+    tiles = sorted(segments["tile"].unique()) if "tile" in segments else None
+    footprints = []
+    if cfg is not None:
+        xmin, ymin, xmax, ymax = segments.total_bounds
+        footprints = building_footprints(cfg.data_dir, tiles=tiles,
+                                         bounds=(xmin - 200, ymin - 200, xmax + 200, ymax + 200))
     figs = [
         ("monthly_yield", "Monthly yield, clear-sky vs all-sky, with shading losses", fig_monthly(monthly, summary)),
-        ("map_yield", "Segment-level yield (Wh per pass)",
-         fig_map(smg, "yield_wh_per_pass", "PV energy per pass (Wh)", "viridis")),
-        ("map_shading", "Segment-level shading loss", fig_map(smg, "shading_loss", "shading loss (all-sky)", "magma_r")),
+        ("map_yield", "Yield per segment",
+         fig_map(segments, "kwh_per_kwp_year", "specific yield (kWh/kWp per year)", "viridis",
+                 "PV yield of a bus in each segment's light, all-sky (kWh/kWp per year)", footprints, crs)),
+        ("map_shading", "Shading loss per segment",
+         fig_map(segments, "shading_loss", "shading loss, all-sky (%)", "magma_r",
+                 "Direct and sky light the buildings take away, all-sky (%)", footprints, crs, scale=100.0)),
         ("avoided_cycles", "Avoided charging cycles per month", fig_cycles(monthly)),
         ("hourly_pattern", "Daily irradiance pattern by hour and month", fig_hourly(hp)),
         ("routes", "Route comparison", fig_routes(rm)),
     ]
     parts = []
     for name, title, fig in figs:
-        parts.append(f"<h2>{html.escape(title)}</h2><img alt='{name}' src='data:image/png;base64,{_save(fig, run_dir, name)}'>")
-    rows = "".join(f"<tr><th>{html.escape(str(k))}</th><td>{html.escape(_fmt(v))}</td></tr>"
-                   for k, v in summary.items() if not isinstance(v, dict))
+        parts.append(f"<h2>{html.escape(title)}</h2>"
+                     f"<img alt='{name}' src='data:image/png;base64,{_save(fig, run_dir, name)}'>")
+    title = f"{summary['scenario']} {summary['year']}"
     doc = f"""<!doctype html><html><head><meta charset="utf-8">
-<title>vipvflow: {html.escape(summary['scenario'])} {summary['year']}</title>
-<style>body{{font-family:sans-serif;max-width:1000px;margin:2em auto}}img{{max-width:100%}}
-td,th{{text-align:left;padding:2px 8px}}</style></head><body>
-<h1>VIPV fleet-year: {html.escape(summary['scenario'])} {summary['year']}</h1>
-<table>{rows}</table>{''.join(parts)}</body></html>"""
+<title>vipvflow: {html.escape(title)}</title>
+<style>body{{font-family:sans-serif;max-width:1100px;margin:2em auto;color:#222}}img{{max-width:100%}}
+td,th{{text-align:left;padding:2px 10px}}td.num{{text-align:right;font-variant-numeric:tabular-nums}}
+th.sec{{padding-top:10px;border-bottom:1px solid #ccc}}tr[title]:hover{{background:#f4f4f4}}
+p{{line-height:1.45;max-width:900px}}</style></head><body>
+<h1>Bus-roof PV, fleet-year: {html.escape(title)}</h1>
+<h2>How to read this</h2>{_how_to_read(summary)}
+<h2>Summary</h2>{summary_table(summary)}
+<h2>Inputs</h2>{_inputs_table(cfg, crs, len(tiles) if tiles else None)}
+{''.join(parts)}</body></html>"""
     path = run_dir / "report.html"
     path.write_text(doc, encoding="utf-8")
     return path
-
-
-def _fmt(v) -> str:
-    if isinstance(v, float):
-        return f"{v:,.4g}"
-    return str(v)

@@ -40,18 +40,39 @@ def write_parquet(df: pd.DataFrame, path: Path) -> Path:
     """Write *df* (DataFrame or GeoDataFrame) to *path* atomically (temporary name, rename).
 
     Plain tables (numbers, bools, dates, strings) go straight to pyarrow: pandas' own
-    conversion costs more than the write for the run's wide, small tables."""
+    conversion costs more than the write for the run's wide, small tables.  A file named as
+    one of the run's outputs (``trip_energy.parquet``, ... :data:`dictionary.OUTPUTS`) is
+    written as the data dictionary describes it: ``month`` as a date, every documented
+    column with its unit and meaning in the field metadata."""
     import pyarrow.parquet as pq
+
+    from .dictionary import OUTPUTS, annotate
 
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    output = path.stem if path.suffix == ".parquet" and path.stem in OUTPUTS else None
     table = _plain_table(df)
+    if table is None and output is not None:
+        table = _arrow_table(df)
     if table is None:
         df.to_parquet(tmp, index=False)
     else:
-        pq.write_table(table, tmp)
+        pq.write_table(annotate(table, output) if output else table, tmp)
     os.replace(tmp, path)
     return path
+
+
+def _arrow_table(df: pd.DataFrame):
+    """*df* as pyarrow converts it for ``to_parquet`` (GeoDataFrames with their GeoParquet
+    metadata)."""
+    import pyarrow as pa
+
+    if hasattr(df, "geometry"):
+        # geopandas' own conversion of to_parquet (WKB geometry, "geo" schema metadata)
+        from geopandas.io.arrow import _geopandas_to_arrow
+
+        return _geopandas_to_arrow(df, index=False)
+    return pa.Table.from_pandas(df, preserve_index=False)
 
 
 def write_json(obj, path: Path) -> Path:

@@ -1,0 +1,351 @@
+"""The data dictionary of a run's outputs: every column of every output file, its unit and meaning.
+
+The same entries go three ways: into each output Parquet file as field metadata (``unit``,
+``description``; :func:`annotate`, applied by :func:`vipvflow.simulation.storage.write_parquet`
+to files named as an output), into ``docs/outputs.md`` (:func:`render_markdown`, kept in sync
+by a test) and into the report.
+
+A column is looked up first in its file's own entries (:data:`OUTPUTS`), then in the
+vocabulary shared by every file (:data:`COLUMNS`); the file says what one row holds, so
+``pv_kwh`` is "PV energy" of a trip in ``trip_energy`` and of a month in ``monthly``.
+Columns nobody documented are written without metadata (never an error); the tests require
+an entry for every column a run writes.
+
+Months are dates: ``month`` is written as a Parquet ``date32``, the first day of the month
+(local calendar of the feed), whatever the table held in memory (``"YYYY-MM"`` strings).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True)
+class Column:
+    unit: str
+    meaning: str
+
+
+#: the light a roof receives, by component and sky (``h_<c>`` sums, ``g_<c>`` means, ``pv_kwh_<c>``)
+_LIGHT = {
+    "direct": "beam (direct) light on the roof, after the buildings' shadow",
+    "diffuse": "sky diffuse light on the roof, from the part of the sky the buildings leave open",
+    "reflected": "light reflected onto the roof by the buildings and the ground",
+    "total": "all light on the roof: direct + diffuse + reflected, with the buildings",
+    "total_unshaded": "all light on the roof without any building (the reference of the shading loss)",
+    "ghi": "global horizontal irradiance of the sky (CAMS) at the times of the passes, for comparison",
+}
+
+
+def _light(component: str) -> str:
+    clear = component.endswith("_clear") or "_clear_" in component
+    base = component.replace("_clear", "")
+    sky = "clear-sky (CAMS McClear)" if clear else "all-sky (CAMS)"
+    return f"{_LIGHT[base]}; {sky}"
+
+
+_PV = {
+    "pv_kwh": "PV energy, all-sky, with the buildings (shading and reflections): the run's result",
+    "pv_kwh_clear": "PV energy, clear-sky (cloudless reference), with the buildings",
+    "pv_kwh_unshaded": "PV energy, all-sky, without buildings (shading loss reference)",
+    "pv_kwh_clear_unshaded": "PV energy, clear-sky, without buildings",
+    "pv_kwh_direct": "part of pv_kwh from direct (beam) light",
+    "pv_kwh_diffuse": "part of pv_kwh from sky diffuse light",
+    "pv_kwh_reflected": "part of pv_kwh from light the buildings and the ground reflect",
+    # the whole-day model (energy outside the timetabled trips and what the battery refused)
+    "pv_kwh_driving": "PV energy while driving timetabled trips (whole-day model)",
+    "pv_kwh_layover": "PV energy while standing at terminals between trips (whole-day model)",
+    "pv_kwh_parked": "PV energy while parked out of service, e.g. at the depot (whole-day model)",
+    "pv_kwh_curtailed": "PV energy the battery could not take (full), lost (whole-day model)",
+}
+
+_COMPONENTS = ["direct", "diffuse", "reflected", "total", "total_unshaded",
+               "direct_clear", "diffuse_clear", "reflected_clear", "total_clear",
+               "total_clear_unshaded", "ghi", "ghi_clear"]
+
+#: columns shared by the output files (a file's own entry overrides)
+COLUMNS: dict[str, Column] = {
+    # keys and labels
+    "segment_id": Column("", "segment number (gtfs/segments.parquet), 0..N-1"),
+    "shape_id": Column("", "GTFS shape_id: the path the buses drive"),
+    "seg_index": Column("", "position of the segment along its shape, from 0"),
+    "tile": Column("", "city tile holding the segment's start, named by its south-west corner in "
+                       "hundreds of metres of the city CRS (E0770N0750: x 77,000 m, y 75,000 m)"),
+    "trip_id": Column("", "GTFS trip_id"),
+    "service_date": Column("date", "GTFS service date (local calendar of the feed)"),
+    "month": Column("date", "month, as its first day (local calendar of the feed)"),
+    "hour": Column("h", "local clock hour, 0..23 (hour starting then)"),
+    "route_id": Column("", "GTFS route_id"),
+    "route_short_name": Column("", "GTFS route_short_name (the line's public name)"),
+    "direction_id": Column("", "GTFS direction_id (0 or 1)"),
+    "service_id": Column("", "GTFS service_id (the trip's calendar)"),
+    "block_id": Column("", "GTFS block_id: one vehicle's sequence of trips in a day"),
+    "pattern_id": Column("", "stop pattern of the trip (same stops and times: same driving cycle)"),
+    "trips": Column("count", "trips (trip x service date) in the row"),
+    "n_passes": Column("count", "segment passes: one bus crossing the segment once"),
+    "seconds": Column("s", "time buses spent on the road in the row (sum over passes, stops included)"),
+    "start_s": Column("s", "departure of the trip, seconds after local midnight of the service date "
+                           "(may exceed 86,400 after midnight)"),
+    "first_departure_s": Column("s", "first departure of the block that day, seconds after local midnight"),
+    "geometry": Column("m (CRS in the GeoParquet metadata)",
+                       "the segment's line (LineString Z at roof height) in the city's projected CRS"),
+    # consumption and economics
+    "consumption_kwh": Column("kWh", "battery energy the bus used (vehicle model or VECTO), at the "
+                                     "month's mean temperature"),
+    "consumption_source": Column("", "'built-in' (vipvflow's vehicle model) or 'vecto' (VECTO modal results)"),
+    "traction_kwh": Column("kWh", "energy at the wheels for driving (vehicle model)"),
+    "recuperated_kwh": Column("kWh", "braking energy recovered into the battery (vehicle model)"),
+    "aux_kwh": Column("kWh", "auxiliaries: base load and heating/cooling at the month's temperature"),
+    "coverage": Column("fraction", "pv_kwh / consumption_kwh: share of the battery energy the roof supplied"),
+    "shading_loss": Column("fraction", "1 - (direct + diffuse) / total_unshaded, all-sky: light the "
+                                       "buildings take away (reflections not counted; see reflection_gain)"),
+    "shading_loss_clear": Column("fraction", "shading_loss under clear sky"),
+    "reflection_gain": Column("fraction", "reflected / total_unshaded, all-sky: light the buildings add"),
+    "avoided_charging_cycles": Column("cycles", "pv_kwh / (battery capacity x usable SoC window), fleet"),
+    "kwh_per_kwp_allsky": Column("kWh/kWp", "all-sky PV energy per installed kWp of the fleet (specific yield)"),
+    "kwh_per_kwp_clearsky": Column("kWh/kWp", "clear-sky PV energy per installed kWp of the fleet"),
+    # segment geometry (gtfs/segments.parquet)
+    "x": Column("m", "segment start, easting in the city CRS"),
+    "y": Column("m", "segment start, northing in the city CRS"),
+    "z": Column("m", "roof height at the segment start (ground + roof height), in the CRS's height system"),
+    "x_end": Column("m", "segment end, easting"),
+    "y_end": Column("m", "segment end, northing"),
+    "z_end": Column("m", "roof height at the segment end"),
+    "ground_z": Column("m", "ground (terrain) height at the segment start"),
+    "heading_deg": Column("deg", "driving direction, clockwise from grid north"),
+    "gradient": Column("m/m", "road gradient dz/ds of the ground (positive uphill)"),
+    "length_m": Column("m", "segment length along the shape"),
+    "cum_dist_m": Column("m", "distance of the segment start from the shape's start"),
+    # public geometry factors (parts/geometry holds the internal reflector geometry)
+    "tilt_deg": Column("deg", "roof tilt (follows the road gradient)"),
+    "azimuth_deg": Column("deg", "direction the tilted roof faces, clockwise from north"),
+    "svf": Column("fraction", "sky view factor of the roof: cosine-weighted share of the sky it sees "
+                              "(1 on open flat ground)"),
+    "refl_vf": Column("fraction", "albedo-weighted view factor of the building and ground surfaces the roof sees"),
+    # per segment over the run's months
+    "g_total_in_service": Column("W/m2", "mean all-sky irradiance on the roof while buses are on the "
+                                         "segment (h_total / seconds)"),
+    "g_total_unshaded_in_service": Column("W/m2", "the same without buildings"),
+    "kwh_per_kwp_year": Column("kWh/kWp per year",
+                               "specific yield of a bus that spent its whole service year in this "
+                               "segment's light: pv_kwh per kWp and hour on the segment x the fleet's "
+                               "service hours per bus and year (the fleet's kWh/kWp is their "
+                               "time-weighted mean)"),
+    "irradiation_kwh_m2_year": Column("kWh/m2 per year",
+                                      "the same for the all-sky light on the roof: mean irradiance on "
+                                      "the segment x service hours per bus and year"),
+    **{k: Column("kWh", v) for k, v in _PV.items()},
+    **{f"h_{c}": Column("Wh/m2", f"irradiation summed over the row's passes (every bus, every pass): "
+                                 f"{_light(c)}") for c in _COMPONENTS},
+    **{f"g_{c}": Column("W/m2", f"mean irradiance while buses are on the road: {_light(c)}")
+       for c in _COMPONENTS},
+}
+
+
+@dataclass(frozen=True)
+class Output:
+    title: str
+    rows: str
+    columns: tuple[str, ...]
+    own: dict
+
+
+def _out(title: str, rows: str, columns: str, **own: Column) -> Output:
+    return Output(title, rows, tuple(columns.split()), own)
+
+
+_PVS = "pv_kwh pv_kwh_clear pv_kwh_unshaded pv_kwh_clear_unshaded pv_kwh_direct pv_kwh_diffuse pv_kwh_reflected"
+_HS = " ".join(f"h_{c}" for c in _COMPONENTS)
+_GS = " ".join(f"g_{c}" for c in _COMPONENTS)
+_WHOLE_DAY = "pv_kwh_driving pv_kwh_layover pv_kwh_parked pv_kwh_curtailed"
+
+#: the run's output files (``<name>.parquet`` in ``out/<scenario>/<year>/``), in reading order
+OUTPUTS: dict[str, Output] = {
+    "trip_energy": _out(
+        "PV and consumption per trip", "one row per trip and service date",
+        f"trip_id service_date month route_id route_short_name direction_id shape_id service_id "
+        f"block_id pattern_id start_s seconds {_PVS} consumption_kwh consumption_source "
+        f"traction_kwh recuperated_kwh aux_kwh coverage"),
+    "segments": _out(
+        "The network's segments, their geometry factors and their year (GeoParquet)",
+        "one row per segment of the simulated routes (about 10 m of road); totals over the run's months",
+        f"segment_id shape_id route_short_name direction_id seg_index tile geometry x y z x_end y_end "
+        f"z_end ground_z heading_deg gradient length_m cum_dist_m tilt_deg azimuth_deg svf refl_vf "
+        f"n_passes seconds pv_kwh pv_kwh_unshaded h_total h_total_unshaded g_total_in_service "
+        f"g_total_unshaded_in_service shading_loss reflection_gain kwh_per_kwp_year "
+        f"irradiation_kwh_m2_year"),
+    "segment_month": _out(
+        "Segments per month (GeoParquet, for maps)", "one row per segment and month",
+        f"segment_id month tile shape_id route_short_name direction_id geometry n_passes seconds "
+        f"{_PVS} {_HS} shading_loss shading_loss_clear reflection_gain"),
+    "route_month": _out(
+        "Routes per direction and month", "one row per route, direction and month",
+        f"route_id route_short_name direction_id month trips seconds {_PVS} {_WHOLE_DAY} "
+        f"consumption_kwh coverage shading_loss"),
+    "block_day": _out(
+        "Vehicles per day", "one row per vehicle block and service date",
+        f"block_id service_date trips pv_kwh pv_kwh_clear {_WHOLE_DAY} consumption_kwh first_departure_s"),
+    "monthly": _out(
+        "The fleet per month", "one row per month, the whole fleet",
+        f"month trips {_PVS} {_WHOLE_DAY} consumption_kwh shading_loss avoided_charging_cycles "
+        f"kwh_per_kwp_allsky kwh_per_kwp_clearsky"),
+    "hourly_pattern": _out(
+        "Daily pattern by hour and month", "one row per month and local clock hour, the whole fleet",
+        f"month hour seconds {_HS} {_GS}",
+        seconds=Column("s", "time buses spent on the road in that hour of that month (all buses)")),
+}
+
+#: ``summary.json``: key -> unit and meaning (keys holding a dict have one entry for the dict)
+SUMMARY: dict[str, Column] = {
+    "scenario": Column("", "scenario name (configuration)"),
+    "year": Column("", "simulated year"),
+    "months": Column("", "simulated months (1-12)"),
+    "pv_mode": Column("", "PV model: 'paper' (kWp x POA x PR) or 'pvlib' (PVWatts with cell temperature)"),
+    "diffuse_model": Column("", "sky diffuse model on the tilted, obstructed roof"),
+    "routes": Column("count", "routes simulated"),
+    "trips": Column("count", "trips simulated (trip x service date)"),
+    "buses": Column("count", "fleet size: most vehicle blocks on one service date"),
+    "segments": Column("count", "segments of the simulated routes"),
+    "passes": Column("count", "segment passes evaluated"),
+    "kwp_per_bus": Column("kWp", "installed PV per bus"),
+    "pv_kwh_allsky": Column("kWh", "fleet PV energy over the simulated months, all-sky, with buildings"),
+    "pv_kwh_clearsky": Column("kWh", "the same, clear-sky"),
+    "pv_kwh_allsky_unshaded": Column("kWh", "the same, all-sky, without buildings"),
+    "annualised_from_months": Column("", "true when the yearly figures are scaled by 12 / months"),
+    "kwh_per_kwp_allsky": Column("kWh/kWp per year", "specific yield of the fleet, all-sky"),
+    "kwh_per_kwp_clearsky": Column("kWh/kWp per year", "specific yield of the fleet, clear-sky"),
+    "irradiation_kwh_m2": Column("kWh/m2", "per component: light on the roofs summed over every pass of "
+                                           "every bus in the simulated months - a fleet total, not a site "
+                                           "figure (see roof_irradiation_kwh_m2_per_bus, site_ghi_kwh_m2_year)"),
+    "roof_irradiation_kwh_m2_per_bus": Column("kWh/m2 per year", "all-sky light on one bus's roof in a year "
+                                                                 "of service, with buildings"),
+    "roof_irradiation_unshaded_kwh_m2_per_bus": Column("kWh/m2 per year", "the same without buildings"),
+    "ghi_in_service_kwh_m2_per_bus": Column("kWh/m2 per year", "global horizontal irradiation while one bus "
+                                                               "is in service (its share of the site's year)"),
+    "site_ghi_kwh_m2_year": Column("kWh/m2 per year", "global horizontal irradiation of the site over the "
+                                                      "calendar year (CAMS radiation file; mean of its "
+                                                      "locations); null when the file covers less than 99 %"),
+    "service_hours_per_bus_year": Column("h per year", "time a bus spends on its trips in a year"),
+    "shading_loss_allsky": Column("fraction", "1 - (direct + diffuse) / unshaded light on the roofs, all-sky"),
+    "shading_loss_clearsky": Column("fraction", "the same, clear-sky"),
+    "reflection_gain_allsky": Column("fraction", "reflected / unshaded light, all-sky"),
+    "net_building_effect_allsky": Column("fraction", "light with buildings / without - 1 (shading and "
+                                                     "reflections together), all-sky"),
+    "unshaded_to_ghi_allsky": Column("ratio", "unshaded roof light / GHI at the same times, all-sky"),
+    "unshaded_to_ghi_clearsky": Column("ratio", "the same, clear-sky"),
+    "reflected_share": Column("fraction", "reflected / total light on the roofs, all-sky"),
+    "fleet_demand_mwh": Column("MWh per year", "battery energy the fleet uses in a year"),
+    "coverage": Column("fraction", "PV energy / battery energy of the fleet"),
+    "avoided_charging_cycles_fleet": Column("cycles per year", "fleet PV energy / usable battery energy"),
+    "avoided_charging_cycles_per_bus": Column("cycles per year", "the same per bus"),
+    "system_cost_eur_per_bus": Column("EUR", "PV system cost per bus"),
+    "payback_years": Column("years", "simple payback of one bus's PV system at the configured tariff"),
+}
+
+
+def describe(output: str, column: str) -> Column | None:
+    """The entry of *column* in the output file *output* (``None``: undocumented)."""
+    spec = OUTPUTS.get(output)
+    if spec is not None and column in spec.own:
+        return spec.own[column]
+    return COLUMNS.get(column)
+
+
+def annotate(table, output: str):
+    """*table* (pyarrow) as written for the output file *output*: ``month`` strings
+    (``YYYY-MM``) as dates (first day), each documented field with ``unit`` and
+    ``description`` metadata; in the file's key-value metadata the file's title
+    (``vipvflow:rows``) and the same column entries as JSON (``vipvflow:columns``, for readers
+    that do not show Arrow field metadata, e.g. DuckDB's ``parquet_kv_metadata``)."""
+    import json
+
+    import pyarrow as pa
+    import pyarrow.compute as pc
+
+    spec = OUTPUTS[output]
+    if "month" in table.column_names:
+        i = table.column_names.index("month")
+        col = table.column(i)
+        if pa.types.is_string(col.type) or pa.types.is_large_string(col.type):
+            days = pc.strptime(pc.binary_join_element_wise(col.cast(pa.string()), "-01", ""),
+                               format="%Y-%m-%d", unit="s")
+            table = table.set_column(i, pa.field("month", pa.date32()), days.cast(pa.date32()))
+            table = table.replace_schema_metadata(_pandas_month_as_date(table.schema.metadata))
+    fields, columns = [], {}
+    for f in table.schema:
+        entry = describe(output, f.name)
+        if entry is not None:
+            meta = dict(f.metadata or {})
+            meta.update({b"unit": entry.unit.encode(), b"description": entry.meaning.encode()})
+            f = f.with_metadata(meta)
+            columns[f.name] = {"unit": entry.unit, "description": entry.meaning}
+        fields.append(f)
+    meta = dict(table.schema.metadata or {})
+    meta[b"vipvflow:rows"] = f"{spec.title}: {spec.rows}".encode()
+    meta[b"vipvflow:columns"] = json.dumps(columns).encode()
+    return table.cast(pa.schema(fields, metadata=meta))
+
+
+def _pandas_month_as_date(meta: dict | None) -> dict | None:
+    """Schema metadata whose pandas entry (GeoDataFrames carry one) says ``month`` holds
+    dates, so pandas reads the column back as dates rather than as strings."""
+    import json
+
+    if not meta or b"pandas" not in meta:
+        return meta
+    pandas_meta = json.loads(meta[b"pandas"])
+    for col in pandas_meta.get("columns", []):
+        if col.get("name") == "month":
+            col.update({"pandas_type": "date", "numpy_type": "object", "metadata": None})
+    return {**meta, b"pandas": json.dumps(pandas_meta).encode()}
+
+
+def render_markdown() -> str:
+    """``docs/outputs.md``: every output file's columns, then ``summary.json``'s keys."""
+    lines = [
+        "# Outputs: the data dictionary",
+        "",
+        "<!-- generated from src/vipvflow/simulation/dictionary.py by "
+        "`python -m vipvflow.simulation.dictionary > docs/outputs.md`; a test keeps it in sync -->",
+        "",
+        "A run writes its outputs into `out/<scenario>/<year>/`. Every Parquet file carries the "
+        "unit and meaning of each column: as Arrow field metadata (`unit`, `description`; in Python "
+        "`pyarrow.parquet.read_schema(path).field('pv_kwh').metadata`) and, for other readers, as "
+        "JSON in the file's key-value metadata `vipvflow:columns` (DuckDB: "
+        "`SELECT decode(value) FROM parquet_kv_metadata('segments.parquet') "
+        "WHERE decode(key) = 'vipvflow:columns'`). "
+        "Geometries are in the city's projected CRS (named in the GeoParquet metadata and in "
+        "`report.html`). `month` is a date: the first day of the month. Units: `fraction` is 0..1 "
+        "(x 100 for %), `Wh/m2` and `kWh/m2` are irradiation (energy per m2 of roof), `W/m2` "
+        "irradiance (power).",
+        "",
+        "Sums over *passes* add every bus that crossed: `h_total` of a segment-month is the light "
+        "every roof received on that segment that month, not the light of one place. For "
+        "place-like figures use the means (`g_*`, `g_total_in_service`) or the per-year figures "
+        "of `segments.parquet` (`kwh_per_kwp_year`, `irradiation_kwh_m2_year`).",
+        "",
+        "The internal geometry of the irradiance model (ray origins, reflector groups) is in "
+        "`parts/geometry/tile=<TILE>.parquet`, the horizon profiles in `parts/horizon/`; the web "
+        "app reads them, they are not documented here.",
+        "",
+    ]
+    for name, spec in OUTPUTS.items():
+        lines += [f"## `{name}.parquet`: {spec.title}", "", f"{spec.rows[0].upper()}{spec.rows[1:]}.", "",
+                  "| column | unit | meaning |", "|---|---|---|"]
+        for c in spec.columns:
+            e = describe(name, c)
+            lines.append(f"| `{c}` | {e.unit} | {e.meaning} |")
+        lines.append("")
+    lines += ["Columns of the whole-day model (`pv_kwh_driving`, `pv_kwh_layover`, `pv_kwh_parked`, "
+              "`pv_kwh_curtailed`) appear only in runs that model the whole day.", "",
+              "## `summary.json`", "",
+              "The fleet-year. Yearly figures are scaled by 12 / months when the run covers fewer "
+              "months (`annualised_from_months`).", "",
+              "| key | unit | meaning |", "|---|---|---|"]
+    for k, e in SUMMARY.items():
+        lines.append(f"| `{k}` | {e.unit} | {e.meaning} |")
+    lines.append("")
+    return "\n".join(lines)
+
+
+if __name__ == "__main__":
+    print(render_markdown(), end="")
