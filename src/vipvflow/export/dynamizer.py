@@ -200,9 +200,12 @@ def load_run(run_dir: str | Path) -> RunData:
     for f in (cfg.get("inputs", {}) or {}).get("citygml", []) or []:
         vertical = vertical_epsg(first_srs_name(Path(f))) if Path(f).is_file() else None
         break
-    sm = pq.read_table(run_dir / "segment_month.parquet", columns=["month", "route_short_name"])
-    months = sorted(set(_month_strings(sm.column("month")).unique().to_pylist()))
-    routes = sorted({str(r) for r in sm.column("route_short_name").unique().to_pylist() if r is not None})
+    months, routes = set(), set()
+    for b in pq.ParquetFile(run_dir / "segment_month.parquet").iter_batches(
+            _BATCH_ROWS * 4, columns=["month", "route_short_name"]):
+        months.update(_month_strings(b.column(0)).unique().to_pylist())
+        routes.update(str(r) for r in b.column(1).unique().to_pylist() if r is not None)
+    months, routes = sorted(months), sorted(routes)
     return RunData(run_dir, data_dir, manifest, tz, epsg, vertical, months, routes)
 
 
@@ -828,9 +831,17 @@ def choose_aggregate(run: RunData, sel: Selection, aggregate: str | None) -> str
         return aggregate
     n = pq.ParquetFile(run.segments_path).metadata.num_rows
     if sel.routes is not None:
-        t = pq.read_table(run.segment_month_path, columns=["segment_id", "route_short_name"])
-        d = t.to_pandas()
-        n = d.loc[d["route_short_name"].astype(str).isin(sel.routes), "segment_id"].nunique()
+        import pyarrow as pa
+        import pyarrow.compute as pc
+
+        ids = set()
+        for b in pq.ParquetFile(run.segment_month_path).iter_batches(
+                _BATCH_ROWS * 4, columns=["segment_id", "route_short_name"]):
+            keep = pc.is_in(pc.cast(b.column(1), pa.string()), value_set=pa.array(sel.routes))
+            ids.update(pc.unique(b.column(0).filter(keep)).to_pylist())
+            if len(ids) > AUTO_ROUTE_ABOVE:
+                break
+        n = len(ids)
     if sel.max_segments is not None:
         n = min(n, sel.max_segments)
     return "segment" if n <= AUTO_ROUTE_ABOVE else "route"
