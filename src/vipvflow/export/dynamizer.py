@@ -310,6 +310,10 @@ class _Geometries:
 
     def __init__(self, path: Path):
         self._batches = pq.ParquetFile(path).iter_batches(_BATCH_ROWS, columns=["segment_id", "geometry"])
+        if not _sorted_by_segment(path):
+            log.info("%s is not in segment order: read whole", path)
+            table = pq.read_table(path, columns=["segment_id", "geometry"]).sort_by("segment_id")
+            self._batches = iter(table.to_batches())
         self._buf: dict[int, np.ndarray] = {}
         self._last = -1
 
