@@ -1,48 +1,48 @@
 """Simulation results as CityGML 3.0 Dynamizers (a "digital twin" file) and their reader.
 
-Modelling (see ``docs/dynamizer.md`` for the content model of every element):
+Modelling (``docs/dynamizer.md`` maps every element to the official schema):
 
-- one ``tran:Road`` per route shape (route and direction), holding one ``tran:TrafficSpace``
-  per 10 m segment with its ``lod0MultiCurve`` (a 3D ``gml:LineString`` at roof height in
-  the city CRS); each TrafficSpace carries ``gen:DoubleAttribute`` values for the run's
-  total (``h_direct``, ``h_diffuse``, ``h_reflected``, ``h_total`` in Wh/m2 and ``pv_kwh``
-  in kWh) and one ``dyn:Dynamizer`` per attribute driving it with the monthly series;
+- ``--aggregate segment``: one ``tran:Road`` per route shape (route and direction) holding one
+  ``tran:TrafficSpace`` per 10 m segment with its ``lod0MultiCurve`` (a 3D ``gml:LineString``
+  at roof height in the run's CRS); ``--aggregate route``: one ``tran:Road`` per route holding
+  one ``tran:TrafficSpace`` per direction whose MultiCurve has one LineString per shape, the
+  values summed over the direction's segments.  Each TrafficSpace carries ``gen:DoubleAttribute``
+  totals (``h_direct``, ``h_diffuse``, ``h_reflected``, ``h_total`` in Wh/m2, ``pv_kwh`` in kWh)
+  and one ``dyn:Dynamizer`` per attribute driving it with the monthly series;
 - one ``gen:GenericLogicalSpace`` for the whole network with the mean roof irradiance by
-  hour of the day of each month (W/m2, ``g_*``): the run stores the hourly pattern for the
-  network only, not per segment;
-- one ``gen:GenericThematicSurface`` per building surface that reflects light onto a
-  route, ``core:relatedTo`` its building, with the reflected PV energy attributed to it
-  per month (kWh, ``pv_kwh_reflected``; an approximation, see :func:`reflector_contributions`).
+  hour of the day of each month (W/m2, ``g_*``);
+- one ``gen:GenericThematicSurface`` per building surface that reflects light onto an exported
+  segment, related to its building, with the reflected PV energy attributed to it per month.
 
-Values are written with ``repr`` precision so that reading them back gives the exact
-float64 of the run's GeoParquet.
+The file is written as a stream (``lxml.etree.xmlfile``): one city object is built in memory at
+a time and the run's tables are read in record batches, so memory does not grow with the
+number of segments.  Values are written with ``repr`` precision so that reading them back gives
+the exact float64 of the run's GeoParquet.
 """
 from __future__ import annotations
 
 import csv
+import itertools
 import json
 import logging
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Iterable, Iterator
+from typing import Callable, Iterator
 
 import numpy as np
 import pandas as pd
+import pyarrow.parquet as pq
 from lxml import etree
 
 from ..errors import InputError
+from .citygml3 import (CORE, DYN, NSMAP, SCHEMA_LOCATIONS, XSI, first_srs_name, q, schema_location,
+                       srs_name, vertical_epsg)
 
 log = logging.getLogger(__name__)
 
-CORE = "http://www.opengis.net/citygml/3.0"
-DYN = "http://www.opengis.net/citygml/dynamizer/3.0"
-GEN = "http://www.opengis.net/citygml/generics/3.0"
-TRAN = "http://www.opengis.net/citygml/transportation/3.0"
-GML = "http://www.opengis.net/gml/3.2"
-XLINK = "http://www.w3.org/1999/xlink"
-NSMAP = {"core": CORE, "dyn": DYN, "gen": GEN, "tran": TRAN, "gml": GML, "xlink": XLINK}
-GML_ID = f"{{{GML}}}id"
+GML_ID = q("gml:id")
+PREFIX = "vipv_"
 
 #: per-segment monthly series: attribute -> (observed property, unit)
 SEGMENT_SERIES = {
@@ -51,6 +51,14 @@ SEGMENT_SERIES = {
     "h_reflected": ("irradiation reflected by the city onto the bus roof per month", "Wh/m2"),
     "h_total": ("total irradiation on the bus roof per month", "Wh/m2"),
     "pv_kwh": ("PV energy harvested on the segment per month (all passes)", "kWh"),
+}
+#: the same series summed over a route direction's segments (``--aggregate route``)
+ROUTE_SERIES = {
+    "h_direct": ("direct irradiation on the bus roof per month, summed over the segments", "Wh/m2"),
+    "h_diffuse": ("diffuse irradiation on the bus roof per month, summed over the segments", "Wh/m2"),
+    "h_reflected": ("reflected irradiation on the bus roof per month, summed over the segments", "Wh/m2"),
+    "h_total": ("total irradiation on the bus roof per month, summed over the segments", "Wh/m2"),
+    "pv_kwh": ("PV energy harvested on the route direction per month (all passes)", "kWh"),
 }
 #: network series from hourly_pattern.parquet: attribute -> (observed property, unit)
 NETWORK_SERIES = {
@@ -64,32 +72,30 @@ SURFACE_SERIES = {
     "pv_kwh_reflected": ("PV energy from light this surface reflects onto the routes, per month "
                          "(attributed by albedo-weighted view factor)", "kWh"),
 }
-CITY_OBJECT = {"segment": "tran:TrafficSpace", "network": "gen:GenericLogicalSpace",
-               "surface": "gen:GenericThematicSurface"}
 ENCODINGS = ("inline", "tabulated")
+AGGREGATES = ("segment", "route")
+#: above this many selected segments the default aggregation is per route
+AUTO_ROUTE_ABOVE = 20_000
 _REF = re.compile(r"\[@gml:id='(?P<id>[^']+)'\].*\[gen:name='(?P<attr>[^']+)'\]")
+_BATCH_ROWS = 65_536
 
-
-def _q(prefix_name: str) -> str:
-    prefix, name = prefix_name.split(":")
-    return f"{{{NSMAP[prefix]}}}{name}"
-
-
-def _sub(parent, tag: str, text=None, **attrib):
-    el = etree.SubElement(parent, _q(tag), {(_q(k) if ":" in k else k): v for k, v in attrib.items()})
-    if text is not None:
-        el.text = text
-    return el
+T = {name: q(name) for name in ("core:CityModel", "core:cityObjectMember", "tran:Road", "gml:name")}
 
 
 def _num(v: float) -> str:
-    """Shortest text that parses back to the same float64 (``repr``)."""
-    return repr(float(v))
+    """Shortest text that parses back to the same float64 (``repr``), in xs:double spelling."""
+    v = float(v)
+    if v != v:
+        return "NaN"
+    if v in (float("inf"), float("-inf")):
+        return "INF" if v > 0 else "-INF"
+    return repr(v)
 
 
-def _srs_name(crs) -> str:
-    epsg = crs.to_epsg() if crs is not None else None
-    return f"http://www.opengis.net/def/crs/EPSG/0/{epsg}" if epsg else (crs.to_string() if crs else "")
+def xml_id(text) -> str:
+    """A gml:id (an XML NCName) from a GTFS id: characters outside ``[A-Za-z0-9_.-]`` become
+    ``_xHHHH_`` (so distinct ids stay distinct)."""
+    return re.sub(r"[^A-Za-z0-9_.-]", lambda m: f"_x{ord(m.group()):04x}_", str(text))
 
 
 def attribute_ref(object_tag: str, object_id: str, attribute: str, value_kind: str = "DoubleAttribute") -> str:
@@ -118,34 +124,60 @@ class Series:
         return f"{self.object_id}_dyn_{self.attribute}"
 
 
-def _iso(ts: pd.Timestamp) -> str:
-    return ts.isoformat()
+class _Months:
+    """ISO timestamps of month starts in the feed's time zone (cached: few distinct months)."""
 
+    def __init__(self, tz: str):
+        self.tz = tz
+        self._start: dict[str, str] = {}
+        self._end: dict[str, str] = {}
 
-def _month_bounds(months: Iterable, tz: str) -> tuple[list[str], str]:
-    """Local starts of months (dates of their first day, or ``YYYY-MM``) and the end of the last."""
-    firsts = [pd.Timestamp(str(m)[:7] + "-01") for m in months]
-    starts = [f.tz_localize(tz) for f in firsts]
-    end = (max(firsts) + pd.offsets.MonthBegin(1)).tz_localize(tz)
-    return [_iso(s) for s in starts], _iso(end)
+    def start(self, month: str) -> str:
+        if month not in self._start:
+            self._start[month] = pd.Timestamp(f"{month}-01", tz=self.tz).isoformat()
+        return self._start[month]
+
+    def end(self, month: str) -> str:
+        if month not in self._end:
+            self._end[month] = (pd.Timestamp(f"{month}-01") + pd.offsets.MonthBegin(1)).tz_localize(
+                self.tz).isoformat()
+        return self._end[month]
 
 
 # ----------------------------------------------------------------------------- run inputs
 @dataclass
 class RunData:
+    """What the export reads of a finished run: paths and small metadata, no big tables."""
+
     run_dir: Path
-    segments: "pd.DataFrame"          # GeoDataFrame: segment_id, shape_id, geometry, ...
-    segment_month: pd.DataFrame
-    hourly: pd.DataFrame
+    data_dir: Path
     manifest: dict
     timezone: str
-    crs: object
+    horizontal_epsg: int | None
+    vertical_epsg: int | None
+    months: list[str]                 # months of the run (YYYY-MM), sorted
+    routes: list[str]                 # route_short_name of the run, sorted
+
+    @property
+    def srs_name(self) -> str | None:
+        return srs_name(self.horizontal_epsg, self.vertical_epsg)
+
+    @property
+    def segment_month_path(self) -> Path:
+        return self.run_dir / "segment_month.parquet"
+
+    @property
+    def segments_path(self) -> Path:
+        return self.run_dir / "segments.parquet"
+
+
+def _run_data_dir(run_dir: Path, manifest: dict) -> Path:
+    """The data directory of the run (as its configuration names it)."""
+    return Path(manifest.get("config", {}).get("data_dir", ""))
 
 
 def load_run(run_dir: str | Path) -> RunData:
     """The outputs of a finished run that the export needs (InputError names what is missing)."""
-    import geopandas as gpd
-
     run_dir = Path(run_dir)
     if not run_dir.is_dir():
         raise InputError(f"run directory not found: {run_dir}")
@@ -154,56 +186,578 @@ def load_run(run_dir: str | Path) -> RunData:
     if missing:
         raise InputError(f"{run_dir}: not a finished run (missing {', '.join(missing)})")
     manifest = json.loads((run_dir / "manifest.json").read_text())
-    segments = gpd.read_parquet(run_dir / "segments.parquet")
-    sm = pd.read_parquet(run_dir / "segment_month.parquet",
-                         columns=["segment_id", "month", *SEGMENT_SERIES, "pv_kwh_reflected"])
-    hourly = pd.read_parquet(run_dir / "hourly_pattern.parquet")
+    data_dir = _run_data_dir(run_dir, manifest)
     tz = "UTC"
-    feed = Path(manifest.get("config", {}).get("data_dir", "")) / "gtfs" / "feed.json"
+    feed = data_dir / "gtfs" / "feed.json"
     if feed.exists():
         tz = json.loads(feed.read_text()).get("timezone", "UTC")
-    return RunData(run_dir, segments, sm, hourly, manifest, tz, segments.crs)
+    else:
+        log.warning("%s not found: timestamps are written in UTC", feed)
+    meta = pq.read_schema(run_dir / "segments.parquet").metadata or {}
+    epsg = _geoparquet_epsg(meta)
+    vertical = None
+    cfg = manifest.get("config", {})
+    for f in (cfg.get("inputs", {}) or {}).get("citygml", []) or []:
+        vertical = vertical_epsg(first_srs_name(Path(f))) if Path(f).is_file() else None
+        break
+    months, routes = set(), set()
+    for b in pq.ParquetFile(run_dir / "segment_month.parquet").iter_batches(
+            _BATCH_ROWS * 4, columns=["month", "route_short_name"]):
+        months.update(_month_strings(b.column(0)).unique().to_pylist())
+        routes.update(str(r) for r in b.column(1).unique().to_pylist() if r is not None)
+    months, routes = sorted(months), sorted(routes)
+    return RunData(run_dir, data_dir, manifest, tz, epsg, vertical, months, routes)
+
+
+def _month_strings(col):
+    """A ``month`` column as ``YYYY-MM`` strings (runs write it as a date, the first day of the
+    month; older runs as ``YYYY-MM`` text)."""
+    import pyarrow as pa
+    import pyarrow.compute as pc
+
+    if pa.types.is_string(col.type) or pa.types.is_large_string(col.type):
+        return pc.utf8_slice_codeunits(col, 0, 7)
+    if pa.types.is_dictionary(col.type):
+        return _month_strings(pc.cast(col, pa.string()))
+    return pc.strftime(col, format="%Y-%m")
+
+
+def _geoparquet_epsg(meta: dict) -> int | None:
+    geo = meta.get(b"geo")
+    if not geo:
+        return None
+    from pyproj import CRS
+
+    info = json.loads(geo)
+    col = info.get("columns", {}).get(info.get("primary_column", "geometry"), {})
+    crs = col.get("crs")
+    return CRS.from_user_input(crs).to_epsg() if crs is not None else None
+
+
+# ----------------------------------------------------------------------------- selection
+@dataclass
+class Selection:
+    """What to export: months (YYYY-MM), routes (route_short_name), the first N segments."""
+
+    months: list[str]
+    routes: list[str] | None = None
+    max_segments: int | None = None
+    #: the selected segment ids met while streaming, as closed ranges [first, last]
+    ranges: list = field(default_factory=list)
+
+    def note(self, segment_id: int) -> None:
+        if self.ranges and self.ranges[-1][1] == segment_id - 1:
+            self.ranges[-1][1] = segment_id
+        else:
+            self.ranges.append([segment_id, segment_id])
+
+    def contains(self, ids: np.ndarray) -> np.ndarray:
+        """Which of *ids* were exported (boolean mask)."""
+        if not self.ranges:
+            return np.zeros(len(ids), bool)
+        r = np.asarray(self.ranges)
+        k = np.searchsorted(r[:, 0], ids, side="right") - 1
+        return (k >= 0) & (ids <= r[np.maximum(k, 0), 1])
+
+
+def _selection(run: RunData, months, routes, max_segments) -> Selection:
+    chosen = run.months
+    if months:
+        wanted = []
+        for m in months:
+            text = str(m).strip()
+            if re.fullmatch(r"\d{1,2}", text):
+                text = f"{run.manifest.get('year', run.months[0][:4])}-{int(text):02d}"
+            if text not in run.months:
+                raise InputError(f"--months: {m} is not a month of the run {run.run_dir} "
+                                 f"(it has {', '.join(run.months)})")
+            wanted.append(text)
+        chosen = sorted(set(wanted))
+    if routes:
+        unknown = [r for r in routes if str(r) not in run.routes]
+        if unknown:
+            raise InputError(f"--routes: {', '.join(map(str, unknown))} not in the run {run.run_dir} "
+                             f"(it has {', '.join(run.routes)})")
+        routes = [str(r) for r in routes]
+    if max_segments is not None and max_segments < 1:
+        raise InputError(f"--segments must be at least 1, got {max_segments}")
+    return Selection(chosen, routes or None, max_segments)
+
+
+# ----------------------------------------------------------------------------- streams
+@dataclass
+class SegmentRecord:
+    segment_id: int
+    shape_id: str
+    route: str
+    direction: int
+    coords: np.ndarray      # (n, 3) float64
+    months: list[str]
+    values: np.ndarray      # (len(months), len(SEGMENT_SERIES)) float64
+
+
+def _wkb_coords(wkb) -> list[np.ndarray]:
+    import shapely
+
+    geoms = shapely.from_wkb(np.asarray(wkb, dtype=object))
+    coords, index = shapely.get_coordinates(geoms, include_z=True, return_index=True)
+    cuts = np.flatnonzero(np.diff(index)) + 1
+    return np.split(coords, cuts)
+
+
+class _Geometries:
+    """Segment geometries from ``segments.parquet`` read forward in segment id order."""
+
+    def __init__(self, path: Path):
+        self._batches = pq.ParquetFile(path).iter_batches(_BATCH_ROWS, columns=["segment_id", "geometry"])
+        if not _sorted_by_segment(path):
+            log.info("%s is not in segment order: read whole", path)
+            table = pq.read_table(path, columns=["segment_id", "geometry"]).sort_by("segment_id")
+            self._batches = iter(table.to_batches())
+        self._buf: dict[int, np.ndarray] = {}
+        self._last = -1
+
+    def take(self, segment_id: int) -> np.ndarray:
+        while segment_id > self._last:
+            try:
+                b = next(self._batches)
+            except StopIteration:
+                break
+            ids = b.column("segment_id").to_numpy()
+            for k in [k for k in self._buf if k < segment_id]:      # not selected: drop
+                del self._buf[k]
+            self._buf.update(zip(ids.tolist(), _wkb_coords(b.column("geometry").to_pylist())))
+            if len(ids):
+                self._last = max(self._last, int(ids.max()))
+        coords = self._buf.pop(segment_id, None)
+        if coords is None:
+            raise InputError(f"segments.parquet: segment {segment_id} of segment_month.parquet "
+                             "has no geometry")
+        return coords
+
+
+def _segment_records(run: RunData, sel: Selection) -> Iterator[SegmentRecord]:
+    """Each selected segment with its monthly values, in segment id order, streamed in record
+    batches (a segment's rows may straddle two batches: the last id of a batch waits for the
+    next one)."""
+    import pyarrow as pa
+    import pyarrow.compute as pc
+
+    cols = ["segment_id", "shape_id", "route_short_name", "direction_id", "month", *SEGMENT_SERIES]
+    geoms = _Geometries(run.segments_path)
+    months = pa.array(sel.months)
+    routes = pa.array(sel.routes) if sel.routes is not None else None
+    if _sorted_by_segment(run.segment_month_path):
+        source = (pa.Table.from_batches([b]) for b in
+                  pq.ParquetFile(run.segment_month_path).iter_batches(_BATCH_ROWS, columns=cols))
+    else:
+        log.info("%s is not in segment order: read whole and sorted", run.segment_month_path)
+        source = iter([pq.read_table(run.segment_month_path, columns=cols)
+                       .sort_by([("segment_id", "ascending"), ("month", "ascending")])])
+    carry, last_id, n = None, -1, 0
+    for table in itertools.chain(source, [None]):
+        if table is None:
+            if carry is None:
+                break
+            done, carry = carry, None
+        else:
+            if carry is not None:
+                table = pa.concat_tables([carry, table])
+            ids = table.column("segment_id").to_numpy()
+            if not len(ids):
+                continue
+            tail = int(np.searchsorted(ids, ids[-1]))       # ids ascending: the last id's rows
+            carry, done = table.slice(tail), table.slice(0, tail)
+        done = done.set_column(done.schema.get_field_index("month"), "month", _month_strings(done.column("month")))
+        keep = pc.is_in(done.column("month"), value_set=months)
+        if routes is not None:
+            keep = pc.and_(keep, pc.is_in(pc.cast(done.column("route_short_name"), pa.string()),
+                                          value_set=routes))
+        done = done.filter(keep)
+        if not done.num_rows:
+            continue
+        ids = done.column("segment_id").to_numpy()
+        month_col = done.column("month").to_numpy(zero_copy_only=False).astype(str)
+        order = np.lexsort((month_col, ids))
+        ids, month_col = ids[order], month_col[order]
+        values = np.column_stack([done.column(c).to_numpy(zero_copy_only=False) for c in SEGMENT_SERIES]
+                                 ).astype(np.float64)[order]
+        shape_col = done.column("shape_id").to_numpy(zero_copy_only=False)[order]
+        route_col = done.column("route_short_name").to_numpy(zero_copy_only=False)[order]
+        dir_col = done.column("direction_id").to_numpy(zero_copy_only=False)[order]
+        starts = np.flatnonzero(np.r_[True, ids[1:] != ids[:-1]])
+        ends = np.r_[starts[1:], len(ids)]
+        for a, b in zip(starts.tolist(), ends.tolist()):
+            sid = int(ids[a])
+            if sid <= last_id:
+                raise InputError(f"{run.segment_month_path}: segment {sid} appears twice")
+            last_id = sid
+            sel.note(sid)
+            yield SegmentRecord(sid, str(shape_col[a]), str(route_col[a]), int(dir_col[a]), geoms.take(sid),
+                                month_col[a:b].tolist(), values[a:b])
+            n += 1
+            if sel.max_segments is not None and n >= sel.max_segments:
+                return
+
+
+def _sorted_by_segment(path: Path) -> bool:
+    """True when the segment ids of the file never decrease (checked from row group statistics
+    when they exist, else from the column streamed)."""
+    prev = None
+    for b in pq.ParquetFile(path).iter_batches(_BATCH_ROWS * 4, columns=["segment_id"]):
+        ids = b.column(0).to_numpy()
+        if len(ids) and ((prev is not None and ids[0] < prev) or (np.diff(ids) < 0).any()):
+            return False
+        if len(ids):
+            prev = ids[-1]
+    return True
+
+
+# ----------------------------------------------------------------------------- XML pieces
+# City objects are written as text (one chunk per city object, indented, one element a line),
+# parsed by libxml2 into an element and handed to the xmlfile stream: much faster than
+# building each of the ~60 elements of a Dynamizer with SubElement, and the parse checks
+# that every chunk is well-formed.
+_DECL = {ns: " ".join(f'xmlns:{p}="{NSMAP[p]}"' for p in ns) for ns in (
+    ("core", "dyn", "gen", "tran", "gml"), ("core", "dyn", "gen", "tran", "gml", "xlink"))}
+
+
+def _esc(text) -> str:
+    return (str(text).replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;")
+            .replace('"', "&quot;"))
+
+
+def _chunk(text: str) -> etree._Element:
+    return etree.fromstring(text, _PARSER)
+
+
+_PARSER = etree.XMLParser(remove_blank_text=False, huge_tree=True)
+
+
+def _generic(out: list, ind: str, kind: str, name: str, value: str) -> None:
+    out.append(f"{ind}<core:genericAttribute>\n{ind}  <gen:{kind}>\n{ind}    <gen:name>{_esc(name)}</gen:name>\n"
+               f"{ind}    <gen:value>{_esc(value)}</gen:value>\n{ind}  </gen:{kind}>\n"
+               f"{ind}</core:genericAttribute>\n")
+
+
+class _Tabulated:
+    """The CSV beside the GML holding every tabulated series (one row per value)."""
+
+    HEADER = ["series", "timestamp", "value"]
+
+    def __init__(self, path: Path):
+        self.path = path
+        self.tmp = path.with_name(path.name + ".tmp")
+        self._fh = self.tmp.open("w", newline="", encoding="utf-8")
+        self._w = csv.writer(self._fh, lineterminator="\n")
+        self._w.writerow(self.HEADER)
+
+    def add(self, s: Series) -> str:
+        key = f"{s.object_id}/{s.attribute}"
+        self._w.writerows([key, t, _num(v)] for t, v in zip(s.timestamps, s.values))
+        return key
+
+    def close(self, keep: bool) -> None:
+        self._fh.close()
+        if keep:
+            self.tmp.replace(self.path)
+        else:
+            self.tmp.unlink(missing_ok=True)
+
+
+def _dynamizer(out: list, ind: str, s: Series, table: _Tabulated | None) -> None:
+    """``core:dynamizer`` / ``dyn:Dynamizer`` with its time series (schema order)."""
+    i2, i3, i4, i5 = ind + "  ", ind + "    ", ind + "      ", ind + "        "
+    kind = "GenericTimeseries" if table is None else "TabulatedFileTimeseries"
+    out.append(
+        f'{ind}<core:dynamizer>\n{i2}<dyn:Dynamizer gml:id="{s.dynamizer_id}">\n'
+        f"{i3}<gml:name>{_esc(s.attribute)} of {s.object_id}</gml:name>\n"
+        f"{i3}<dyn:attributeRef>{_esc(attribute_ref(s.object_tag, s.object_id, s.attribute))}</dyn:attributeRef>\n"
+        f"{i3}<dyn:startTime>{s.start}</dyn:startTime>\n{i3}<dyn:endTime>{s.end}</dyn:endTime>\n"
+        f'{i3}<dyn:dynamicData>\n{i4}<dyn:{kind} gml:id="{s.dynamizer_id}_ts">\n'
+        f"{i5}<dyn:firstTimestamp>{s.timestamps[0]}</dyn:firstTimestamp>\n"
+        f"{i5}<dyn:lastTimestamp>{s.timestamps[-1]}</dyn:lastTimestamp>\n"
+        f"{i5}<dyn:observationProperty>{_esc(s.observation)}</dyn:observationProperty>\n"
+        f"{i5}<dyn:uom>{_esc(s.uom)}</dyn:uom>\n")
+    if table is None:
+        out.append(f"{i5}<dyn:valueType>double</dyn:valueType>\n")
+        out.extend(f"{i5}<dyn:timeValuePair><dyn:TimeValuePair><dyn:timestamp>{t}</dyn:timestamp>"
+                   f"<dyn:doubleValue>{_num(v)}</dyn:doubleValue></dyn:TimeValuePair></dyn:timeValuePair>\n"
+                   for t, v in zip(s.timestamps, s.values))
+    else:
+        key = table.add(s)
+        out.append(
+            f"{i5}<dyn:fileLocation>{_esc(table.path.name)}</dyn:fileLocation>\n"
+            f"{i5}<dyn:fileType>csv</dyn:fileType>\n{i5}<dyn:mimeType>text/csv</dyn:mimeType>\n"
+            f"{i5}<dyn:valueType>double</dyn:valueType>\n"
+            f"{i5}<dyn:numberOfHeaderLines>1</dyn:numberOfHeaderLines>\n"
+            f"{i5}<dyn:fieldSeparator>,</dyn:fieldSeparator>\n{i5}<dyn:decimalSymbol>.</dyn:decimalSymbol>\n"
+            f"{i5}<dyn:idColumnName>series</dyn:idColumnName>\n{i5}<dyn:idValue>{_esc(key)}</dyn:idValue>\n"
+            f"{i5}<dyn:timeColumnName>timestamp</dyn:timeColumnName>\n"
+            f"{i5}<dyn:valueColumnName>value</dyn:valueColumnName>\n")
+    out.append(f"{i4}</dyn:{kind}>\n{i3}</dyn:dynamicData>\n{i2}</dyn:Dynamizer>\n{ind}</core:dynamizer>\n")
+
+
+def _multi_curve(out: list, ind: str, lines: list[np.ndarray], srs: str | None, gid: str) -> None:
+    crs = f' srsName="{_esc(srs)}" srsDimension="3"' if srs else ""
+    out.append(f'{ind}<core:lod0MultiCurve>\n{ind}  <gml:MultiCurve gml:id="{gid}_mc"{crs}>\n')
+    for k, coords in enumerate(lines):
+        out.append(f'{ind}    <gml:curveMember><gml:LineString gml:id="{gid}_ls{k}"><gml:posList>'
+                   f'{" ".join(map(_num, coords.ravel()))}</gml:posList></gml:LineString></gml:curveMember>\n')
+    out.append(f"{ind}  </gml:MultiCurve>\n{ind}</core:lod0MultiCurve>\n")
+
+
+def _space_series(oid: str, months: list[str], values: np.ndarray, series: dict, clock: _Months) -> list[Series]:
+    stamps = [clock.start(m) for m in months]
+    return [Series(oid, "tran:TrafficSpace", a, obs, uom, stamps, values[:, j], stamps[0], clock.end(months[-1]))
+            for j, (a, (obs, uom)) in enumerate(series.items())]
+
+
+def _traffic_space(out: list, ind: str, oid: str, name: str, ints: dict, strings: dict,
+                   series: list[Series], lines: list[np.ndarray], srs: str | None, table, counts: dict) -> None:
+    """``tran:trafficSpace`` / ``tran:TrafficSpace`` (schema order: city object, space, own)."""
+    i2 = ind + "  "
+    out.append(f'{ind}<tran:trafficSpace>\n{i2}<tran:TrafficSpace gml:id="{oid}">\n'
+               f"{i2}  <gml:name>{_esc(name)}</gml:name>\n")
+    i3 = i2 + "  "
+    for k, v in strings.items():
+        _generic(out, i3, "StringAttribute", k, v)
+    for k, v in ints.items():
+        _generic(out, i3, "IntAttribute", k, str(int(v)))
+    for s in series:
+        _generic(out, i3, "DoubleAttribute", s.attribute, _num(s.values.sum()))
+    for s in series:
+        _dynamizer(out, i3, s, table)
+    counts["dynamizers"] += len(series)
+    _multi_curve(out, i3, lines, srs, oid)
+    out.append(f"{i3}<tran:granularity>lane</tran:granularity>\n{i2}</tran:TrafficSpace>\n{ind}</tran:trafficSpace>")
+
+
+def _with_decl(text: str, decl: str) -> str:
+    """Declare the namespaces on the chunk's first element."""
+    i = _FIRST_TAG.match(text).end()
+    return text[:i] + " " + decl + text[i:]
+
+
+_FIRST_TAG = re.compile(r"\s*<[^\s>/]+")
+
+
+# ----------------------------------------------------------------------------- members
+#: a member writer: writes one core:cityObjectMember into an open xmlfile
+MemberWriter = Callable[[etree.xmlfile], None]
+_CHUNK = _DECL[("core", "dyn", "gen", "tran", "gml")]
+_CHUNK_X = _DECL[("core", "dyn", "gen", "tran", "gml", "xlink")]
+
+
+def _member(body: list[str]) -> etree._Element:
+    """A complete ``core:cityObjectMember`` chunk from the lines of its city object."""
+    return _chunk(f"<core:cityObjectMember {_CHUNK_X}>\n{''.join(body)}</core:cityObjectMember>")
+
+
+def _segment_members(run: RunData, sel: Selection, table, counts: dict) -> Iterator[MemberWriter]:
+    """One Road per shape, its TrafficSpaces written one at a time."""
+    srs, clock = run.srs_name, _Months(run.timezone)
+    records = _segment_records(run, sel)
+    for shape_id, group in itertools.groupby(records, key=lambda r: r.shape_id):
+        def write(xf, shape_id=shape_id, group=group):
+            first = next(group)
+            with xf.element(T["core:cityObjectMember"], nsmap=_MEMBER_NSMAP):
+                with xf.element(T["tran:Road"], {GML_ID: f"{PREFIX}road_{xml_id(shape_id)}"}):
+                    xf.write("\n", _chunk(f"<gml:name {_CHUNK}>bus roof path of shape {_esc(shape_id)} "
+                                           f"(route {_esc(first.route)}, direction {first.direction})</gml:name>"))
+                    for k, v in (("shape_id", shape_id), ("route", first.route)):
+                        out: list[str] = []
+                        _generic(out, "", "StringAttribute", k, v)
+                        xf.write("\n", _chunk(_with_decl("".join(out).rstrip(), _CHUNK)))
+                    for rec in itertools.chain([first], group):
+                        out = []
+                        oid = f"{PREFIX}seg_{rec.segment_id}"
+                        _traffic_space(out, "", oid, f"segment {rec.segment_id} of shape {shape_id}",
+                                       {"segment_id": rec.segment_id}, {},
+                                       _space_series(oid, rec.months, rec.values, SEGMENT_SERIES, clock),
+                                       [rec.coords], srs, table, counts)
+                        xf.write("\n", _chunk(_with_decl("".join(out), _CHUNK)))
+                        counts["segments"] += 1
+                    xf.write("\n")
+        yield write
+
+
+def _join_lines(pieces: list[np.ndarray], tol: float = 1e-6) -> list[np.ndarray]:
+    """Consecutive segment polylines joined where one ends at the next's start."""
+    lines, cur = [], None
+    for p in pieces:
+        if cur is not None and np.allclose(cur[-1][-1], p[0], atol=tol):
+            cur.append(p[1:])
+        else:
+            if cur is not None:
+                lines.append(np.concatenate(cur))
+            cur = [p]
+    if cur is not None:
+        lines.append(np.concatenate(cur))
+    return lines
+
+
+def route_totals(segment_month: pd.DataFrame) -> pd.DataFrame:
+    """The route aggregation: ``SEGMENT_SERIES`` summed per route, direction and month."""
+    return (segment_month.groupby(["route_short_name", "direction_id", "month"], sort=True)[list(SEGMENT_SERIES)]
+            .sum().reset_index())
+
+
+def _route_members(run: RunData, sel: Selection, table, counts: dict) -> Iterator[MemberWriter]:
+    """One Road per route, one TrafficSpace per direction (its shapes' lines, summed values)."""
+    srs, clock = run.srs_name, _Months(run.timezone)
+    sums: dict[tuple, dict[str, np.ndarray]] = {}
+    pieces: dict[tuple, dict[str, list[np.ndarray]]] = {}
+    n_seg: dict[tuple, int] = {}
+    for rec in _segment_records(run, sel):
+        key = (rec.route, rec.direction)
+        acc = sums.setdefault(key, {})
+        for m, v in zip(rec.months, rec.values):
+            if m in acc:
+                acc[m] = acc[m] + v
+            else:
+                acc[m] = v.copy()
+        pieces.setdefault(key, {}).setdefault(rec.shape_id, []).append(rec.coords)
+        n_seg[key] = n_seg.get(key, 0) + 1
+    for route in sorted({k[0] for k in sums}):
+        def write(xf, route=route):
+            rid = f"{PREFIX}route_{xml_id(route)}"
+            out = [f'<tran:Road gml:id="{rid}">\n  <gml:name>bus roof paths of route {_esc(route)}</gml:name>\n']
+            _generic(out, "  ", "StringAttribute", "route", route)
+            for (r, direction) in sorted(k for k in sums if k[0] == route):
+                acc = sums[(r, direction)]
+                months = sorted(acc)
+                values = np.stack([acc[m] for m in months])
+                oid = f"{rid}_dir{direction}"
+                shapes = pieces[(r, direction)]
+                lines = [line for s in sorted(shapes) for line in _join_lines(shapes[s])]
+                _traffic_space(out, "  ", oid, f"route {route} direction {direction}",
+                               {"direction_id": direction, "segments": n_seg[(r, direction)]},
+                               {"route": route, "shapes": " ".join(sorted(shapes))},
+                               _space_series(oid, months, values, ROUTE_SERIES, clock), lines, srs, table,
+                               counts)
+                out.append("\n")
+                counts["route_directions"] += 1
+                counts["segments"] += n_seg[(r, direction)]
+            out.append("</tran:Road>\n")
+            xf.write(_member(out))
+        yield write
+
+
+def _network_member(run: RunData, sel: Selection, table, counts: dict) -> MemberWriter | None:
+    hp = pd.read_parquet(run.run_dir / "hourly_pattern.parquet")
+    hp["month"] = hp["month"].astype(str).str.slice(0, 7)
+    hp = hp[hp["month"].isin(sel.months)].sort_values(["month", "hour"])
+    if hp.empty:
+        return None
+    clock = _Months(run.timezone)
+    oid = f"{PREFIX}network"
+    stamps = [(pd.Timestamp(f"{m}-01", tz=run.timezone) + pd.Timedelta(hours=int(h))).isoformat()
+              for m, h in zip(hp["month"], hp["hour"])]
+    months = list(hp["month"])
+    series = [Series(oid, "gen:GenericLogicalSpace", a, obs, uom, stamps, hp[a].to_numpy(np.float64),
+                     clock.start(months[0]), clock.end(months[-1]))
+              for a, (obs, uom) in NETWORK_SERIES.items() if a in hp]
+
+    def write(xf):
+        out = [f'<gen:GenericLogicalSpace gml:id="{oid}">\n'
+               "  <gml:name>bus network of the run (hourly pattern, all segments)</gml:name>\n"]
+        for s in series:
+            _generic(out, "  ", "DoubleAttribute", s.attribute, _num(np.nanmean(s.values)))
+        for s in series:
+            _dynamizer(out, "  ", s, table)
+        out.append("</gen:GenericLogicalSpace>\n")
+        counts["dynamizers"] += len(series)
+        counts["network"] += 1
+        xf.write(_member(out))
+    return write
+
+
+def _surface_members(run: RunData, sel: Selection, table, counts: dict) -> Iterator[MemberWriter]:
+    refl = reflector_contributions(run, sel)
+    clock = _Months(run.timezone)
+    for (surface_id, building_id, stype), g in refl.groupby(["surface_id", "building_id", "surface_type"],
+                                                            sort=True, dropna=False):
+        def write(xf, surface_id=surface_id, building_id=building_id, stype=stype, g=g):
+            g = g.sort_values("month")
+            oid = f"{PREFIX}refl_{xml_id(surface_id)}"
+            out = [f'<gen:GenericThematicSurface gml:id="{oid}">\n'
+                   f"  <gml:name>reflection onto the routes by {_esc(stype)} surface {_esc(surface_id)}</gml:name>\n"]
+            if isinstance(building_id, str):
+                out.append(f'  <core:relatedTo>\n    <core:CityObjectRelation gml:id="{oid}_rel">\n'
+                           "      <core:relationType>reflectsLightOntoRoutesFrom</core:relationType>\n"
+                           f'      <core:relatedTo xlink:href="#{_esc(building_id)}"/>\n'
+                           "    </core:CityObjectRelation>\n  </core:relatedTo>\n")
+            months = list(g["month"])
+            stamps = [clock.start(m) for m in months]
+            obs, uom = SURFACE_SERIES["pv_kwh_reflected"]
+            s = Series(oid, "gen:GenericThematicSurface", "pv_kwh_reflected", obs, uom, stamps,
+                       g["pv_kwh_reflected"].to_numpy(np.float64), stamps[0], clock.end(months[-1]))
+            _generic(out, "  ", "StringAttribute", "surface_id", str(surface_id))
+            if isinstance(building_id, str):
+                _generic(out, "  ", "StringAttribute", "building_id", building_id)
+            _generic(out, "  ", "StringAttribute", "surface_type", str(stype))
+            _generic(out, "  ", "IntAttribute", "segments", str(int(g["segments"].max())))
+            _generic(out, "  ", "DoubleAttribute", s.attribute, _num(s.values.sum()))
+            _dynamizer(out, "  ", s, table)
+            out.append("</gen:GenericThematicSurface>\n")
+            counts["dynamizers"] += 1
+            counts["surfaces"] += 1
+            xf.write(_member(out))
+        yield write
+
+
+#: namespaces declared on each element written into the stream (xmlfile does not reuse the
+#: declarations of the enclosing elements it has open)
+_MEMBER_NSMAP = {k: v for k, v in NSMAP.items() if k != "xsi"}
+_GML_NSMAP = {"gml": NSMAP["gml"]}
 
 
 # ----------------------------------------------------------------------------- reflectors
-def reflector_contributions(run: RunData, segment_ids=None) -> pd.DataFrame:
+def reflector_contributions(run: RunData, sel: Selection | None = None) -> pd.DataFrame:
     """Reflected PV energy attributed to the building surfaces that reflect onto the routes.
 
     Each segment's reflector groups (``parts/geometry``: weight ``r{g}_w`` = albedo x view
     factor, representative hit point ``r{g}_x, r{g}_y, r{g}_z``) are attributed to the
     surface hit by a ray from the segment's roof point to the group's representative point
     (the tile mesh of the ingested city, ``data_dir/city/meshes``).  A segment's monthly
-    ``pv_kwh_reflected`` is shared among its groups in proportion to their weights; a group
-    merges every surface of one orientation class seen from the segment, so the whole group
-    is credited to the surface of its representative point.  Groups on terrain, or whose
-    ray does not come back to the representative point, stay unattributed.
+    ``pv_kwh_reflected`` (``parts/segment_month``) is shared among its groups in proportion to
+    their weights; a group merges every surface of one orientation class seen from the
+    segment, so the whole group is credited to the surface of its representative point.
+    Groups on terrain, or whose ray does not come back to the representative point, stay
+    unattributed.  Read tile by tile.
+
+    Parameters
+    ----------
+    run : :func:`load_run`
+    sel : the export's selection (months, and the segment ids it met while streaming);
+        None: the whole run
 
     Returns
     -------
     DataFrame ``surface_id, building_id, surface_type, month, pv_kwh_reflected`` (kWh),
-    ``segments`` (number of segments the surface reflects onto; only *segment_ids* when
-    given); empty when the run's
-    geometry parts or the city meshes are absent.
+    ``segments`` (number of selected segments the surface reflects onto); empty when the
+    run's geometry parts or the city meshes are absent.
     """
     from ..mesh import SURFACE_TYPES, TileMesh
     from ..shading import Scene
 
     cols = ["surface_id", "building_id", "surface_type", "month", "pv_kwh_reflected", "segments"]
-    data_dir = Path(run.manifest.get("config", {}).get("data_dir", ""))
+    months = sel.months if sel is not None else run.months
     files = sorted((run.run_dir / "parts" / "geometry").glob("tile=*.parquet"))
-    seg_tile = run.segments.set_index("segment_id")["tile"]
-    if segment_ids is not None:
-        seg_tile = seg_tile[seg_tile.index.isin(np.asarray(segment_ids))]
     pieces = []
     for f in files:
         tile = f.stem.split("=", 1)[1]
-        mesh_path = data_dir / "city" / "meshes" / f"{tile}.npz"
+        mesh_path = run.data_dir / "city" / "meshes" / f"{tile}.npz"
         if not mesh_path.exists():
             log.warning("no city mesh for tile %s (%s): its reflectors are not attributed", tile, mesh_path)
             continue
         geo = pd.read_parquet(f)
-        geo = geo[geo["segment_id"].isin(seg_tile.index)]
+        if sel is not None:
+            geo = geo[sel.contains(geo["segment_id"].to_numpy(np.int64))]
         groups = sorted(int(c[1:-2]) for c in geo.columns if re.fullmatch(r"r\d+_w", c))
+        sm = _tile_reflected(run, tile, months)
+        geo = geo[geo["segment_id"].isin(sm["segment_id"])]
         if geo.empty or not groups:
             continue
         w = np.stack([geo[f"r{g}_w"].to_numpy(np.float64) for g in groups], 1)          # (n, G)
@@ -222,205 +776,86 @@ def reflector_contributions(run: RunData, segment_ids=None) -> pd.DataFrame:
         tri_all = np.full(len(seg_idx), -1)
         tri_all[np.flatnonzero(ok)] = np.where(np.abs(t - dist[ok]) < 0.25, tri, -1)
         hit = tri_all >= 0
-        sid = mesh.surface_ids[mesh.surface_index[tri_all[hit]]]
-        stype = np.asarray(SURFACE_TYPES)[mesh.surface_type[tri_all[hit]]]
-        pieces.append(pd.DataFrame({"segment_id": geo["segment_id"].to_numpy()[seg_idx[hit]],
-                                    "surface_id": sid, "surface_type": stype,
-                                    "share": share[seg_idx[hit], g_idx[hit]]}))
+        att = pd.DataFrame({"segment_id": geo["segment_id"].to_numpy()[seg_idx[hit]],
+                            "surface_id": mesh.surface_ids[mesh.surface_index[tri_all[hit]]],
+                            "surface_type": np.asarray(SURFACE_TYPES)[mesh.surface_type[tri_all[hit]]],
+                            "share": share[seg_idx[hit], g_idx[hit]]})
+        att = att[~att["surface_type"].isin(["terrain", "ground", "vegetation"])]
+        if att.empty:
+            continue
+        att = att.groupby(["segment_id", "surface_id", "surface_type"], as_index=False)["share"].sum()
+        per = att.merge(sm, on="segment_id")
+        per["pv_kwh_reflected"] = per["pv_kwh_reflected"] * per["share"]
+        pieces.append(per[["surface_id", "surface_type", "segment_id", "month", "pv_kwh_reflected"]])
     if not pieces:
         return pd.DataFrame(columns=cols)
-    att = pd.concat(pieces, ignore_index=True)
-    att = att[~att["surface_type"].isin(["terrain", "ground", "vegetation"])]
-    if att.empty:
-        return pd.DataFrame(columns=cols)
-    att = att.groupby(["segment_id", "surface_id", "surface_type"], as_index=False)["share"].sum()
-    bid = _building_ids(data_dir, set(att["surface_id"]))
-    att["building_id"] = att["surface_id"].map(bid)
-    sm = run.segment_month[["segment_id", "month", "pv_kwh_reflected"]]
-    per = att.merge(sm, on="segment_id")
-    per["pv_kwh_reflected"] = per["pv_kwh_reflected"] * per["share"]
+    per = pd.concat(pieces, ignore_index=True)
+    bid = _building_ids(run.data_dir, set(per["surface_id"]))
+    per["building_id"] = per["surface_id"].map(bid)
     out = (per.groupby(["surface_id", "building_id", "surface_type", "month"], as_index=False, dropna=False)
            .agg(pv_kwh_reflected=("pv_kwh_reflected", "sum"), segments=("segment_id", "nunique")))
     return out[cols]
 
 
+def _tile_reflected(run: RunData, tile: str, months: list[str]) -> pd.DataFrame:
+    """``segment_id, month, pv_kwh_reflected`` of one tile (its run partitions)."""
+    frames = []
+    for m in months:
+        f = run.run_dir / "parts" / "segment_month" / f"tile={tile}" / f"month={m}.parquet"
+        if f.exists():
+            d = pq.read_table(f, columns=["segment_id", "pv_kwh_reflected"])
+            frames.append(pd.DataFrame({"segment_id": d.column(0).to_numpy(), "month": m,
+                                        "pv_kwh_reflected": d.column(1).to_numpy()}))
+    if not frames:
+        return pd.DataFrame({"segment_id": pd.Series(dtype=np.int64), "month": pd.Series(dtype=object),
+                             "pv_kwh_reflected": pd.Series(dtype=np.float64)})
+    return pd.concat(frames, ignore_index=True)
+
+
 def _building_ids(data_dir: Path, wanted: set) -> dict:
+    import pyarrow as pa
+    import pyarrow.compute as pc
+
+    value_set = pa.array(sorted(map(str, wanted)), pa.string())
     out = {}
     for f in sorted((data_dir / "city" / "surfaces").glob("tile=*/*.parquet")):
-        s = pd.read_parquet(f, columns=["surface_id", "building_id"])
-        s = s[s["surface_id"].isin(wanted)]
-        out.update(zip(s["surface_id"], s["building_id"]))
+        t = pq.read_table(f, columns=["surface_id", "building_id"])
+        t = t.filter(pc.is_in(pc.cast(t.column("surface_id"), pa.string()), value_set=value_set))
+        out.update(zip(t.column("surface_id").to_pylist(), t.column("building_id").to_pylist()))
     return out
-
-
-# ----------------------------------------------------------------------------- XML building
-def _generic(parent, kind: str, name: str, value: str) -> None:
-    prop = _sub(parent, "core:genericAttribute")
-    attr = _sub(prop, f"gen:{kind}")
-    _sub(attr, "gen:name", name)
-    _sub(attr, "gen:value", value)
-
-
-class _Tabulated:
-    """The CSV beside the GML holding every tabulated series (one row per value)."""
-
-    HEADER = ["series", "timestamp", "value"]
-
-    def __init__(self, path: Path):
-        self.path = path
-        self._fh = path.open("w", newline="", encoding="utf-8")
-        self._w = csv.writer(self._fh, lineterminator="\n")
-        self._w.writerow(self.HEADER)
-
-    def add(self, s: Series) -> str:
-        key = f"{s.object_id}/{s.attribute}"
-        for t, v in zip(s.timestamps, s.values):
-            self._w.writerow([key, t, _num(v)])
-        return key
-
-    def close(self) -> None:
-        self._fh.close()
-
-
-def _dynamizer(parent, s: Series, encoding: str, table: _Tabulated | None) -> None:
-    prop = _sub(parent, "core:dynamizer")
-    dyn = _sub(prop, "dyn:Dynamizer", **{"gml:id": s.dynamizer_id})
-    _sub(dyn, "gml:name", f"{s.attribute} of {s.object_id}")
-    _sub(dyn, "dyn:attributeRef", attribute_ref(s.object_tag, s.object_id, s.attribute))
-    _sub(dyn, "dyn:startTime", s.start)
-    _sub(dyn, "dyn:endTime", s.end)
-    data = _sub(dyn, "dyn:dynamicData")
-    if encoding == "inline":
-        ts = _sub(data, "dyn:GenericTimeseries", **{"gml:id": s.dynamizer_id + "_ts"})
-    else:
-        ts = _sub(data, "dyn:TabulatedFileTimeseries", **{"gml:id": s.dynamizer_id + "_ts"})
-    _sub(ts, "dyn:firstTimestamp", s.timestamps[0])
-    _sub(ts, "dyn:lastTimestamp", s.timestamps[-1])
-    _sub(ts, "dyn:observationProperty", s.observation)
-    _sub(ts, "dyn:uom", s.uom)
-    _sub(ts, "dyn:valueType", "double")
-    if encoding == "inline":
-        for t, v in zip(s.timestamps, s.values):
-            tvp = _sub(_sub(ts, "dyn:contents"), "dyn:TimeValuePair")
-            _sub(tvp, "dyn:timestamp", t)
-            _sub(tvp, "dyn:doubleValue", _num(v))
-        return
-    key = table.add(s)
-    _sub(ts, "dyn:fileLocation", table.path.name)
-    _sub(ts, "dyn:fileType", "csv")
-    _sub(ts, "dyn:mimeType", "text/csv")
-    _sub(ts, "dyn:numberOfHeaderLines", "1")
-    _sub(ts, "dyn:fieldSeparator", ",")
-    _sub(ts, "dyn:decimalSymbol", ".")
-    _sub(ts, "dyn:idColumnName", "series")
-    _sub(ts, "dyn:idValue", key)
-    _sub(ts, "dyn:timeColumnName", "timestamp")
-    _sub(ts, "dyn:valueColumnName", "value")
-
-
-def _line_string(parent, geom, srs: str, gid: str) -> None:
-    mc = _sub(_sub(parent, "core:lod0MultiCurve"), "gml:MultiCurve", **{"gml:id": gid + "_mc"})
-    ls = _sub(_sub(mc, "gml:curveMember"), "gml:LineString", **{"gml:id": gid + "_ls"})
-    ls.set("srsName", srs)
-    ls.set("srsDimension", "3")
-    coords = np.asarray(geom.coords, dtype=np.float64)
-    if coords.shape[1] == 2:
-        coords = np.column_stack([coords, np.zeros(len(coords))])
-    _sub(ls, "gml:posList", " ".join(_num(v) for v in coords.ravel()))
-
-
-def _segment_series(run: RunData, seg_ids: np.ndarray, prefix: str) -> dict[int, list[Series]]:
-    sm = run.segment_month[run.segment_month["segment_id"].isin(seg_ids)].sort_values(["segment_id", "month"])
-    out: dict[int, list[Series]] = {}
-    for sid, g in sm.groupby("segment_id", sort=True):
-        stamps, end = _month_bounds(g["month"], run.timezone)
-        oid = f"{prefix}seg_{sid}"
-        out[int(sid)] = [Series(oid, CITY_OBJECT["segment"], a, obs, uom, stamps,
-                                g[a].to_numpy(np.float64), stamps[0], end)
-                         for a, (obs, uom) in SEGMENT_SERIES.items()]
-    return out
-
-
-def _members(run: RunData, encoding: str, table: _Tabulated | None, prefix: str,
-             max_segments: int | None, counts: dict) -> Iterator[etree._Element]:
-    """``core:cityObjectMember`` elements, one shape (Road) at a time."""
-    srs = _srs_name(run.crs)
-    segs = run.segments.sort_values(["shape_id", "segment_id"])
-    if max_segments is not None:
-        segs = segs.iloc[:max_segments]
-    for shape_id, block in segs.groupby("shape_id", sort=True):
-        series = _segment_series(run, block["segment_id"].to_numpy(), prefix)
-        member = etree.Element(_q("core:cityObjectMember"), nsmap=NSMAP)
-        road = _sub(member, "tran:Road", **{"gml:id": f"{prefix}road_{shape_id}"})
-        _sub(road, "gml:name", f"bus roof path of shape {shape_id}")
-        _generic(road, "StringAttribute", "shape_id", str(shape_id))
-        for _, row in block.iterrows():
-            sid = int(row["segment_id"])
-            if sid not in series:          # segment without passes in the run's months
-                continue
-            ts = _sub(_sub(road, "tran:trafficSpace"), "tran:TrafficSpace",
-                      **{"gml:id": f"{prefix}seg_{sid}"})
-            _generic(ts, "IntAttribute", "segment_id", str(sid))
-            for s in series[sid]:
-                _generic(ts, "DoubleAttribute", s.attribute, _num(s.values.sum()))
-            for s in series[sid]:
-                _dynamizer(ts, s, encoding, table)
-                counts["dynamizers"] += 1
-            _line_string(ts, row.geometry, srs, f"{prefix}seg_{sid}")
-            _sub(ts, "tran:granularity", "lane")
-            counts["segments"] += 1
-        yield member
-    # network-level hourly pattern
-    hp = run.hourly.sort_values(["month", "hour"])
-    if len(hp):
-        member = etree.Element(_q("core:cityObjectMember"), nsmap=NSMAP)
-        oid = f"{prefix}network"
-        net = _sub(member, "gen:GenericLogicalSpace", **{"gml:id": oid})
-        _sub(net, "gml:name", "bus network of the run (hourly pattern, all segments)")
-        stamps = [_iso(pd.Timestamp(str(m)[:7] + "-01", tz=run.timezone) + pd.Timedelta(hours=int(h)))
-                  for m, h in zip(hp["month"], hp["hour"])]
-        _, end = _month_bounds(hp["month"], run.timezone)
-        net_series = [Series(oid, CITY_OBJECT["network"], a, obs, uom, stamps,
-                             hp[a].to_numpy(np.float64), _month_bounds(hp["month"], run.timezone)[0][0], end)
-                      for a, (obs, uom) in NETWORK_SERIES.items() if a in hp]
-        for s in net_series:
-            _generic(net, "DoubleAttribute", s.attribute, _num(np.nanmean(s.values)))
-        for s in net_series:
-            _dynamizer(net, s, encoding, table)
-            counts["dynamizers"] += 1
-        counts["network"] += 1
-        yield member
-    # reflecting building surfaces
-    refl = reflector_contributions(run, segs["segment_id"].to_numpy())
-    for (surface_id, building_id, stype), g in refl.groupby(["surface_id", "building_id", "surface_type"],
-                                                            sort=True, dropna=False):
-        g = g.sort_values("month")
-        oid = f"{prefix}refl_{surface_id}"
-        member = etree.Element(_q("core:cityObjectMember"), nsmap=NSMAP)
-        surf = _sub(member, "gen:GenericThematicSurface", **{"gml:id": oid})
-        _sub(surf, "gml:name", f"reflection onto the routes by {stype} surface {surface_id}")
-        if isinstance(building_id, str):
-            _sub(surf, "core:relatedTo", **{"xlink:href": f"#{building_id}"})
-        stamps, end = _month_bounds(g["month"], run.timezone)
-        obs, uom = SURFACE_SERIES["pv_kwh_reflected"]
-        s = Series(oid, CITY_OBJECT["surface"], "pv_kwh_reflected", obs, uom, stamps,
-                   g["pv_kwh_reflected"].to_numpy(np.float64), stamps[0], end)
-        _generic(surf, "StringAttribute", "surface_id", str(surface_id))
-        if isinstance(building_id, str):
-            _generic(surf, "StringAttribute", "building_id", building_id)
-        _generic(surf, "StringAttribute", "surface_type", str(stype))
-        _generic(surf, "IntAttribute", "segments", str(int(g["segments"].max())))
-        _generic(surf, "DoubleAttribute", s.attribute, _num(s.values.sum()))
-        _dynamizer(surf, s, encoding, table)
-        counts["dynamizers"] += 1
-        counts["surfaces"] += 1
-        yield member
 
 
 # ----------------------------------------------------------------------------- writer
+def choose_aggregate(run: RunData, sel: Selection, aggregate: str | None) -> str:
+    """*aggregate* itself, or for None ``"segment"`` up to ``AUTO_ROUTE_ABOVE`` selected segments
+    and ``"route"`` above (counted from ``segments.parquet`` and the selected routes)."""
+    if aggregate is not None:
+        if aggregate not in AGGREGATES:
+            raise InputError(f"unknown aggregation {aggregate!r} (choose {' or '.join(AGGREGATES)})")
+        return aggregate
+    n = pq.ParquetFile(run.segments_path).metadata.num_rows
+    if sel.routes is not None:
+        import pyarrow as pa
+        import pyarrow.compute as pc
+
+        ids = set()
+        for b in pq.ParquetFile(run.segment_month_path).iter_batches(
+                _BATCH_ROWS * 4, columns=["segment_id", "route_short_name"]):
+            keep = pc.is_in(pc.cast(b.column(1), pa.string()), value_set=pa.array(sel.routes))
+            ids.update(pc.unique(b.column(0).filter(keep)).to_pylist())
+            if len(ids) > AUTO_ROUTE_ABOVE:
+                break
+        n = len(ids)
+    if sel.max_segments is not None:
+        n = min(n, sel.max_segments)
+    return "segment" if n <= AUTO_ROUTE_ABOVE else "route"
+
+
 def write_dynamizers(run_dir: str | Path, out: str | Path, encoding: str = "inline",
-                     embed: str | Path | None = None, max_segments: int | None = None) -> dict:
-    """Write the run's results as a CityGML 3.0 file with Dynamizers.
+                     embed: str | Path | None = None, max_segments: int | None = None,
+                     aggregate: str | None = "segment", routes=None, months=None,
+                     reflectors: bool | None = None) -> dict:
+    """Write the run's results as a CityGML 3.0 file with Dynamizers, streamed.
 
     Parameters
     ----------
@@ -429,51 +864,105 @@ def write_dynamizers(run_dir: str | Path, out: str | Path, encoding: str = "inli
     encoding : ``"inline"`` (``dyn:GenericTimeseries``) or ``"tabulated"``
         (``dyn:TabulatedFileTimeseries`` pointing at ``<out stem>.csv`` beside *out*)
     embed : a CityGML 3.0 file: *out* is then a streamed copy of it with the results added
-        as further ``cityObjectMember`` elements
-    max_segments : export only the first N segments (ordered by shape, segment id)
+        as further ``cityObjectMember`` elements (and the modules added to its schemaLocation)
+    max_segments : export only the first N selected segments (in segment id order)
+    aggregate : ``"segment"`` (a TrafficSpace per segment), ``"route"`` (per route and
+        direction), or None: segment up to ``AUTO_ROUTE_ABOVE`` segments, route above
+    routes : route short names to export (default all)
+    months : months to export, ``6`` or ``"2024-06"`` (default all of the run)
+    reflectors : write the reflecting building surfaces (default: with ``"segment"`` only; a
+        network's reflecting surfaces outnumber its route directions by far)
 
     Returns
     -------
-    dict: ``files`` (paths written), ``segments``, ``surfaces``, ``network``, ``dynamizers``
+    dict: ``files`` (paths written), ``aggregate``, ``segments``, ``route_directions``,
+    ``surfaces``, ``network``, ``dynamizers``
     """
     if encoding not in ENCODINGS:
         raise InputError(f"unknown encoding {encoding!r} (choose {' or '.join(ENCODINGS)})")
+    if embed is not None and not Path(embed).exists():
+        raise InputError(f"--embed: file not found: {embed}")
     run = load_run(run_dir)
+    sel = _selection(run, months, routes, max_segments)
+    aggregate = choose_aggregate(run, sel, aggregate)
     out = Path(out)
     out.parent.mkdir(parents=True, exist_ok=True)
-    counts = {"segments": 0, "surfaces": 0, "network": 0, "dynamizers": 0}
+    counts = {"segments": 0, "route_directions": 0, "surfaces": 0, "network": 0, "dynamizers": 0}
     table = _Tabulated(out.with_suffix(".csv")) if encoding == "tabulated" else None
-    prefix = "vipv_"
     tmp = out.with_name(out.name + ".tmp")
-    try:
-        members = _members(run, encoding, table, prefix, max_segments, counts)
-        if embed is None:
-            _write_standalone(tmp, run, members)
+
+    def members() -> Iterator[MemberWriter]:
+        if aggregate == "segment":
+            yield from _segment_members(run, sel, table, counts)
         else:
-            _write_embedded(tmp, Path(embed), members)
+            yield from _route_members(run, sel, table, counts)
+        net = _network_member(run, sel, table, counts)
+        if net is not None:
+            yield net
+        if reflectors if reflectors is not None else aggregate == "segment":
+            yield from _surface_members(run, sel, table, counts)
+
+    ok = False
+    try:
+        if embed is None:
+            _write_standalone(tmp, run, sel, members())
+        else:
+            _write_embedded(tmp, Path(embed), members())
+        ok = True
     finally:
         if table is not None:
-            table.close()
+            table.close(keep=ok)
+        if not ok:
+            tmp.unlink(missing_ok=True)
     tmp.replace(out)
     files = [out] + ([table.path] if table is not None else [])
-    return {"files": files, **counts}
+    return {"files": files, "aggregate": aggregate, **counts}
 
 
-def _write_standalone(path: Path, run: RunData, members: Iterator[etree._Element]) -> None:
+def _envelope(run: RunData) -> etree._Element | None:
+    """``gml:boundedBy`` of every segment of the run (streamed min / max of the end points)."""
+    lo, hi = np.full(3, np.inf), np.full(3, -np.inf)
+    cols = ["x", "y", "z", "x_end", "y_end", "z_end"]
+    for b in pq.ParquetFile(run.segments_path).iter_batches(_BATCH_ROWS, columns=cols):
+        a = np.column_stack([b.column(c).to_numpy() for c in cols]).reshape(-1, 3)
+        if len(a):
+            lo, hi = np.minimum(lo, a.min(0)), np.maximum(hi, a.max(0))
+    if not np.isfinite(lo).all():
+        return None
+    crs = f' srsName="{_esc(run.srs_name)}"' if run.srs_name else ""
+    return _chunk(f'<gml:boundedBy xmlns:gml="{NSMAP["gml"]}">\n  <gml:Envelope srsDimension="3"{crs}>\n'
+                  f'    <gml:lowerCorner>{" ".join(map(_num, lo))}</gml:lowerCorner>\n'
+                  f'    <gml:upperCorner>{" ".join(map(_num, hi))}</gml:upperCorner>\n'
+                  "  </gml:Envelope>\n</gml:boundedBy>")
+
+
+def _write_standalone(path: Path, run: RunData, sel: Selection, members: Iterator[MemberWriter]) -> None:
+    attrib = {GML_ID: f"{PREFIX}results", f"{{{XSI}}}schemaLocation": schema_location()}
     with etree.xmlfile(str(path), encoding="utf-8") as xf:
         xf.write_declaration()
-        with xf.element(_q("core:CityModel"), {GML_ID: "vipv_results"}, nsmap=NSMAP):
-            xf.write(etree.fromstring(
-                f'<gml:name xmlns:gml="{GML}">vipvflow results of '
-                f'{run.manifest.get("scenario", "?")} {run.manifest.get("year", "?")}</gml:name>'))
-            for m in members:
+        with xf.element(T["core:CityModel"], attrib, nsmap=NSMAP):
+            name = etree.Element(T["gml:name"], nsmap=_GML_NSMAP)
+            name.text = (f"vipvflow results of {run.manifest.get('scenario', '?')} "
+                         f"{run.manifest.get('year', '?')} ({', '.join(sel.months)})")
+            xf.write("\n", name)
+            bounds = _envelope(run)
+            if bounds is not None:
+                xf.write("\n", bounds, pretty_print=False)
+            for write in members:
                 xf.write("\n")
-                xf.write(m)
+                write(xf)
             xf.write("\n")
 
 
-#: CityModel children that must follow every cityObjectMember (CityGML 3.0 core.xsd order)
-_AFTER_MEMBERS = {"appearanceMember", "featureMember", "versionMember", "versionTransitionMember"}
+# ----------------------------------------------------------------------------- embedding
+#: CityModel children after which no cityObjectMember may come (CityGML 3.0 core.xsd: the
+#: members form one repeated choice, closed by the ADE hook adeOfCityModel); inserting before
+#: the first non-cityObjectMember member keeps the input's own order of members too
+_AFTER_MEMBERS = {"appearanceMember", "featureMember", "versionMember", "versionTransitionMember",
+                  "adeOfCityModel"}
+_START_TAG = re.compile(rb"<(?P<name>[^\s/>?!]+)(?P<attrs>(?:\s+[^\s=/>]+\s*=\s*(?:\"[^\"]*\"|'[^']*'))*)\s*(?P<end>/?>)")
+_PROLOG_ITEM = re.compile(rb"\s*(<\?.*?\?>|<!--.*?-->|<!DOCTYPE[^>]*>)", re.S)
+_XMLNS = re.compile(rb"\sxmlns:(?P<p>[A-Za-z_][\w.-]*)\s*=\s*([\"'])(?P<uri>[^\"']*)\2")
 
 
 def _insertion_point(src: Path) -> tuple[str, int | None]:
@@ -482,13 +971,12 @@ def _insertion_point(src: Path) -> tuple[str, int | None]:
     before the closing root tag)."""
     depth, root_qname, line = 0, None, None
     try:
-        ctx = etree.iterparse(str(src), events=("start", "end"), huge_tree=True)
-        for event, el in ctx:
+        for event, el in etree.iterparse(str(src), events=("start", "end"), huge_tree=True):
             if event == "start":
                 depth += 1
                 if depth == 1:
-                    q = etree.QName(el)
-                    if q.namespace != CORE or q.localname != "CityModel":
+                    name = etree.QName(el)
+                    if name.namespace != CORE or name.localname != "CityModel":
                         raise InputError(f"{src}: not a CityGML 3.0 CityModel (root {el.tag}); "
                                          "--embed needs CityGML 3.0")
                     root_qname = f"{el.prefix}:CityModel" if el.prefix else "CityModel"
@@ -506,40 +994,101 @@ def _insertion_point(src: Path) -> tuple[str, int | None]:
     return root_qname, line
 
 
-def _write_embedded(path: Path, src: Path, members: Iterator[etree._Element]) -> None:
-    """Copy *src* line by line, inserting the members where CityGML 3.0 allows them."""
-    if not src.exists():
-        raise InputError(f"--embed: file not found: {src}")
+def _root_start_tag(head: bytes, src: Path) -> re.Match:
+    """The root start tag in the first bytes of a file (after declaration, comments, DOCTYPE)."""
+    pos = 0
+    while True:
+        m = _PROLOG_ITEM.match(head, pos)
+        if not m:
+            break
+        pos = m.end()
+    m = _START_TAG.search(head, pos)
+    if m is None:
+        raise InputError(f"{src}: root start tag not found in the first {len(head):,} bytes")
+    return m
+
+
+def _with_schema_locations(tag: bytes) -> bytes:
+    """The root start tag with the export's modules added to its ``xsi:schemaLocation``."""
+    prefixes = {m["p"]: m["uri"] for m in _XMLNS.finditer(tag)}
+    xsi = next((p for p, uri in prefixes.items() if uri == XSI.encode()), None)
+    end = tag.rstrip()[-2:] if tag.rstrip().endswith(b"/>") else tag.rstrip()[-1:]
+    body = tag.rstrip()[:-len(end)]
+    if xsi is None:
+        xsi = b"xsi"
+        while xsi in prefixes:
+            xsi += b"_"
+        body += b' xmlns:' + xsi + b'="' + XSI.encode() + b'"'
+    loc = re.compile(rb"(\s" + re.escape(xsi) + rb":schemaLocation\s*=\s*)([\"'])([^\"']*)\2")
+    m = loc.search(body)
+    present = set(m.group(3).split()[::2]) if m else set()
+    extra = " ".join(f"{ns} {url}" for ns, url in SCHEMA_LOCATIONS.items() if ns.encode() not in present).encode()
+    if not extra:
+        return tag
+    if m:
+        value = (m.group(3).rstrip() + b" " + extra).strip()
+        body = body[:m.start(3)] + value + body[m.end(3):]
+    else:
+        body += b" " + xsi + b':schemaLocation="' + extra + b'"'
+    return body + end
+
+
+def _write_embedded(path: Path, src: Path, members: Iterator[MemberWriter]) -> None:
+    """Copy *src* as a stream, inserting the members where CityGML 3.0 allows them and adding
+    the export's modules to the root's ``xsi:schemaLocation``."""
     root_qname, line = _insertion_point(src)
     close = f"</{root_qname}".encode()
 
     def emit(fh):
-        for m in members:
-            fh.write(etree.tostring(m, encoding="utf-8"))
+        for write in members:
+            with etree.xmlfile(fh, encoding="utf-8") as xf:
+                write(xf)
             fh.write(b"\n")
 
     with src.open("rb") as fin, path.open("wb") as fout:
+        head = fin.read(1 << 20)
+        m = _root_start_tag(head, src)
+        fout.write(head[:m.start()])
+        fout.write(_with_schema_locations(m.group(0)))
+        start_lines = head[:m.end()].count(b"\n")       # lines before the rest of the copy
+        rest = head[m.end():]
         if line is not None:
-            for no, raw in enumerate(fin, start=1):
+            # copy up to the line of the first non-cityObjectMember member, insert, copy on
+            no = start_lines + 1
+            buf = rest
+            while True:
+                nl = buf.find(b"\n")
+                if nl < 0:
+                    more = fin.read(1 << 20)
+                    if not more:
+                        raise InputError(f"{src}:{line}: insertion line not found")
+                    buf += more
+                    continue
                 if no == line:
-                    head = raw[:len(raw) - len(raw.lstrip())]
-                    if raw[len(head):len(head) + 1] != b"<":
+                    stripped = buf.lstrip(b" \t")
+                    if not stripped.startswith(b"<"):
                         raise InputError(f"{src}:{line}: cannot insert before a member sharing its line")
                     emit(fout)
-                fout.write(raw)
+                    fout.write(buf)
+                    break
+                fout.write(buf[:nl + 1])
+                buf = buf[nl + 1:]
+                no += 1
+            while chunk := fin.read(1 << 20):
+                fout.write(chunk)
             return
         # insert before the closing root tag: copy everything up to it, in chunks
         size = src.stat().st_size
-        tail_len = min(size, 1 << 16)
+        tail_len = min(size - m.end(), 1 << 16)
         fin.seek(size - tail_len)
         tail = fin.read()
         pos = tail.rfind(close)
         if pos < 0:
             raise InputError(f"{src}: closing {root_qname} tag not found")
         cut = size - tail_len + pos
-        fin.seek(0)
-        left = cut
-        while left:
+        fin.seek(m.end())
+        left = cut - m.end()
+        while left > 0:
             chunk = fin.read(min(left, 1 << 20))
             fout.write(chunk)
             left -= len(chunk)
@@ -550,7 +1099,7 @@ def _write_embedded(path: Path, src: Path, members: Iterator[etree._Element]) ->
 
 # ----------------------------------------------------------------------------- reader
 def read_dynamizers(path: str | Path) -> pd.DataFrame:
-    """Every Dynamizer's values in a CityGML 3.0 file, inline or tabulated.
+    """Every Dynamizer's values in a CityGML 3.0 file, inline or tabulated (streamed).
 
     Returns
     -------
@@ -562,34 +1111,49 @@ def read_dynamizers(path: str | Path) -> pd.DataFrame:
         raise InputError(f"file not found: {path}")
     tables: dict[Path, pd.DataFrame] = {}
     rows: list[tuple] = []
-    for _, el in etree.iterparse(str(path), events=("end",), tag=f"{{{DYN}}}Dynamizer", huge_tree=True):
-        ref = el.findtext(f"{{{DYN}}}attributeRef") or ""
+    d = f"{{{DYN}}}"
+    member = q("core:cityObjectMember")
+    for _, el in etree.iterparse(str(path), events=("end",), tag=(f"{d}Dynamizer", member), huge_tree=True):
+        if el.tag == member:          # a city object read: drop it and what came before
+            el.clear()
+            parent = el.getparent()
+            if parent is not None:
+                while el.getprevious() is not None:
+                    del parent[0]
+            continue
+        ref = el.findtext(f"{d}attributeRef") or ""
         m = _REF.search(ref)
         if not m:
-            raise InputError(f"{path}: Dynamizer {el.get(GML_ID)}: attributeRef not understood: {ref!r}")
+            raise InputError(f"{path}:{el.sourceline}: Dynamizer {el.get(GML_ID)}: attributeRef not "
+                             f"understood: {ref!r}")
         oid, attr = m["id"], m["attr"]
-        ts = el.find(f"{{{DYN}}}dynamicData/*")
-        uom = ts.findtext(f"{{{DYN}}}uom")
-        if ts.tag == f"{{{DYN}}}GenericTimeseries":
-            for tvp in ts.iterfind(f"{{{DYN}}}contents/{{{DYN}}}TimeValuePair"):
-                rows.append((oid, attr, tvp.findtext(f"{{{DYN}}}timestamp"),
-                             float(tvp.findtext(f"{{{DYN}}}doubleValue")), uom))
-        elif ts.tag == f"{{{DYN}}}TabulatedFileTimeseries":
-            loc = path.parent / ts.findtext(f"{{{DYN}}}fileLocation")
+        ts = el.find(f"{d}dynamicData/*")
+        if ts is None:
+            raise InputError(f"{path}:{el.sourceline}: Dynamizer {el.get(GML_ID)} has no dynamicData")
+        uom = ts.findtext(f"{d}uom")
+        if ts.tag == f"{d}GenericTimeseries":
+            for pair in ts.iterfind(f"{d}timeValuePair/{d}TimeValuePair"):
+                rows.append((oid, attr, pair.findtext(f"{d}timestamp"),
+                             float(pair.findtext(f"{d}doubleValue")), uom))
+        elif ts.tag == f"{d}TabulatedFileTimeseries":
+            loc = path.parent / ts.findtext(f"{d}fileLocation")
             if loc not in tables:
                 if not loc.exists():
                     raise InputError(f"{path}: tabulated time series file not found: {loc}")
-                sep = ts.findtext(f"{{{DYN}}}fieldSeparator") or ","
-                skip = int(ts.findtext(f"{{{DYN}}}numberOfHeaderLines") or 0)
-                tables[loc] = pd.read_csv(loc, sep=sep, skiprows=max(skip - 1, 0), header=0 if skip else None,
-                                          dtype=str, keep_default_na=False)
-            tab = tables[loc]
-            idc, idv = ts.findtext(f"{{{DYN}}}idColumnName"), ts.findtext(f"{{{DYN}}}idValue")
-            sel = tab[tab[idc] == idv] if idc else tab
-            tcol, vcol = ts.findtext(f"{{{DYN}}}timeColumnName"), ts.findtext(f"{{{DYN}}}valueColumnName")
+                sep = ts.findtext(f"{d}fieldSeparator") or ","
+                skip = int(ts.findtext(f"{d}numberOfHeaderLines") or 0)
+                tab = pd.read_csv(loc, sep=sep, skiprows=max(skip - 1, 0), header=0 if skip else None,
+                                  dtype=str, keep_default_na=False)
+                idc = ts.findtext(f"{d}idColumnName")
+                tables[loc] = (tab, {k: g for k, g in tab.groupby(idc, sort=False)} if idc else None)
+            tab, by_id = tables[loc]
+            idv = ts.findtext(f"{d}idValue")
+            sel = by_id.get(idv, tab.iloc[:0]) if by_id is not None else tab
+            tcol, vcol = ts.findtext(f"{d}timeColumnName"), ts.findtext(f"{d}valueColumnName")
             rows.extend((oid, attr, t, float(v), uom) for t, v in zip(sel[tcol], sel[vcol]))
         else:
-            raise InputError(f"{path}: Dynamizer {el.get(GML_ID)}: unsupported time series {ts.tag}")
+            raise InputError(f"{path}:{el.sourceline}: Dynamizer {el.get(GML_ID)}: unsupported time "
+                             f"series {ts.tag}")
         el.clear()
     df = pd.DataFrame(rows, columns=["object_id", "attribute", "timestamp", "value", "uom"])
     df["timestamp"] = pd.to_datetime(df["timestamp"], utc=True)
