@@ -3,6 +3,7 @@ two `dask worker` processes), driven through `vipvflow simulate --scheduler tcp:
 another working directory: the results equal the LocalCluster run's."""
 from __future__ import annotations
 
+import json
 import os
 import shutil
 import signal
