@@ -1,0 +1,148 @@
+"""A bus standing still: layovers at terminals and parking at the depot.
+
+A standing roof is a fixed point, so it goes through the same irradiance kernel as a road
+segment: its geometry factors (sky view factor, reflector groups) once per point with
+:func:`vipvflow.irradiance.segment_geometry` (a flat roof: no gradient), then
+:func:`vipvflow.irradiance.evaluate_passes` at the middle of every minute the point's
+intervals span (the radiation table's own grid: CAMS minute means at minute centres).  The
+minute values are summed into a running total per point, and an interval ``[t0, t1)`` takes
+the difference of that total at its ends, interpolated within a minute: the exact integral
+of the minute-constant irradiance, whatever the interval's length, so splitting a span into
+intervals never changes its sum.
+
+``depot_shading``: ``city`` points are evaluated in their tile's city model, ``open`` points
+in an empty scene (no shade, no reflection: the roof of a bus in an open field, so the
+all-sky ``total`` is ``DNI cos(zenith) + DHI``), ``covered`` points receive nothing.
+"""
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from ..config import IrradianceCfg
+from .storage import partition_path, write_parquet
+
+#: energy (kWh) columns of an interval and the irradiance component each integrates
+PV_SOURCE = {"pv_kwh": "total", "pv_kwh_clear": "total_clear", "pv_kwh_unshaded": "total_unshaded",
+             "pv_kwh_clear_unshaded": "total_clear_unshaded", "pv_kwh_direct": "direct",
+             "pv_kwh_diffuse": "diffuse", "pv_kwh_reflected": "reflected"}
+H_COMPONENTS = ("direct", "diffuse", "reflected", "total", "total_unshaded", "direct_clear",
+                "diffuse_clear", "reflected_clear", "total_clear", "total_clear_unshaded", "ghi",
+                "ghi_clear")
+_MINUTE = 60.0
+
+
+def timeline_dir(run_dir) -> Path:
+    return Path(run_dir) / "parts" / "timeline"
+
+
+def open_scene():
+    """A scene without any surface: an open field."""
+    from ..shading import Scene, box_mesh
+
+    return Scene(box_mesh([]))
+
+
+def point_geometry(scene, points: pd.DataFrame, cfg: IrradianceCfg) -> pd.DataFrame:
+    """Geometry factors of standing roof points (``point_id, x, y, z``, m): a flat roof."""
+    from ..irradiance import segment_geometry
+
+    seg = pd.DataFrame({"segment_id": points["point_id"].to_numpy(np.int64),
+                        "x": points["x"].to_numpy(float), "y": points["y"].to_numpy(float),
+                        "z": points["z"].to_numpy(float), "heading_deg": 0.0, "gradient": 0.0})
+    return segment_geometry(scene, seg, cfg)
+
+
+def interval_integrals(intervals: pd.DataFrame, geometry: pd.DataFrame, radiation, scene,
+                       cfg: IrradianceCfg, energy_kwh, ground_albedo: float = 0.20,
+                       dark: bool = False) -> pd.DataFrame:
+    """Irradiation and PV energy of standing intervals.
+
+    Parameters
+    ----------
+    intervals : DataFrame with ``point_id`` and ``t0_utc, t1_utc`` (Unix s)
+    geometry : :func:`point_geometry` of the points (``segment_id`` = ``point_id``)
+    radiation : vipvflow.radiation.RadiationTable
+    scene : vipvflow.shading.Scene
+    cfg : IrradianceCfg
+    energy_kwh : callable ``(poa_wm2, dt_s) -> kWh`` per minute (the run's PV model, still)
+    ground_albedo : float
+    dark : bool, a covered depot: no light at all
+
+    Returns
+    -------
+    DataFrame indexed like *intervals*: ``seconds``, :data:`PV_SOURCE` columns (kWh) and
+    ``h_<component>`` (Wh/m2) for :data:`H_COMPONENTS`.
+    """
+    from ..irradiance import evaluate_passes
+
+    n = len(intervals)
+    out = {"seconds": (intervals["t1_utc"] - intervals["t0_utc"]).to_numpy(float)}
+    for c in PV_SOURCE:
+        out[c] = np.zeros(n)
+    for c in H_COMPONENTS:
+        out[f"h_{c}"] = np.zeros(n)
+    if dark or not n:
+        return pd.DataFrame(out, index=intervals.index)
+    pid = intervals["point_id"].to_numpy(np.int64)
+    t0 = intervals["t0_utc"].to_numpy(float)
+    t1 = intervals["t1_utc"].to_numpy(float)
+    for p in np.unique(pid):
+        sel = np.flatnonzero(pid == p)
+        lo = np.floor(t0[sel].min() / _MINUTE) * _MINUTE
+        hi = np.ceil(t1[sel].max() / _MINUTE) * _MINUTE
+        edges = np.arange(lo, hi + _MINUTE / 2, _MINUTE)
+        minutes = pd.DataFrame({"segment_id": np.full(len(edges) - 1, p, np.int64),
+                                "t_utc": edges[:-1], "dt_s": np.full(len(edges) - 1, _MINUTE, np.float32)})
+        irr = evaluate_passes(minutes, None, geometry, radiation, scene, cfg,
+                              ground_albedo=ground_albedo, time_at="mid")
+        dt = minutes["dt_s"].to_numpy(np.float64)
+
+        def integral(per_minute):
+            total = np.r_[0.0, np.cumsum(per_minute, dtype=np.float64)]
+            return np.interp(t1[sel], edges, total) - np.interp(t0[sel], edges, total)
+
+        for name, comp in PV_SOURCE.items():
+            out[name][sel] = integral(energy_kwh(irr[comp].to_numpy(np.float64), dt))
+        for c in H_COMPONENTS:
+            out[f"h_{c}"][sel] = integral(irr[c].to_numpy(np.float64) * dt / 3600.0)
+    return pd.DataFrame(out, index=intervals.index)
+
+
+def run_standing(ctx, tile: str, month: str) -> dict:
+    """Evaluate the layover and parked intervals at the points of *tile* (``open`` and
+    ``covered``: the depot outside the city model) of block-days in *month*; writes
+    ``parts/standing/tile=T/month=M.parquet``, one row per interval."""
+    from .partition import _radiation, _scene, pv_energy_kwh, tune_malloc
+
+    tune_malloc()
+    t_start = time.perf_counter()
+    tdir = timeline_dir(ctx.run_dir)
+    points = pd.read_parquet(tdir / "points.parquet")
+    points = points[points["tile"] == tile]
+    iv = pd.read_parquet(tdir / "intervals.parquet", filters=[("month", "==", month)])
+    iv = iv[iv["point_id"].isin(points["point_id"])].reset_index(drop=True)
+    cfg = IrradianceCfg(**ctx.irradiance)
+    m = int(month[5:7])
+
+    def energy(poa, dt):        # the run's PV model, standing still (no cooling by speed)
+        return pv_energy_kwh(poa, dt, np.zeros(len(poa)), m, ctx)
+
+    if tile == "covered" or not len(iv):
+        res = interval_integrals(iv, None, None, None, cfg, energy, dark=True)
+    else:
+        scene = open_scene() if tile == "open" else _scene(ctx, tile)
+        geom = point_geometry(scene, points, cfg)
+        res = interval_integrals(iv, geom, _radiation(ctx.data_dir, ctx.year), scene, cfg, energy,
+                                 ground_albedo=ctx.ground_albedo)
+    table = pd.concat([iv[["block_id", "service_date", "kind", "after_trip", "point_id", "t0_utc",
+                           "t1_utc"]].astype({"block_id": str, "kind": str}), res], axis=1)
+    table["tile"] = tile
+    write_parquet(table, partition_path(Path(ctx.run_dir), "standing", tile, month))
+    elapsed = time.perf_counter() - t_start
+    return {"tile": tile, "month": month, "passes": 0, "trips": 0, "kwh": float(res["pv_kwh"].sum()),
+            "kwh_by_route": {}, "timings": {"standing_s": elapsed}, "intervals": int(len(iv)),
+            "elapsed_s": elapsed}
