@@ -16,6 +16,7 @@ import pandas as pd
 from ..config import Config
 from ..errors import InputError
 from .partition import RunContext, partition_done, run_partition, tile_geometry, worker_bvh_builds
+from .standing import run_standing, standing_done, write_timeline
 from .storage import write_json
 
 log = logging.getLogger(__name__)
@@ -175,9 +176,15 @@ def run_simulation(cfg: Config, year: int, scheduler: str | None = None,
         route_of_trip=dict(zip(trips["trip_id"], trips["route_id"].astype(str))))
 
     todo = [(t, m) for t in tiles for m in _months(cfg, year) if not partition_done(run_dir, t, m)]
-    total = len(tiles) * len(cfg.run.months)
+    # layovers and parked time: one ``standing`` task per (tile of a standing point, month)
+    t_tl = time.perf_counter()
+    standing = write_timeline(cfg, year, run_dir, routes=routes)
+    timings["timeline_s"] = time.perf_counter() - t_tl
+    standing_todo = [(t, m) for t, m in standing if not standing_done(run_dir, t, m)]
+    total = len(tiles) * len(cfg.run.months) + len(standing)
     if max_partitions is not None:
         todo = todo[:max_partitions]
+        standing_todo = standing_todo[:max(0, max_partitions - len(todo))]
     # the radiation table's sun positions are computed (and cached beside the radiation
     # file, where every worker loads them) while the cluster starts
     warm = threading.Thread(target=_warm_radiation, args=(ctx.data_dir, year), daemon=True,
@@ -191,14 +198,15 @@ def run_simulation(cfg: Config, year: int, scheduler: str | None = None,
             max(1, (os.cpu_count() or 1) // max(1, n_workers_now)) if cluster is not None else 1)
         ctx = dataclasses.replace(ctx, ray_threads=ray_threads)
         say(f"dask dashboard: {client.dashboard_link}")
-        say(f"{len(tiles)} tiles x {len(cfg.run.months)} months = {total} partitions, {len(todo)} to compute "
-            f"({total - len(todo)} already done) with {n_workers_now} workers")
+        say(f"{len(tiles)} tiles x {len(cfg.run.months)} months + {len(standing)} standing = {total} partitions, "
+            f"{len(todo) + len(standing_todo)} to compute ({total - len(todo) - len(standing_todo)} already done) "
+            f"with {n_workers_now} workers")
         warm.join()
         t_map = time.perf_counter()
         # the reduce's plotting libraries load while the workers compute
         threading.Thread(target=importlib.import_module, args=("vipvflow.simulation.report",),
                          daemon=True, name="import-report").start()
-        results = _map(client, ctx, todo)
+        results = _map(client, ctx, todo, standing_todo)
         timings["map_s"] = time.perf_counter() - t_map
         builds = client.run(worker_bvh_builds)
     except BaseException:
@@ -208,7 +216,8 @@ def run_simulation(cfg: Config, year: int, scheduler: str | None = None,
     closer = threading.Thread(target=_close, args=(client, cluster), name="close-cluster")
     closer.start()
     try:
-        if not all(partition_done(run_dir, t, m) for t in tiles for m in _months(cfg, year)):
+        if not (all(partition_done(run_dir, t, m) for t in tiles for m in _months(cfg, year))
+                and all(standing_done(run_dir, t, m) for t, m in standing)):
             say("stopped before all partitions were computed; run the same command again to resume")
             return run_dir
         t_red = time.perf_counter()
@@ -240,7 +249,8 @@ def _warm_radiation(data_dir: str, year: int) -> None:
         pass
 
 
-def _map(client, ctx: RunContext, todo: list[tuple[str, str]], every_s: float = 1.0) -> list[dict]:
+def _map(client, ctx: RunContext, todo: list[tuple[str, str]], standing: list[tuple[str, str]] = (),
+         every_s: float = 1.0) -> list[dict]:
     from distributed import as_completed
 
     geometry = {}
@@ -250,6 +260,8 @@ def _map(client, ctx: RunContext, todo: list[tuple[str, str]], every_s: float = 
     for tile, month in todo:
         futures.append(client.submit(run_partition, ctx, tile, month, geometry[tile],
                                      key=f"irradiance-{tile}-{month}"))
+    for tile, month in standing:
+        futures.append(client.submit(run_standing, ctx, tile, month, key=f"standing-{tile}-{month}"))
     view = FleetView(len(futures))
     results = []
     done, last = [], time.perf_counter()
@@ -296,8 +308,14 @@ def _write_manifest(cfg, year, run_dir, checksums, timings, results, builds) -> 
 
 
 def _summary_line(s: dict) -> str:
-    return (f"annual yield {s['kwh_per_kwp_allsky']:.0f} kWh/kWp all-sky, "
-            f"{s['kwh_per_kwp_clearsky']:.0f} clear-sky; shading loss {100 * s['shading_loss_allsky']:.1f} %; "
+    def yield_of(key):
+        return "not computed" if s.get(key) is None else f"{s[key]:.0f} kWh/kWp"
+
+    return (f"annual yield (all-sky) driving {s['kwh_per_kwp_allsky']:.0f} kWh/kWp "
+            f"({s['kwh_per_kwp_clearsky']:.0f} clear-sky), in service {yield_of('kwh_per_kwp_in_service')}, "
+            f"whole day {yield_of('kwh_per_kwp_whole_day')}; "
+            f"shading loss {100 * s['shading_loss_allsky']:.1f} % on the road; "
+            f"the battery takes {s['pv_kwh_usable'] / 1000:.1f} MWh ({s['pv_kwh_curtailed'] / 1000:.1f} MWh curtailed): "
             f"PV covers {100 * s['coverage']:.2f} % of {s['fleet_demand_mwh']:.0f} MWh; "
             f"{s['avoided_charging_cycles_per_bus']:.1f} charging cycles avoided per bus; "
             f"payback {s['payback_years']:.1f} years")

@@ -115,7 +115,8 @@ def interval_integrals(intervals: pd.DataFrame, geometry: pd.DataFrame, radiatio
 def run_standing(ctx, tile: str, month: str) -> dict:
     """Evaluate the layover and parked intervals at the points of *tile* (``open`` and
     ``covered``: the depot outside the city model) of block-days in *month*; writes
-    ``parts/standing/tile=T/month=M.parquet``, one row per interval."""
+    ``parts/standing/tile=T/month=M.parquet``, one row per interval (``seconds`` and the
+    sums are per bus times ``buses``: more than 1 only for the idle buses of a day)."""
     from .partition import _radiation, _scene, pv_energy_kwh, tune_malloc
 
     tune_malloc()
@@ -138,11 +139,74 @@ def run_standing(ctx, tile: str, month: str) -> dict:
         geom = point_geometry(scene, points, cfg)
         res = interval_integrals(iv, geom, _radiation(ctx.data_dir, ctx.year), scene, cfg, energy,
                                  ground_albedo=ctx.ground_albedo)
+    # idle rows stand for several buses: their sums are per bus times the buses
+    res = res.mul(iv["buses"].to_numpy(np.float64), axis=0)
     table = pd.concat([iv[["block_id", "service_date", "kind", "after_trip", "point_id", "t0_utc",
-                           "t1_utc"]].astype({"block_id": str, "kind": str}), res], axis=1)
+                           "t1_utc", "buses"]].astype({"block_id": str, "kind": str}), res], axis=1)
     table["tile"] = tile
     write_parquet(table, partition_path(Path(ctx.run_dir), "standing", tile, month))
     elapsed = time.perf_counter() - t_start
     return {"tile": tile, "month": month, "passes": 0, "trips": 0, "kwh": float(res["pv_kwh"].sum()),
             "kwh_by_route": {}, "timings": {"standing_s": elapsed}, "intervals": int(len(iv)),
             "elapsed_s": elapsed}
+
+
+def depot_point(cfg, data_dir) -> tuple | None:
+    """The configured depot (``fleet.depot``, WGS84) as ``(x, y, z, tile)`` in the run's CRS:
+    the roof height above the road nearest to it; ``None`` when no depot is configured.
+
+    Raises
+    ------
+    InputError
+        With ``depot_shading: city`` when the city model has no mesh at the depot.
+    """
+    import json
+
+    from pyproj import Transformer
+
+    from ..errors import InputError
+    from ..tiles import tile_names
+
+    depot = cfg.fleet.depot
+    if depot is None:
+        return None
+    feed = json.loads((Path(data_dir) / "gtfs" / "feed.json").read_text())
+    x, y = Transformer.from_crs("EPSG:4326", feed["crs"], always_xy=True).transform(depot.lon, depot.lat)
+    seg = pd.read_parquet(Path(data_dir) / "gtfs" / "segments.parquet", columns=["x", "y", "z"])
+    near = int(np.argmin(np.hypot(seg["x"].to_numpy() - x, seg["y"].to_numpy() - y)))
+    tile = str(tile_names([x], [y], float(feed.get("tile_size_m", 500.0)))[0])
+    if cfg.fleet.depot_shading == "city" and not (Path(data_dir) / "city" / "meshes" / f"{tile}.npz").exists():
+        raise InputError(f"{cfg._source}: fleet.depot ({depot.lat}, {depot.lon}) lies outside the city "
+                         f"model (no mesh for tile {tile}); set fleet.depot_shading to open or covered")
+    return float(x), float(y), float(seg["z"].to_numpy()[near]), tile
+
+
+def write_timeline(cfg, year: int, run_dir, routes=None) -> list[tuple[str, str]]:
+    """Cut the run's block-days into driving, layover and parked time
+    (:func:`vipvflow.trajectory.schedule.block_timeline`), keep the kinds ``fleet.harvest``
+    counts, write ``parts/timeline/{block_days,intervals,points}.parquet`` once per run and
+    return the (tile, month) pairs that have standing intervals (the ``standing`` tasks)."""
+    from ..trajectory.schedule import block_timeline
+
+    tdir = timeline_dir(run_dir)
+    if not (tdir / "points.parquet").exists():
+        tl = block_timeline(cfg.data_dir, year, months=cfg.run.months, routes=routes,
+                            depot=depot_point(cfg, cfg.data_dir), depot_shading=cfg.fleet.depot_shading)
+        iv = tl["intervals"]
+        if cfg.fleet.harvest == "in_service":
+            iv = iv[iv["kind"] == "layover"]
+        elif cfg.fleet.harvest == "driving":
+            iv = iv.iloc[:0]
+        write_parquet(tl["block_days"].reset_index(drop=True), tdir / "block_days.parquet")
+        write_parquet(iv.astype({"kind": str}).reset_index(drop=True), tdir / "intervals.parquet")
+        write_parquet(tl["trip_runs"], tdir / "trip_runs.parquet")
+        write_parquet(tl["points"].astype({"stop_id": str, "tile": str, "shading": str}),
+                      tdir / "points.parquet")
+    iv = pd.read_parquet(tdir / "intervals.parquet", columns=["point_id", "month"])
+    tiles = pd.read_parquet(tdir / "points.parquet").set_index("point_id")["tile"]
+    pairs = pd.DataFrame({"tile": tiles.reindex(iv["point_id"]).to_numpy(), "month": iv["month"].to_numpy()})
+    return sorted(set(map(tuple, pairs.drop_duplicates().to_numpy().tolist())))
+
+
+def standing_done(run_dir, tile: str, month: str) -> bool:
+    return partition_path(Path(run_dir), "standing", tile, month).exists()

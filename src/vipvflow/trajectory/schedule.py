@@ -443,6 +443,8 @@ def date_of(value) -> dt.date:
 # the whole day of a vehicle block: trips, layovers, parked
 
 TIMELINE_KINDS = ("layover", "parked")
+#: block id of the buses without a block on a day (parked all day at the depot)
+IDLE_BLOCK = "(idle)"
 
 
 def stop_positions(data_dir, shape_dist: pd.DataFrame) -> pd.DataFrame:
@@ -511,8 +513,13 @@ def block_timeline(data_dir, year: int, months=None, routes=None, depot=None,
         window_end_utc, first_departure_utc, last_arrival_utc, driving_s, overlap_s``;
         ``intervals``: ``block_id, service_date, month, kind`` (layover | parked), ``after_trip``
         (position of the trip before it in the block-day; -1 before the first),
-        ``point_id, t0_utc, t1_utc``; ``points``: ``point_id, stop_id, x, y, z, tile,
-        shading`` (tile ``open`` / ``covered`` for a depot not in the city model).
+        ``point_id, t0_utc, t1_utc, buses`` (1; for the idle rows, block id
+        :data:`IDLE_BLOCK`, the number of buses without a block that day: the fleet has as
+        many buses as the busiest day has blocks, the others stand at the depot, the
+        configured one or the commonest first stop, from the day's origin to the next);
+        ``points``: ``point_id, stop_id, x, y, z, tile, shading`` (tile ``open`` /
+        ``covered`` for a depot not in the city model); ``trip_runs``: ``trip_id,
+        service_date, block_id, position`` (the trip's place in its block-day); ``buses``.
     """
     from ..vehicle import infer_blocks
 
@@ -597,10 +604,24 @@ def block_timeline(data_dir, year: int, months=None, routes=None, depot=None,
     pm = pd.DataFrame({"block_id": bd["block_id"], "date": bd["date"], "kind": "parked",
                        "after_trip": bd["trips"] - 1, "point_id": dp, "t0_utc": bd["last_arrival_utc"],
                        "t1_utc": bd["window_end_utc"]})
-    iv = pd.concat([am, lay, pm], ignore_index=True)
+    # idle buses: on a day with fewer blocks than the fleet has buses (the most blocks of
+    # any day), the others stand parked at the depot from the day's origin to the next
+    per_day = bd.groupby("date").size()
+    n_buses = int(per_day.max()) if len(per_day) else 0
+    days = pd.DatetimeIndex(sorted({d for d in pd.date_range(f"{year}-01-01", f"{year}-12-31", freq="D")
+                                    if months is None or d.month in set(months)})).astype("datetime64[ns]")
+    idle_n = n_buses - per_day.reindex(days, fill_value=0).to_numpy()
+    fleet_depot = (depot_point["depot"] if depot is not None
+                   else int(dp.mode().iloc[0]) if len(dp) else -1)
+    d0, d1 = service_day_origin_utc(days, tz), service_day_origin_utc(days + pd.Timedelta(days=1), tz)
+    idle = pd.DataFrame({"block_id": IDLE_BLOCK, "date": days, "kind": "parked", "after_trip": -1,
+                         "point_id": fleet_depot, "t0_utc": d0, "t1_utc": d1, "buses": idle_n})
+    idle = idle[idle["buses"] > 0]
+    iv = pd.concat([am.assign(buses=1), lay.assign(buses=1), pm.assign(buses=1), idle], ignore_index=True)
     iv = iv[iv["t1_utc"] > iv["t0_utc"]]
     iv = iv.sort_values(key + ["t0_utc"], kind="stable").reset_index(drop=True)
-    iv = iv.rename(columns={"date": "service_date"}).astype({"point_id": np.int64, "after_trip": np.int64})
+    iv = iv.rename(columns={"date": "service_date"}).astype({"point_id": np.int64, "after_trip": np.int64,
+                                                             "buses": np.int64})
     iv["month"] = iv["service_date"].dt.strftime("%Y-%m")
 
     driving = runs.assign(s=runs["t1"] - runs["t0"]).groupby(key, sort=True)["s"].sum()
@@ -609,4 +630,6 @@ def block_timeline(data_dir, year: int, months=None, routes=None, depot=None,
         pd.MultiIndex.from_frame(bd[key]), fill_value=0.0).to_numpy() if len(over) else 0.0
     bd = bd.rename(columns={"date": "service_date"}).drop(columns=["day0", "day1", "first_stop_id"])
     bd["month"] = bd["service_date"].dt.strftime("%Y-%m")
-    return {"block_days": bd, "intervals": iv, "points": pts}
+    trip_runs = pd.DataFrame({"trip_id": runs["trip_id"].astype(str), "service_date": runs["date"],
+                              "block_id": runs["block_id"].astype(str), "position": pos})
+    return {"block_days": bd, "intervals": iv, "points": pts, "trip_runs": trip_runs, "buses": n_buses}
