@@ -184,3 +184,99 @@ def test_timeline_partitions_every_block_day(small_feed):
         assert ((one["t1_utc"] - one["t0_utc"]) == seconds).all()
     parked = iv[(iv["block_id"] == "B1") & (iv["kind"] == "parked")]
     assert set(pts.loc[parked["point_id"], "stop_id"]) == {"A"}
+
+
+def test_block_day_balance_by_hand():
+    from vipvflow.vehicle import VehicleParams, block_day_balance
+
+    params = VehicleParams(curb_mass_kg=12000, cda_m2=6.0, crr=0.007, motor_power_kw=250,
+                           motor_torque_nm=2000, battery_kwh=100.0, soc_min=0.2, soc_max=0.9)
+    # day 0: -30, +5 (PV 15 > use 10: charges 0.6 -> 0.65), parked 40 -> room (0.9-0.65) x 100 = 25
+    # day 1: +8 at the ceiling: all 8 curtailed; parked 3, no room: curtailed
+    pv = np.array([[10.0, 15.0], [18.0, 0.0]])
+    use = np.array([[40.0, 10.0], [10.0, 0.0]])
+    out = block_day_balance(pv, use, [40.0, 3.0], params)
+    np.testing.assert_allclose(out["soc_end"], [0.65, 0.9])
+    np.testing.assert_allclose(out["curtailed_in_service_kwh"], [0.0, 8.0])
+    np.testing.assert_allclose(out["parked_usable_kwh"], [25.0, 0.0])
+    np.testing.assert_allclose(out["curtailed_parked_kwh"], [15.0, 3.0])
+
+
+def test_small_run_splits_every_block_day(small_run, small_config):
+    import json
+
+    from vipvflow.config import load_config
+
+    cfg = load_config(small_config)
+    bd = pd.read_parquet(small_run / "block_day.parquet")
+    s = json.loads((small_run / "summary.json").read_text())
+    # driving + layover + parked = the block-day's window, in time and in energy
+    assert (bd["seconds_driving"] + bd["seconds_layover"] + bd["seconds_parked"] == bd["window_s"]).all()
+    assert (bd["pv_kwh_driving"] + bd["pv_kwh_layover"] + bd["pv_kwh_parked"] == bd["pv_kwh_whole_day"]).all()
+    np.testing.assert_allclose(bd["pv_kwh_usable"] + bd["pv_kwh_curtailed"], bd["pv_kwh_whole_day"], rtol=1e-12)
+    assert (bd["pv_kwh_layover"] > 0).all() and (bd["seconds_layover"] > 0).all()
+    # the driving time is the trips' time on the segments (their passes)
+    trips = pd.read_parquet(small_run / "trip_energy.parquet")
+    np.testing.assert_allclose(bd["seconds_driving"].sum(), trips["seconds"].sum(), rtol=1e-9)
+    # the layovers' auxiliaries: base load and HVAC at June's mean temperature, per hour stood
+    v = cfg.vehicle_params()
+    aux_kw = float(v.aux_kw(cfg.climate.monthly_mean_temperature_c[5]))
+    np.testing.assert_allclose(bd["layover_aux_kwh"], aux_kw * bd["seconds_layover"] / 3600.0
+                               / v.discharge_efficiency, rtol=1e-9)
+    assert bd["demand_kwh"].sum() == pytest.approx(bd["consumption_kwh"].sum() + bd["layover_aux_kwh"].sum())
+    # the fleet: both yields, the whole day includes the idle buses parked at the depot
+    assert s["harvest"] == "whole_day"
+    assert s["kwh_per_kwp_driving"] == pytest.approx(s["kwh_per_kwp_allsky"])
+    assert s["kwh_per_kwp_driving"] < s["kwh_per_kwp_in_service"] < s["kwh_per_kwp_whole_day"]
+    assert s["pv_kwh_whole_day"] == pytest.approx(s["pv_kwh_driving"] + s["pv_kwh_layover"] + s["pv_kwh_parked"])
+    assert s["pv_kwh_usable"] + s["pv_kwh_curtailed"] == pytest.approx(s["pv_kwh_whole_day"])
+    assert s["pv_kwh_usable"] == pytest.approx(bd["pv_kwh_usable"].sum())
+    days = bd.groupby("service_date").size()
+    assert s["idle_bus_days"] == int((s["buses"] - days.reindex(pd.date_range("2024-06-01", "2024-06-30"),
+                                                                   fill_value=0)).sum())
+    # one month run: the annual figures are the month's x 12, coverage on what the battery takes
+    assert s["coverage"] == pytest.approx(s["pv_kwh_usable"] * 12 / (s["fleet_demand_mwh"] * 1000.0))
+    monthly = pd.read_parquet(small_run / "monthly.parquet")
+    assert monthly["pv_kwh_whole_day"].sum() == pytest.approx(s["pv_kwh_whole_day"])
+
+
+def test_depot_options_are_checked(tmp_path):
+    from vipvflow.config import load_config
+    from vipvflow.errors import ConfigError
+
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("fleet:\n  depot_shading: garage\n")
+    with pytest.raises(ConfigError, match=r"bad.yaml: key 'fleet.depot_shading'"):
+        load_config(bad)
+    bad.write_text("fleet:\n  depot: {lat: 95.0, lon: 6.1}\n")
+    with pytest.raises(ConfigError, match=r"key 'fleet.depot.lat'"):
+        load_config(bad)
+
+
+def test_paper_scenario_is_the_papers_accounting():
+    from pathlib import Path
+
+    from vipvflow.config import load_config
+
+    cfg = load_config(Path(__file__).parents[1] / "conf" / "paper.yaml")
+    assert (cfg.fleet.harvest, cfg.irradiance.diffuse_model, cfg.pv.mode) == ("driving", "isotropic", "paper")
+
+
+def test_driving_only_run_keeps_the_papers_figures(small_run, small_config, tmp_path):
+    import json
+
+    from vipvflow.config import load_config
+    from vipvflow.simulation import run_simulation
+
+    cfg = load_config(small_config, overrides={"out_dir": str(tmp_path), "fleet": {"harvest": "driving"},
+                                               "dask": {"n_workers": 1}})
+    run = run_simulation(cfg, 2024, say=lambda *a: None)
+    s = json.loads((run / "summary.json").read_text())
+    full = json.loads((small_run / "summary.json").read_text())
+    assert not (run / "parts" / "standing").exists()
+    assert s["kwh_per_kwp_in_service"] is None and s["kwh_per_kwp_whole_day"] is None
+    assert s["kwh_per_kwp_allsky"] == pytest.approx(full["kwh_per_kwp_allsky"], rel=1e-12)
+    # every driving kWh counts, against the trips' demand alone
+    assert (s["pv_kwh_usable"], s["pv_kwh_curtailed"]) == (pytest.approx(s["pv_kwh_driving"]), 0.0)
+    trips = pd.read_parquet(run / "trip_energy.parquet")
+    assert s["coverage"] == pytest.approx(trips["pv_kwh"].sum() / trips["consumption_kwh"].sum())

@@ -299,7 +299,10 @@ def _write_manifest(cfg, year, run_dir, checksums, timings, results, builds) -> 
         "config": cfg.model_dump(mode="json"), "inputs_sha256": checksums, "versions": versions,
         "timings_s": {k: round(v, 3) for k, v in timings.items()},
         "partition_timings_s": {k: round(v, 3) for k, v in stage.items()},
-        "partitions_computed": len(results),
+        "partitions_computed": sum(1 for r in results if "intervals" not in r),
+        # layovers and parked time (the standing tasks; their worker time is standing_s above)
+        "standing_partitions_computed": sum(1 for r in results if "intervals" in r),
+        "standing_intervals": int(sum(r.get("intervals", 0) for r in results)),
         "passes_computed": int(sum(r["passes"] for r in results)),
         "bvh_builds_per_worker": builds,
         "created_utc": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
