@@ -281,3 +281,18 @@ def test_driving_only_run_keeps_the_papers_figures(small_run, small_config, tmp_
     assert (s["pv_kwh_usable"], s["pv_kwh_curtailed"]) == (pytest.approx(s["pv_kwh_driving"]), 0.0)
     trips = pd.read_parquet(run / "trip_energy.parquet")
     assert s["coverage"] == pytest.approx(trips["pv_kwh"].sum() / trips["consumption_kwh"].sum())
+
+
+def test_depot_outside_the_city_model_is_one_clear_error(small_run, small_config):
+    from vipvflow.config import load_config
+    from vipvflow.errors import InputError
+    from vipvflow.simulation.standing import depot_point
+
+    far = {"fleet": {"depot": {"lat": 49.9, "lon": 5.8}}}
+    cfg = load_config(small_config, overrides=far)
+    with pytest.raises(InputError, match=r"fleet.depot \(49.9, 5.8\) lies outside the city model"):
+        depot_point(cfg, cfg.data_dir)
+    # in the open it stands anywhere: the roof height of the nearest road, an open field
+    cfg = load_config(small_config, overrides={"fleet": {**far["fleet"], "depot_shading": "open"}})
+    x, y, z, tile = depot_point(cfg, cfg.data_dir)
+    assert 40000 < x < 110000 and 50000 < y < 140000 and z > 0      # LUREF, Luxembourg

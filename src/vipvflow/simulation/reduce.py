@@ -155,7 +155,8 @@ def block_day_table(cfg: Config, run_dir: Path, trip: pd.DataFrame, vehicle):
     idle["pv_kwh_curtailed"] = idle["pv_kwh"] if cfg.fleet.harvest != "driving" else 0.0
 
     bd = tl[key + ["month", "trips", "window_start_utc", "window_end_utc", "first_departure_utc",
-                   "last_arrival_utc", "driving_s", "overlap_s"]].sort_values(key).reset_index(drop=True)
+                   "last_arrival_utc", "driving_s", "layover_s", "parked_s", "overlap_s"]
+            ].sort_values(key).reset_index(drop=True)
     idx = pd.MultiIndex.from_frame(bd[key])
     first = trip.groupby(key)["start_s"].min()
     drive = trip.groupby(key)[["pv_kwh", "pv_kwh_clear", "consumption_kwh"]].sum()
@@ -163,24 +164,29 @@ def block_day_table(cfg: Config, run_dir: Path, trip: pd.DataFrame, vehicle):
         bd[c] = drive[c].reindex(idx, fill_value=0.0).to_numpy()
     bd["first_departure_s"] = first.reindex(idx).to_numpy()
     bd["pv_kwh_driving"] = bd["pv_kwh"]
-    bd["seconds_driving"] = bd["driving_s"]
+    bd["seconds_driving"] = bd.pop("driving_s")
     for kind in ("layover", "parked"):
-        part = st[st["kind"] == kind].groupby(key)[["pv_kwh", "pv_kwh_clear", "seconds"]].sum()
+        # the time from the timeline (whatever fleet.harvest evaluates), the PV from the
+        # standing partitions (0 where not evaluated)
+        part = st[st["kind"] == kind].groupby(key)[["pv_kwh", "pv_kwh_clear"]].sum()
         part = part.reindex(idx, fill_value=0.0)
         bd[f"pv_kwh_{kind}"] = part["pv_kwh"].to_numpy()
         bd[f"pv_kwh_clear_{kind}"] = part["pv_kwh_clear"].to_numpy()
-        bd[f"seconds_{kind}"] = part["seconds"].to_numpy()
+        bd[f"seconds_{kind}"] = bd.pop(f"{kind}_s")
     bd["pv_kwh_whole_day"] = bd["pv_kwh_driving"] + bd["pv_kwh_layover"] + bd["pv_kwh_parked"]
     bd["window_s"] = bd["window_end_utc"] - bd["window_start_utc"]
 
     # the layovers' auxiliaries (kWh from the battery) at the month's temperature
-    lay = st[st["kind"] == "layover"]
     temps = np.asarray(cfg.climate.monthly_mean_temperature_c, float)
-    month_no = pd.to_datetime(lay["service_date"]).dt.month.to_numpy()
-    aux = (np.asarray(vehicle.aux_kw(temps[month_no - 1]), float) * lay["seconds"].to_numpy(float) / 3600.0
-           / vehicle.discharge_efficiency)
-    lay = lay.assign(aux_kwh=aux)
-    bd["layover_aux_kwh"] = lay.groupby(key)["aux_kwh"].sum().reindex(idx, fill_value=0.0).to_numpy()
+
+    def aux_kwh(service_date, seconds):
+        month_no = pd.to_datetime(service_date).dt.month.to_numpy()
+        return (np.asarray(vehicle.aux_kw(temps[month_no - 1]), float) * np.asarray(seconds, float)
+                / 3600.0 / vehicle.discharge_efficiency)
+
+    lay = st[st["kind"] == "layover"]
+    lay = lay.assign(aux_kwh=aux_kwh(lay["service_date"], lay["seconds"]))
+    bd["layover_aux_kwh"] = aux_kwh(bd["service_date"], bd["seconds_layover"])
     bd["demand_kwh"] = bd["consumption_kwh"] + (bd["layover_aux_kwh"] if cfg.fleet.harvest != "driving" else 0.0)
 
     # the battery's share: steps (a trip and the layover after it) per block-day

@@ -510,7 +510,8 @@ def block_timeline(data_dir, year: int, months=None, routes=None, depot=None,
     -------
     dict of DataFrames
         ``block_days``: ``block_id, service_date, month, trips, window_start_utc,
-        window_end_utc, first_departure_utc, last_arrival_utc, driving_s, overlap_s``;
+        window_end_utc, first_departure_utc, last_arrival_utc, driving_s, overlap_s,
+        layover_s, parked_s``;
         ``intervals``: ``block_id, service_date, month, kind`` (layover | parked), ``after_trip``
         (position of the trip before it in the block-day; -1 before the first),
         ``point_id, t0_utc, t1_utc, buses`` (1; for the idle rows, block id
@@ -628,6 +629,10 @@ def block_timeline(data_dir, year: int, months=None, routes=None, depot=None,
     bd["driving_s"] = driving.to_numpy()
     bd["overlap_s"] = over.groupby(key, sort=True)["overlap_s"].sum().reindex(
         pd.MultiIndex.from_frame(bd[key]), fill_value=0.0).to_numpy() if len(over) else 0.0
+    own = iv[iv["block_id"] != IDLE_BLOCK].assign(s=iv["t1_utc"] - iv["t0_utc"])
+    for kind in TIMELINE_KINDS:
+        bd[f"{kind}_s"] = own[own["kind"] == kind].groupby(["block_id", "service_date"])["s"].sum().reindex(
+            pd.MultiIndex.from_frame(bd[key]), fill_value=0.0).to_numpy()
     bd = bd.rename(columns={"date": "service_date"}).drop(columns=["day0", "day1", "first_stop_id"])
     bd["month"] = bd["service_date"].dt.strftime("%Y-%m")
     trip_runs = pd.DataFrame({"trip_id": runs["trip_id"].astype(str), "service_date": runs["date"],
