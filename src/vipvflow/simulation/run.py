@@ -176,11 +176,11 @@ def run_simulation(cfg: Config, year: int, scheduler: str | None = None,
         route_of_trip=dict(zip(trips["trip_id"], trips["route_id"].astype(str))))
 
     todo = [(t, m) for t in tiles for m in _months(cfg, year) if not partition_done(run_dir, t, m)]
-    # layovers and parked time: one ``standing`` task per (tile of a standing point, month)
+    # layovers and parked time: one ``standing`` task per tile holding standing points
     t_tl = time.perf_counter()
     standing = write_timeline(cfg, year, run_dir, routes=routes)
     timings["timeline_s"] = time.perf_counter() - t_tl
-    standing_todo = [(t, m) for t, m in standing if not standing_done(run_dir, t, m)]
+    standing_todo = [t for t in standing if not standing_done(run_dir, t)]
     total = len(tiles) * len(cfg.run.months) + len(standing)
     if max_partitions is not None:
         todo = todo[:max_partitions]
@@ -217,7 +217,7 @@ def run_simulation(cfg: Config, year: int, scheduler: str | None = None,
     closer.start()
     try:
         if not (all(partition_done(run_dir, t, m) for t in tiles for m in _months(cfg, year))
-                and all(standing_done(run_dir, t, m) for t, m in standing)):
+                and all(standing_done(run_dir, t) for t in standing)):
             say("stopped before all partitions were computed; run the same command again to resume")
             return run_dir
         t_red = time.perf_counter()
@@ -249,7 +249,7 @@ def _warm_radiation(data_dir: str, year: int) -> None:
         pass
 
 
-def _map(client, ctx: RunContext, todo: list[tuple[str, str]], standing: list[tuple[str, str]] = (),
+def _map(client, ctx: RunContext, todo: list[tuple[str, str]], standing: list[str] = (),
          every_s: float = 1.0) -> list[dict]:
     from distributed import as_completed
 
@@ -260,8 +260,8 @@ def _map(client, ctx: RunContext, todo: list[tuple[str, str]], standing: list[tu
     for tile, month in todo:
         futures.append(client.submit(run_partition, ctx, tile, month, geometry[tile],
                                      key=f"irradiance-{tile}-{month}"))
-    for tile, month in standing:
-        futures.append(client.submit(run_standing, ctx, tile, month, key=f"standing-{tile}-{month}"))
+    for tile in standing:
+        futures.append(client.submit(run_standing, ctx, tile, key=f"standing-{tile}"))
     view = FleetView(len(futures))
     results = []
     done, last = [], time.perf_counter()

@@ -112,10 +112,15 @@ def interval_integrals(intervals: pd.DataFrame, geometry: pd.DataFrame, radiatio
     return pd.DataFrame(out, index=intervals.index)
 
 
-def run_standing(ctx, tile: str, month: str) -> dict:
+#: the ``month`` of a standing partition: one per tile holds all the run's months (a tile
+#: has only a few standing points; per month, loading the tile's scene cost more than them)
+ALL_MONTHS = "all"
+
+
+def run_standing(ctx, tile: str) -> dict:
     """Evaluate the layover and parked intervals at the points of *tile* (``open`` and
-    ``covered``: the depot outside the city model) of block-days in *month*; writes
-    ``parts/standing/tile=T/month=M.parquet``, one row per interval (``seconds`` and the
+    ``covered``: the depot outside the city model) of the run's block-days; writes
+    ``parts/standing/tile=T/month=all.parquet``, one row per interval (``seconds`` and the
     sums are per bus times ``buses``: more than 1 only for the idle buses of a day)."""
     from .partition import _radiation, _scene, pv_energy_kwh, tune_malloc
 
@@ -124,29 +129,35 @@ def run_standing(ctx, tile: str, month: str) -> dict:
     tdir = timeline_dir(ctx.run_dir)
     points = pd.read_parquet(tdir / "points.parquet")
     points = points[points["tile"] == tile]
-    iv = pd.read_parquet(tdir / "intervals.parquet", filters=[("month", "==", month)])
+    iv = pd.read_parquet(tdir / "intervals.parquet")
     iv = iv[iv["point_id"].isin(points["point_id"])].reset_index(drop=True)
     cfg = IrradianceCfg(**ctx.irradiance)
-    m = int(month[5:7])
-
-    def energy(poa, dt):        # the run's PV model, standing still (no cooling by speed)
-        return pv_energy_kwh(poa, dt, np.zeros(len(poa)), m, ctx)
-
-    if tile == "covered" or not len(iv):
-        res = interval_integrals(iv, None, None, None, cfg, energy, dark=True)
-    else:
+    dark = tile == "covered" or not len(iv)
+    if not dark:
         scene = open_scene() if tile == "open" else _scene(ctx, tile)
         geom = point_geometry(scene, points, cfg)
-        res = interval_integrals(iv, geom, _radiation(ctx.data_dir, ctx.year), scene, cfg, energy,
-                                 ground_albedo=ctx.ground_albedo)
+    parts = []
+    for month, group in iv.groupby("month", sort=True):
+        m = int(month[5:7])
+
+        def energy(poa, dt, m=m):        # the run's PV model, standing still (no cooling by speed)
+            return pv_energy_kwh(poa, dt, np.zeros(len(poa)), m, ctx)
+
+        if dark:
+            parts.append(interval_integrals(group, None, None, None, cfg, energy, dark=True))
+        else:
+            parts.append(interval_integrals(group, geom, _radiation(ctx.data_dir, ctx.year), scene, cfg,
+                                            energy, ground_albedo=ctx.ground_albedo))
+    res = (pd.concat(parts).reindex(iv.index) if parts
+           else interval_integrals(iv, None, None, None, cfg, None, dark=True))
     # idle rows stand for several buses: their sums are per bus times the buses
     res = res.mul(iv["buses"].to_numpy(np.float64), axis=0)
     table = pd.concat([iv[["block_id", "service_date", "kind", "after_trip", "point_id", "t0_utc",
                            "t1_utc", "buses"]].astype({"block_id": str, "kind": str}), res], axis=1)
     table["tile"] = tile
-    write_parquet(table, partition_path(Path(ctx.run_dir), "standing", tile, month))
+    write_parquet(table, partition_path(Path(ctx.run_dir), "standing", tile, ALL_MONTHS))
     elapsed = time.perf_counter() - t_start
-    return {"tile": tile, "month": month, "passes": 0, "trips": 0, "kwh": float(res["pv_kwh"].sum()),
+    return {"tile": tile, "month": ALL_MONTHS, "passes": 0, "trips": 0, "kwh": float(res["pv_kwh"].sum()),
             "kwh_by_route": {}, "timings": {"standing_s": elapsed}, "intervals": int(len(iv)),
             "elapsed_s": elapsed}
 
@@ -184,8 +195,8 @@ def depot_point(cfg, data_dir) -> tuple | None:
 def write_timeline(cfg, year: int, run_dir, routes=None) -> list[tuple[str, str]]:
     """Cut the run's block-days into driving, layover and parked time
     (:func:`vipvflow.trajectory.schedule.block_timeline`), keep the kinds ``fleet.harvest``
-    counts, write ``parts/timeline/{block_days,intervals,points}.parquet`` once per run and
-    return the (tile, month) pairs that have standing intervals (the ``standing`` tasks)."""
+    counts, write ``parts/timeline/{block_days,intervals,points,trip_runs}.parquet`` once per
+    run and return the tiles that have standing intervals (one ``standing`` task each)."""
     from ..trajectory.schedule import block_timeline
 
     tdir = timeline_dir(run_dir)
@@ -202,11 +213,10 @@ def write_timeline(cfg, year: int, run_dir, routes=None) -> list[tuple[str, str]
         write_parquet(tl["trip_runs"], tdir / "trip_runs.parquet")
         write_parquet(tl["points"].astype({"stop_id": str, "tile": str, "shading": str}),
                       tdir / "points.parquet")
-    iv = pd.read_parquet(tdir / "intervals.parquet", columns=["point_id", "month"])
+    iv = pd.read_parquet(tdir / "intervals.parquet", columns=["point_id"])
     tiles = pd.read_parquet(tdir / "points.parquet").set_index("point_id")["tile"]
-    pairs = pd.DataFrame({"tile": tiles.reindex(iv["point_id"]).to_numpy(), "month": iv["month"].to_numpy()})
-    return sorted(set(map(tuple, pairs.drop_duplicates().to_numpy().tolist())))
+    return sorted(set(tiles.reindex(iv["point_id"].unique()).astype(str)))
 
 
-def standing_done(run_dir, tile: str, month: str) -> bool:
-    return partition_path(Path(run_dir), "standing", tile, month).exists()
+def standing_done(run_dir, tile: str) -> bool:
+    return partition_path(Path(run_dir), "standing", tile, ALL_MONTHS).exists()
