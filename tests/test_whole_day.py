@@ -296,3 +296,20 @@ def test_depot_outside_the_city_model_is_one_clear_error(small_run, small_config
     cfg = load_config(small_config, overrides={"fleet": {**far["fleet"], "depot_shading": "open"}})
     x, y, z, tile = depot_point(cfg, cfg.data_dir)
     assert 40000 < x < 110000 and 50000 < y < 140000 and z > 0      # LUREF, Luxembourg
+
+
+def test_timeline_of_a_real_feed_without_blocks(shared_data, tmp_path):
+    """Cairns (gtfs-kit's sample feed, no block_id: blocks inferred): every block-day of 2014
+    is cut into driving, layover and parked time that add up to its window exactly."""
+    ingest_gtfs(shared_data / "gtfs" / "cairns_gtfs_kit" / "cairns_gtfs.zip", tmp_path, TrajectoryCfg())
+    tl = block_timeline(tmp_path, 2014)
+    bd, iv = tl["block_days"], tl["intervals"]
+    assert bd["trips"].sum() == len(tl["trip_runs"]) and (bd["overlap_s"] == 0).all()
+    window = bd["window_end_utc"] - bd["window_start_utc"]
+    assert (window == bd["driving_s"] + bd["layover_s"] + bd["parked_s"]).all()
+    own = iv[iv["block_id"] != "(idle)"]
+    assert (own["t1_utc"] - own["t0_utc"]).sum() == (bd["layover_s"] + bd["parked_s"]).sum()
+    # a block's consecutive days meet without a gap or an overlap
+    for _, g in bd.groupby("block_id"):
+        nxt = g["service_date"].diff().dt.days.to_numpy()[1:] == 1
+        assert (g["window_start_utc"].to_numpy()[1:][nxt] == g["window_end_utc"].to_numpy()[:-1][nxt]).all()
