@@ -313,3 +313,33 @@ def test_timeline_of_a_real_feed_without_blocks(shared_data, tmp_path):
     for _, g in bd.groupby("block_id"):
         nxt = g["service_date"].diff().dt.days.to_numpy()[1:] == 1
         assert (g["window_start_utc"].to_numpy()[1:][nxt] == g["window_end_utc"].to_numpy()[:-1][nxt]).all()
+
+
+def test_open_depot_run_parks_under_the_open_sky(small_run, small_config, tmp_path):
+    """A configured depot in the open: every parked interval of the run holds the flat roof's
+    open-sky irradiation, DNI cos(zenith) + DHI, of the radiation table minute by minute."""
+    from vipvflow.config import load_config
+    from vipvflow.radiation import RadiationTable
+    from vipvflow.simulation import run_simulation
+
+    cfg = load_config(small_config, overrides={
+        "out_dir": str(tmp_path), "dask": {"n_workers": 1},
+        "fleet": {"depot": {"lat": 49.61, "lon": 6.13}, "depot_shading": "open"}})
+    run = run_simulation(cfg, 2024, say=lambda *a: None)
+    st = pd.read_parquet(run / "parts" / "standing" / "tile=open" / "month=all.parquet")
+    assert set(st["kind"]) == {"parked"} and (st["block_id"] == "(idle)").any()
+    table = RadiationTable.load(cfg.data_dir, 2024)
+    sample = st.sort_values("pv_kwh").iloc[-40:]          # the sunniest intervals
+    expected = []
+    for t0, t1, buses in sample[["t0_utc", "t1_utc", "buses"]].to_numpy():
+        edges = np.arange(np.floor(t0 / 60) * 60, t1 + 60, 60.0)
+        rad = table.lookup(edges[:-1] + 30.0, angles=False)
+        e = np.nan_to_num(rad["dni"] * np.maximum(rad["sun_z"], 0) + rad["dhi"]).astype(float)
+        seconds = np.clip(np.minimum(edges[1:], t1) - np.maximum(edges[:-1], t0), 0, None)
+        expected.append(buses * float(np.sum(e * seconds)) / 3600.0)
+    np.testing.assert_allclose(sample["h_total"], expected, rtol=1e-5)
+    system = cfg.pv_system()
+    np.testing.assert_allclose(sample["pv_kwh"], system.kwp * system.performance_ratio
+                               * np.asarray(expected) / 1000.0, rtol=1e-5)
+    bd = pd.read_parquet(run / "block_day.parquet")
+    assert (bd["seconds_driving"] + bd["seconds_layover"] + bd["seconds_parked"] == bd["window_s"]).all()
