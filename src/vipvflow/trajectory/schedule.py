@@ -562,9 +562,12 @@ def block_timeline(data_dir, year: int, months=None, routes=None, depot=None,
                            pts.loc[pts["shading"] == depot_shading, "point_id"]))
 
     # runs of the year (months), in block, date and time order
+    # the run's months, and the day before each (its block past midnight moves the first
+    # day's start, as in a run of the whole year); the days before are dropped below
     sd = service_dates(data_dir, year)
-    if months is not None:
-        sd = sd[sd["date"].dt.month.isin(list(months))]
+    in_run = sd["date"].dt.month.isin(list(months)) if months is not None else pd.Series(True, sd.index)
+    before = (sd["date"] + pd.Timedelta(days=1)).dt.month.isin(list(months)) if months is not None else in_run
+    sd = sd.assign(in_run=in_run)[in_run | (before & (sd["date"] + pd.Timedelta(days=1)).dt.year.eq(year))]
     runs = trips.merge(sd, on="service_id")
     tz = _feed_info(data_dir)["timezone"]
     udates = np.unique(runs["date"].to_numpy()) if len(runs) else np.zeros(0, "datetime64[ns]")
@@ -585,6 +588,9 @@ def block_timeline(data_dir, year: int, months=None, routes=None, depot=None,
     prev_end = bd.groupby("block_id", sort=False)["window_end_utc"].shift(1)
     start = np.maximum(bd["day0"], prev_end.fillna(-np.inf))
     bd["window_start_utc"] = np.minimum(start, bd["first_departure_utc"])
+    keep = bd.set_index(key).index.isin(pd.MultiIndex.from_frame(runs.loc[runs["in_run"], key]))
+    bd = bd[keep].reset_index(drop=True)
+    runs = runs[runs["in_run"].to_numpy()].reset_index(drop=True)
 
     # layovers: from a trip's arrival to the next trip's departure of the same block-day
     same = ((runs["block_id"].to_numpy()[1:] == runs["block_id"].to_numpy()[:-1])
