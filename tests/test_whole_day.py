@@ -219,7 +219,8 @@ def test_small_run_splits_every_block_day(small_run, small_config):
     # driving + layover + parked = the block-day's window, in time and in energy
     assert (bd["seconds_driving"] + bd["seconds_layover"] + bd["seconds_parked"] == bd["window_s"]).all()
     assert (bd["pv_kwh_driving"] + bd["pv_kwh_layover"] + bd["pv_kwh_parked"] == bd["pv_kwh_whole_day"]).all()
-    np.testing.assert_allclose(bd["pv_kwh_usable"] + bd["pv_kwh_curtailed"], bd["pv_kwh_whole_day"], rtol=1e-12)
+    np.testing.assert_allclose(bd["pv_kwh_usable"] + bd["pv_kwh_curtailed"], bd["pv_kwh_whole_day"],
+                               rtol=1e-12)
     assert (bd["pv_kwh_layover"] > 0).all() and (bd["seconds_layover"] > 0).all()
     # the driving time is the trips' time on the segments (their passes)
     trips = pd.read_parquet(small_run / "trip_energy.parquet")
@@ -235,7 +236,8 @@ def test_small_run_splits_every_block_day(small_run, small_config):
     assert s["harvest"] == "whole_day"
     assert s["kwh_per_kwp_driving"] == pytest.approx(s["kwh_per_kwp_allsky"])
     assert s["kwh_per_kwp_driving"] < s["kwh_per_kwp_in_service"] < s["kwh_per_kwp_whole_day"]
-    assert s["pv_kwh_whole_day"] == pytest.approx(s["pv_kwh_driving"] + s["pv_kwh_layover"] + s["pv_kwh_parked"])
+    parts = s["pv_kwh_driving"] + s["pv_kwh_layover"] + s["pv_kwh_parked"]
+    assert s["pv_kwh_whole_day"] == pytest.approx(parts)
     assert s["pv_kwh_usable"] + s["pv_kwh_curtailed"] == pytest.approx(s["pv_kwh_whole_day"])
     assert s["pv_kwh_usable"] == pytest.approx(bd["pv_kwh_usable"].sum())
     days = bd.groupby("service_date").size()
@@ -349,3 +351,20 @@ def test_open_depot_run_parks_under_the_open_sky(small_run, small_config, tmp_pa
                                * np.asarray(expected) / 1000.0, rtol=1e-5)
     bd = pd.read_parquet(run / "block_day.parquet")
     assert (bd["seconds_driving"] + bd["seconds_layover"] + bd["seconds_parked"] == bd["window_s"]).all()
+
+
+@pytest.mark.parametrize("harvest, kinds", [("driving", set()), ("in_service", {"layover"}),
+                                            ("whole_day", {"layover", "parked"})])
+def test_harvest_chooses_the_standing_work(small_run, small_config, tmp_path, harvest, kinds):
+    from vipvflow.config import load_config
+    from vipvflow.simulation.standing import timeline_dir, write_timeline
+
+    cfg = load_config(small_config, overrides={"fleet": {"harvest": harvest}})
+    tiles = write_timeline(cfg, 2024, tmp_path)
+    iv = pd.read_parquet(timeline_dir(tmp_path) / "intervals.parquet")
+    assert set(iv["kind"]) == kinds and (len(tiles) > 0) == bool(kinds)
+    assert (iv["month"] == "2024-06").all()
+    # the block-days' time is cut the same whatever is evaluated
+    bd = pd.read_parquet(timeline_dir(tmp_path) / "block_days.parquet")
+    assert (bd["window_end_utc"] - bd["window_start_utc"]
+            == bd["driving_s"] + bd["layover_s"] + bd["parked_s"]).all()

@@ -134,6 +134,7 @@ def block_day_table(cfg: Config, run_dir: Path, trip: pd.DataFrame, vehicle):
     battery is full: its PV is all curtailed.  With ``harvest: driving`` (the paper's
     accounting) all the driving PV counts and nothing is curtailed.
     """
+    from ..trajectory.schedule import IDLE_BLOCK
     from ..vehicle import block_day_balance
 
     tdir = run_dir / "parts" / "timeline"
@@ -147,10 +148,11 @@ def block_day_table(cfg: Config, run_dir: Path, trip: pd.DataFrame, vehicle):
     st = _read_parts(run_dir, "standing")
     if st.empty:
         st = pd.DataFrame({c: pd.Series(dtype=t) for c, t in (
-            ("block_id", object), ("service_date", "datetime64[ns]"), ("kind", object), ("after_trip", np.int64),
-            ("buses", np.int64), ("seconds", float), ("pv_kwh", float), ("pv_kwh_clear", float))})
-    idle = st[st["block_id"] == "(idle)"].copy()
-    st = st[st["block_id"] != "(idle)"]
+            ("block_id", object), ("service_date", "datetime64[ns]"), ("kind", object),
+            ("after_trip", np.int64), ("buses", np.int64), ("seconds", float), ("pv_kwh", float),
+            ("pv_kwh_clear", float))})
+    idle = st[st["block_id"] == IDLE_BLOCK].copy()
+    st = st[st["block_id"] != IDLE_BLOCK]
     idle["month"] = pd.to_datetime(idle["service_date"]).dt.strftime("%Y-%m")
     idle["pv_kwh_curtailed"] = idle["pv_kwh"] if cfg.fleet.harvest != "driving" else 0.0
 
@@ -187,7 +189,8 @@ def block_day_table(cfg: Config, run_dir: Path, trip: pd.DataFrame, vehicle):
     lay = st[st["kind"] == "layover"]
     lay = lay.assign(aux_kwh=aux_kwh(lay["service_date"], lay["seconds"]))
     bd["layover_aux_kwh"] = aux_kwh(bd["service_date"], bd["seconds_layover"])
-    bd["demand_kwh"] = bd["consumption_kwh"] + (bd["layover_aux_kwh"] if cfg.fleet.harvest != "driving" else 0.0)
+    in_service = cfg.fleet.harvest != "driving"
+    bd["demand_kwh"] = bd["consumption_kwh"] + (bd["layover_aux_kwh"] if in_service else 0.0)
 
     # the battery's share: steps (a trip and the layover after it) per block-day
     if cfg.fleet.harvest == "driving":

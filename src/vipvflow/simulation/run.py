@@ -198,9 +198,9 @@ def run_simulation(cfg: Config, year: int, scheduler: str | None = None,
             max(1, (os.cpu_count() or 1) // max(1, n_workers_now)) if cluster is not None else 1)
         ctx = dataclasses.replace(ctx, ray_threads=ray_threads)
         say(f"dask dashboard: {client.dashboard_link}")
-        say(f"{len(tiles)} tiles x {len(cfg.run.months)} months + {len(standing)} standing = {total} partitions, "
-            f"{len(todo) + len(standing_todo)} to compute ({total - len(todo) - len(standing_todo)} already done) "
-            f"with {n_workers_now} workers")
+        n_todo = len(todo) + len(standing_todo)
+        say(f"{len(tiles)} tiles x {len(cfg.run.months)} months + {len(standing)} standing = {total} "
+            f"partitions, {n_todo} to compute ({total - n_todo} already done) with {n_workers_now} workers")
         warm.join()
         t_map = time.perf_counter()
         # the reduce's plotting libraries load while the workers compute
@@ -318,7 +318,8 @@ def _summary_line(s: dict) -> str:
             f"({s['kwh_per_kwp_clearsky']:.0f} clear-sky), in service {yield_of('kwh_per_kwp_in_service')}, "
             f"whole day {yield_of('kwh_per_kwp_whole_day')}; "
             f"shading loss {100 * s['shading_loss_allsky']:.1f} % on the road; "
-            f"the battery takes {s['pv_kwh_usable'] / 1000:.1f} MWh ({s['pv_kwh_curtailed'] / 1000:.1f} MWh curtailed): "
+            f"the battery takes {s['pv_kwh_usable'] / 1000:.1f} MWh "
+            f"({s['pv_kwh_curtailed'] / 1000:.1f} MWh curtailed): "
             f"PV covers {100 * s['coverage']:.2f} % of {s['fleet_demand_mwh']:.0f} MWh; "
             f"{s['avoided_charging_cycles_per_bus']:.1f} charging cycles avoided per bus; "
             f"payback {s['payback_years']:.1f} years")

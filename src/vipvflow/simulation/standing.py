@@ -204,7 +204,8 @@ def depot_point(cfg, data_dir) -> tuple | None:
     seg = pd.read_parquet(Path(data_dir) / "gtfs" / "segments.parquet", columns=["x", "y", "z"])
     near = int(np.argmin(np.hypot(seg["x"].to_numpy() - x, seg["y"].to_numpy() - y)))
     tile = str(tile_names([x], [y], float(feed.get("tile_size_m", 500.0)))[0])
-    if cfg.fleet.depot_shading == "city" and not (Path(data_dir) / "city" / "meshes" / f"{tile}.npz").exists():
+    mesh = Path(data_dir) / "city" / "meshes" / f"{tile}.npz"
+    if cfg.fleet.depot_shading == "city" and not mesh.exists():
         raise InputError(f"{cfg._source}: fleet.depot ({depot.lat}, {depot.lon}) lies outside the city "
                          f"model (no mesh for tile {tile}); set fleet.depot_shading to open or covered")
     return float(x), float(y), float(seg["z"].to_numpy()[near]), tile

@@ -557,7 +557,8 @@ def block_timeline(data_dir, year: int, months=None, routes=None, depot=None,
         pts = pd.concat([pts, depots], ignore_index=True)
     pts = pts.reset_index(drop=True)
     pts.insert(0, "point_id", np.arange(len(pts), dtype=np.int64))
-    stop_point = dict(zip(pts.loc[pts["shading"] == "city", "stop_id"], pts.loc[pts["shading"] == "city", "point_id"]))
+    city = pts[pts["shading"] == "city"]
+    stop_point = dict(zip(city["stop_id"], city["point_id"]))
     depot_point = dict(zip(pts.loc[pts["shading"] == depot_shading, "stop_id"],
                            pts.loc[pts["shading"] == depot_shading, "point_id"]))
 
@@ -602,7 +603,8 @@ def block_timeline(data_dir, year: int, months=None, routes=None, depot=None,
                         "kind": "layover", "after_trip": pos[a],
                         "point_id": runs["last_stop_id"].map(stop_point).to_numpy()[a],
                         "t0_utc": runs["t1"].to_numpy()[a], "t1_utc": runs["t0"].to_numpy()[a + 1]})
-    over = pd.DataFrame({"block_id": lay["block_id"], "date": lay["date"], "overlap_s": np.maximum(-gap, 0.0)})
+    over = pd.DataFrame({"block_id": lay["block_id"], "date": lay["date"],
+                         "overlap_s": np.maximum(-gap, 0.0)})
     lay = lay[gap > 0]
     dp = bd["first_stop_id"].map(depot_point) if depot is None else pd.Series(
         depot_point["depot"], index=bd.index)
