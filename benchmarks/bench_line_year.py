@@ -64,6 +64,15 @@ def run(tiny: bool = False) -> dict:
         "share_pack": split["pack_share"],
         "share_load_and_other": split["load_and_other_share"],
         "ingest_s_first": prep["ingest_s"],
+        # the whole day's extra work, apart: the block-day timeline (driver, before the map)
+        # and the standing tasks (layovers and parked time through the irradiance kernel,
+        # worker time summed), against the driving partitions' worker time
+        "timeline_s": timings.get("timeline_s"),
+        "standing_worker_s": round(m["partition_timings_s"].get("standing_s", 0.0), 2),
+        "standing_partitions": m.get("standing_partitions_computed"),
+        "standing_intervals": m.get("standing_intervals"),
+        "standing_share_of_worker_time": round(m["partition_timings_s"].get("standing_s", 0.0) / max(
+            1e-9, split["partition_work_s"] + m["partition_timings_s"].get("standing_s", 0.0)), 3),
     }
     targets = {"wall_s": "< 60 (goal 10)", "peak_rss_gb": "< 4",
                "physics_passes_per_s_per_core": ">= 1e6",

@@ -221,6 +221,26 @@ class RadiationCfg(_Model):
     max_gap_minutes: float = Field(60.0, gt=0)
 
 
+class DepotCfg(_Model):
+    """Where the buses stand outside their blocks (WGS84 degrees)."""
+
+    lat: float = Field(ge=-90, le=90)
+    lon: float = Field(ge=-180, le=180)
+
+
+class FleetCfg(_Model):
+    """What the roofs harvest besides driving: layovers at terminals and parking at a depot."""
+
+    # driving: the minutes on trips only (the paper's accounting); in_service: driving plus
+    # the layovers between the trips of a block; whole_day: also parked outside the blocks
+    harvest: Literal["driving", "in_service", "whole_day"] = "whole_day"
+    # the depot (lat/lon); null: the first stop of each block's first trip
+    depot: DepotCfg | None = None
+    # open: a field without shade; covered: under a roof (no light); city: the depot's
+    # position in the city model (buildings shade and reflect as on the road)
+    depot_shading: Literal["open", "covered", "city"] = "city"
+
+
 class DbCfg(_Model):
     dsn: str | None = None
 
@@ -240,6 +260,7 @@ class Config(_Model):
     climate: ClimateCfg = Field(default_factory=ClimateCfg)
     run: RunCfg = Field(default_factory=RunCfg)
     radiation: RadiationCfg = Field(default_factory=RadiationCfg)
+    fleet: FleetCfg = Field(default_factory=FleetCfg)
     dask: DaskCfg = Field(default_factory=DaskCfg)
     db: DbCfg = Field(default_factory=DbCfg)
 

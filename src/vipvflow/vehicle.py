@@ -429,3 +429,50 @@ def infer_blocks(trips: pd.DataFrame, min_layover_s: float = 0.0) -> pd.Series:
             open_blocks.append([end, dest, block])
             out[idx] = f"{prefix}:{block}"
     return out.astype(str)
+
+
+def block_day_balance(pv_steps: np.ndarray, use_steps: np.ndarray, pv_parked, params: VehicleParams,
+                      soc_start: float | None = None) -> dict:
+    """The battery's share of PV over many block-days at once (vectorised over block-days).
+
+    Parameters
+    ----------
+    pv_steps, use_steps : (n_days, n_steps) arrays, kWh
+        Per block-day, in service order, the PV harvested and the energy drawn from the
+        battery in each step (a trip with the layover after it); unused steps 0.
+    pv_parked : (n_days,) array, kWh, PV harvested parked at the depot outside the block
+    params : VehicleParams (``battery_kwh``, ``soc_max``)
+    soc_start : float, optional, SoC at the first departure (default ``soc_max``: the depot
+        charged the bus)
+
+    Returns
+    -------
+    dict of (n_days,) arrays
+        ``curtailed_in_service_kwh``: PV of the steps that found the battery at ``soc_max``
+        (as :func:`soc_trace`: PV feeds the DC bus first, a surplus charges up to
+        ``soc_max``); ``soc_end``: SoC at the last arrival; ``parked_usable_kwh``: parked
+        PV up to what the depot charger would otherwise put back to reach ``soc_max``
+        (the charger tops up only what the roof did not); ``curtailed_parked_kwh``: the rest.
+
+    Notes
+    -----
+    A trip and the layover after it are one step: the SoC falls on the trip and rises at
+    the layover only when its PV exceeds the auxiliaries, so the step's highest SoC is at its
+    end, where the ceiling is applied.
+    """
+    pv = np.asarray(pv_steps, float)
+    use = np.asarray(use_steps, float)
+    cap = params.battery_kwh
+    s = np.full(pv.shape[0], params.soc_max if soc_start is None else float(soc_start))
+    curtailed = np.zeros(pv.shape[0])
+    for k in range(pv.shape[1]):
+        target = s + (pv[:, k] - use[:, k]) / cap
+        kept = np.maximum(params.soc_max, s)
+        over = (target > kept) & (pv[:, k] > use[:, k])
+        curtailed += np.where(over, (target - kept) * cap, 0.0)
+        s = np.where(over, kept, target)
+    parked = np.asarray(pv_parked, float)
+    room = np.maximum(params.soc_max - s, 0.0) * cap
+    usable = np.minimum(parked, room)
+    return {"curtailed_in_service_kwh": curtailed, "soc_end": s, "parked_usable_kwh": usable,
+            "curtailed_parked_kwh": parked - usable}

@@ -162,6 +162,103 @@ def _check_totals(summary: dict, run_dir: Path) -> None:
     json.dumps(summary, allow_nan=False, default=str)
 
 
+def block_day_table(cfg: Config, run_dir: Path, trip: pd.DataFrame, vehicle):
+    """Per block-day: PV driving, at layovers and parked (kWh), the time of each, the
+    layovers' auxiliaries, and the PV the battery takes (``pv_kwh_usable``) or not
+    (``pv_kwh_curtailed``) under ``fleet.harvest``; the idle buses' parked days; and
+    *trip* (the reduce's per-trip table: ``pv_kwh``, ``consumption_kwh``) with the
+    timeline's ``block_id`` (the GTFS block, or the inferred one).  The
+    layovers' auxiliaries draw the vehicle's base load and HVAC at the month's mean
+    temperature through the battery's discharge efficiency.  Balance: the bus leaves the
+    depot at ``soc_max``; PV offsets each trip and layover, a surplus charges up to
+    ``soc_max`` (the rest is curtailed); PV parked at the depot replaces depot charging up to
+    what the block-day used (:func:`vipvflow.vehicle.block_day_balance`).  An idle bus's
+    battery is full: its PV is all curtailed.  With ``harvest: driving`` (the paper's
+    accounting) all the driving PV counts and nothing is curtailed.
+    """
+    from ..trajectory.schedule import IDLE_BLOCK
+    from ..vehicle import block_day_balance
+
+    tdir = run_dir / "parts" / "timeline"
+    tl = pd.read_parquet(tdir / "block_days.parquet")
+    runs = pd.read_parquet(tdir / "trip_runs.parquet")
+    key = ["block_id", "service_date"]
+    merged = trip.drop(columns=["block_id"]).merge(runs, on=["trip_id", "service_date"], how="left",
+                                                   validate="one_to_one")
+    trip = trip.assign(block_id=merged["block_id"].to_numpy())
+    position = merged["position"].to_numpy(np.int64)
+    st = _read_parts(run_dir, "standing")
+    if st.empty:
+        st = pd.DataFrame({c: pd.Series(dtype=t) for c, t in (
+            ("block_id", object), ("service_date", "datetime64[ns]"), ("kind", object),
+            ("after_trip", np.int64), ("buses", np.int64), ("seconds", float), ("pv_kwh", float),
+            ("pv_kwh_clear", float))})
+    idle = st[st["block_id"] == IDLE_BLOCK].copy()
+    st = st[st["block_id"] != IDLE_BLOCK]
+    idle["month"] = pd.to_datetime(idle["service_date"]).dt.strftime("%Y-%m")
+    idle["pv_kwh_curtailed"] = idle["pv_kwh"] if cfg.fleet.harvest != "driving" else 0.0
+
+    bd = tl[key + ["month", "trips", "window_start_utc", "window_end_utc", "first_departure_utc",
+                   "last_arrival_utc", "driving_s", "layover_s", "parked_s", "overlap_s"]
+            ].sort_values(key).reset_index(drop=True)
+    idx = pd.MultiIndex.from_frame(bd[key])
+    first = trip.groupby(key)["start_s"].min()
+    drive = trip.groupby(key)[["pv_kwh", "pv_kwh_clear", "consumption_kwh"]].sum()
+    for c in ("pv_kwh", "pv_kwh_clear", "consumption_kwh"):
+        bd[c] = drive[c].reindex(idx, fill_value=0.0).to_numpy()
+    bd["first_departure_s"] = first.reindex(idx).to_numpy()
+    bd["pv_kwh_driving"] = bd["pv_kwh"]
+    bd["seconds_driving"] = bd.pop("driving_s")
+    for kind in ("layover", "parked"):
+        # the time from the timeline (whatever fleet.harvest evaluates), the PV from the
+        # standing partitions (0 where not evaluated)
+        part = st[st["kind"] == kind].groupby(key)[["pv_kwh", "pv_kwh_clear"]].sum()
+        part = part.reindex(idx, fill_value=0.0)
+        bd[f"pv_kwh_{kind}"] = part["pv_kwh"].to_numpy()
+        bd[f"pv_kwh_clear_{kind}"] = part["pv_kwh_clear"].to_numpy()
+        bd[f"seconds_{kind}"] = bd.pop(f"{kind}_s")
+    bd["pv_kwh_whole_day"] = bd["pv_kwh_driving"] + bd["pv_kwh_layover"] + bd["pv_kwh_parked"]
+    bd["window_s"] = bd["window_end_utc"] - bd["window_start_utc"]
+
+    # the layovers' auxiliaries (kWh from the battery) at the month's temperature
+    temps = np.asarray(cfg.climate.monthly_mean_temperature_c, float)
+
+    def aux_kwh(service_date, seconds):
+        month_no = pd.to_datetime(service_date).dt.month.to_numpy()
+        return (np.asarray(vehicle.aux_kw(temps[month_no - 1]), float) * np.asarray(seconds, float)
+                / 3600.0 / vehicle.discharge_efficiency)
+
+    lay = st[st["kind"] == "layover"]
+    lay = lay.assign(aux_kwh=aux_kwh(lay["service_date"], lay["seconds"]))
+    bd["layover_aux_kwh"] = aux_kwh(bd["service_date"], bd["seconds_layover"])
+    in_service = cfg.fleet.harvest != "driving"
+    bd["demand_kwh"] = bd["consumption_kwh"] + (bd["layover_aux_kwh"] if in_service else 0.0)
+
+    # the battery's share: steps (a trip and the layover after it) per block-day
+    if cfg.fleet.harvest == "driving":
+        bd["pv_kwh_curtailed"] = 0.0
+        bd["pv_kwh_usable"] = bd["pv_kwh_driving"]
+        bd["soc_end_pv"] = np.nan
+        return bd, idle, trip
+    row = pd.Series(np.arange(len(bd)), index=idx)
+    n_steps = int(bd["trips"].max()) if len(bd) else 0
+    pv_steps = np.zeros((len(bd), max(n_steps, 1)))
+    use_steps = np.zeros_like(pv_steps)
+    t_row = row.reindex(pd.MultiIndex.from_frame(trip[key])).to_numpy()
+    t_pos = position
+    np.add.at(pv_steps, (t_row, t_pos), trip["pv_kwh"].to_numpy(float))
+    np.add.at(use_steps, (t_row, t_pos), trip["consumption_kwh"].to_numpy(float))
+    l_row = row.reindex(pd.MultiIndex.from_frame(lay[key])).to_numpy()
+    l_pos = lay["after_trip"].to_numpy(np.int64)
+    np.add.at(pv_steps, (l_row, l_pos), lay["pv_kwh"].to_numpy(float))
+    np.add.at(use_steps, (l_row, l_pos), lay["aux_kwh"].to_numpy(float))
+    bal = block_day_balance(pv_steps, use_steps, bd["pv_kwh_parked"].to_numpy(), vehicle)
+    bd["pv_kwh_curtailed"] = bal["curtailed_in_service_kwh"] + bal["curtailed_parked_kwh"]
+    bd["pv_kwh_usable"] = bd["pv_kwh_whole_day"] - bd["pv_kwh_curtailed"]
+    bd["soc_end_pv"] = bal["soc_end"]
+    return bd, idle, trip
+
+
 def reduce_run(cfg: Config, year: int, run_dir: Path, say=print) -> dict:
     """Write trip_energy, segments, segment_month, route_month, block_day, monthly, hourly
     outputs, ``summary.json`` and ``report.html``; return the summary."""
@@ -183,6 +280,10 @@ def reduce_run(cfg: Config, year: int, run_dir: Path, say=print) -> dict:
                             vecto_dir=run_dir / "vecto", say=say)
     trip = trip.merge(cons, on=["pattern_id", "month"], how="left", validate="many_to_one")
     trip["coverage"] = trip["pv_kwh"] / trip["consumption_kwh"]
+    # vehicle block per day: driving, layovers, parked; the battery's share (sets the
+    # trips' block_id to the timeline's: the GTFS block or the inferred one)
+    vehicle = cfg.vehicle_params()
+    bd, idle, trip = block_day_table(cfg, run_dir, trip, vehicle)
     write_parquet(trip, run_dir / "trip_energy.parquet")
 
     # --- segments (their geometry factors and year: after the segment-months)
@@ -220,10 +321,6 @@ def reduce_run(cfg: Config, year: int, run_dir: Path, say=print) -> dict:
     write_parquet(rm, run_dir / "route_month.parquet")
 
     # --- vehicle block per day
-    bd = (trip.groupby(["block_id", "service_date"], sort=True)
-          .agg(trips=("trip_id", "size"), pv_kwh=("pv_kwh", "sum"),
-               pv_kwh_clear=("pv_kwh_clear", "sum"), consumption_kwh=("consumption_kwh", "sum"),
-               first_departure_s=("start_s", "min")).reset_index())
     write_parquet(bd, run_dir / "block_day.parquet")
 
     # --- daily pattern by hour and month
@@ -236,13 +333,33 @@ def reduce_run(cfg: Config, year: int, run_dir: Path, say=print) -> dict:
 
     # --- fleet-year
     pv = cfg.pv_system()
-    vehicle = cfg.vehicle_params()
     n_buses = int(trip.groupby("service_date")["block_id"].nunique().max())
     # a run over some months states annual figures scaled by 12 / months (flagged in the summary)
     annualise = 12.0 / len(cfg.run.months)
-    pv_year = float(trip["pv_kwh"].sum()) * annualise
-    demand_year = float(trip["consumption_kwh"].sum()) * annualise
+    pv_year = float(bd["pv_kwh_usable"].sum()) * annualise
+    demand_year = float(bd["demand_kwh"].sum()) * annualise
     window = cfg.economics.soc_window
+    kwp_fleet = pv.kwp * n_buses
+    parts = {"driving": float(bd["pv_kwh_driving"].sum()), "layover": float(bd["pv_kwh_layover"].sum()),
+             "parked": float(bd["pv_kwh_parked"].sum() + idle["pv_kwh"].sum())}
+    harvest = {
+        "harvest": cfg.fleet.harvest, "depot_shading": cfg.fleet.depot_shading,
+        **{f"pv_kwh_{k}": v for k, v in parts.items()},
+        "pv_kwh_in_service": parts["driving"] + parts["layover"],
+        "pv_kwh_whole_day": sum(parts.values()),
+        "kwh_per_kwp_driving": parts["driving"] * annualise / kwp_fleet,
+        # the yields of the time the run evaluated (null: not computed under fleet.harvest)
+        "kwh_per_kwp_in_service": ((parts["driving"] + parts["layover"]) * annualise / kwp_fleet
+                                   if cfg.fleet.harvest != "driving" else None),
+        "kwh_per_kwp_whole_day": (sum(parts.values()) * annualise / kwp_fleet
+                                  if cfg.fleet.harvest == "whole_day" else None),
+        "pv_kwh_usable": float(bd["pv_kwh_usable"].sum()),
+        "pv_kwh_curtailed": float(bd["pv_kwh_curtailed"].sum() + idle["pv_kwh_curtailed"].sum()),
+        "idle_bus_days": int(idle["buses"].sum()),
+        "layover_hours": float(bd["seconds_layover"].sum() / 3600.0),
+        "parked_hours": float((bd["seconds_parked"].sum() + idle["seconds"].sum()) / 3600.0),
+        "layover_aux_kwh": float(bd["layover_aux_kwh"].sum()),
+    }
     eco = {
         "fleet_demand_mwh": demand_year / 1000.0,
         "coverage": float(economics.coverage(pv_year, demand_year)),
@@ -263,8 +380,16 @@ def reduce_run(cfg: Config, year: int, run_dir: Path, say=print) -> dict:
                     consumption_kwh=("consumption_kwh", "sum")).reset_index())
     monthly["shading_loss"] = shading_loss(monthly["pv_kwh_direct"] + monthly["pv_kwh_diffuse"],
                                            monthly["pv_kwh_unshaded"])
+    split = bd.groupby("month", sort=True)[
+        ["pv_kwh_driving", "pv_kwh_layover", "pv_kwh_parked", "pv_kwh_usable", "pv_kwh_curtailed",
+         "layover_aux_kwh"]].sum()
+    idle_month = idle.groupby("month")[["pv_kwh", "pv_kwh_curtailed"]].sum()
+    split["pv_kwh_parked"] += idle_month["pv_kwh"].reindex(split.index, fill_value=0.0)
+    split["pv_kwh_curtailed"] += idle_month["pv_kwh_curtailed"].reindex(split.index, fill_value=0.0)
+    split["pv_kwh_whole_day"] = split[["pv_kwh_driving", "pv_kwh_layover", "pv_kwh_parked"]].sum(axis=1)
+    monthly = monthly.merge(split.reset_index(), on="month", how="left")
     monthly["avoided_charging_cycles"] = economics.avoided_cycles(
-        monthly["pv_kwh"].to_numpy(), vehicle.battery_kwh, window)
+        monthly["pv_kwh_usable"].to_numpy(), vehicle.battery_kwh, window)
     monthly["kwh_per_kwp_allsky"] = monthly["pv_kwh"] / (pv.kwp * n_buses)
     monthly["kwh_per_kwp_clearsky"] = monthly["pv_kwh_clear"] / (pv.kwp * n_buses)
     write_parquet(monthly, run_dir / "monthly.parquet")
@@ -290,6 +415,7 @@ def reduce_run(cfg: Config, year: int, run_dir: Path, say=print) -> dict:
         "unshaded_to_ghi_allsky": float(tot["h_total_unshaded"] / tot["h_ghi"]),
         "unshaded_to_ghi_clearsky": float(tot["h_total_clear_unshaded"] / tot["h_ghi_clear"]),
         "reflected_share": float(tot["h_reflected"] / tot["h_total"]),
+        **harvest,
         **eco,
         **annual.per_bus_figures(tot, n_buses, annualise, hours_per_bus, data_dir, year),
     }

@@ -17,6 +17,7 @@ from ..config import Config
 from ..errors import InputError
 from ..progress import FolderProgress, MapProgress
 from .partition import RunContext, partition_done, run_partition, tile_geometry, worker_bvh_builds
+from .standing import run_standing, standing_done, write_timeline
 from .storage import write_json
 
 log = logging.getLogger(__name__)
@@ -158,9 +159,15 @@ def run_simulation(cfg: Config, year: int, scheduler: str | None = None,
         route_of_trip=dict(zip(trips["trip_id"], trips["route_id"].astype(str))))
 
     todo = [(t, m) for t in tiles for m in _months(cfg, year) if not partition_done(run_dir, t, m)]
-    total = len(tiles) * len(cfg.run.months)
+    # layovers and parked time: one ``standing`` task per tile holding standing points
+    t_tl = time.perf_counter()
+    standing = write_timeline(cfg, year, run_dir, routes=routes)
+    timings["timeline_s"] = time.perf_counter() - t_tl
+    standing_todo = [t for t in standing if not standing_done(run_dir, t)]
+    total = len(tiles) * len(cfg.run.months) + len(standing)
     if max_partitions is not None:
         todo = todo[:max_partitions]
+        standing_todo = standing_todo[:max(0, max_partitions - len(todo))]
     # the radiation table's sun positions are computed (and cached beside the radiation
     # file, where every worker loads them) while the cluster starts
     warm = threading.Thread(target=_warm_radiation, args=(ctx.data_dir, year), daemon=True,
@@ -175,14 +182,15 @@ def run_simulation(cfg: Config, year: int, scheduler: str | None = None,
         ctx = dataclasses.replace(ctx, ray_threads=ray_threads)
         say(f"dask dashboard: {client.dashboard_link}" if importlib.util.find_spec("bokeh")
             else "dask dashboard: off (it needs bokeh: pip install 'vipvflow[app]')")
-        say(f"{len(tiles)} tiles x {len(cfg.run.months)} months = {total} partitions, {len(todo)} to compute "
-            f"({total - len(todo)} already done) with {n_workers_now} workers")
+        n_todo = len(todo) + len(standing_todo)
+        say(f"{len(tiles)} tiles x {len(cfg.run.months)} months + {len(standing)} standing = {total} "
+            f"partitions, {n_todo} to compute ({total - n_todo} already done) with {n_workers_now} workers")
         warm.join()
         t_map = time.perf_counter()
         # the reduce's plotting libraries load while the workers compute
         threading.Thread(target=importlib.import_module, args=("vipvflow.simulation.report",),
                          daemon=True, name="import-report").start()
-        results = _map(client, ctx, todo)
+        results = _map(client, ctx, todo, standing_todo)
         timings["map_s"] = time.perf_counter() - t_map
         builds = client.run(worker_bvh_builds)
     except BaseException:
@@ -192,7 +200,8 @@ def run_simulation(cfg: Config, year: int, scheduler: str | None = None,
     closer = threading.Thread(target=_close, args=(client, cluster), name="close-cluster")
     closer.start()
     try:
-        if not all(partition_done(run_dir, t, m) for t in tiles for m in _months(cfg, year)):
+        if not (all(partition_done(run_dir, t, m) for t in tiles for m in _months(cfg, year))
+                and all(standing_done(run_dir, t) for t in standing)):
             say("stopped before all partitions were computed; run the same command again to resume")
             return run_dir
         t_red = time.perf_counter()
@@ -225,7 +234,8 @@ def _warm_radiation(data_dir: str, year: int) -> None:
         pass
 
 
-def _map(client, ctx: RunContext, todo: list[tuple[str, str]], every_s: float = 1.0) -> list[dict]:
+def _map(client, ctx: RunContext, todo: list[tuple[str, str]], standing: list[str] = (),
+         every_s: float = 1.0) -> list[dict]:
     from distributed import as_completed
 
     geometry = {}
@@ -235,6 +245,8 @@ def _map(client, ctx: RunContext, todo: list[tuple[str, str]], every_s: float = 
     for tile, month in todo:
         futures.append(client.submit(run_partition, ctx, tile, month, geometry[tile],
                                      key=f"irradiance-{tile}-{month}"))
+    for tile in standing:
+        futures.append(client.submit(run_standing, ctx, tile, key=f"standing-{tile}"))
     view = MapProgress(len(futures))
     results = []
     done, last = [], time.perf_counter()
@@ -273,7 +285,10 @@ def _write_manifest(cfg, year, run_dir, checksums, timings, results, builds) -> 
         "config": cfg.model_dump(mode="json"), "inputs_sha256": checksums, "versions": versions,
         "timings_s": {k: round(v, 3) for k, v in timings.items()},
         "partition_timings_s": {k: round(v, 3) for k, v in stage.items()},
-        "partitions_computed": len(results),
+        "partitions_computed": sum(1 for r in results if "intervals" not in r),
+        # layovers and parked time (the standing tasks; their worker time is standing_s above)
+        "standing_partitions_computed": sum(1 for r in results if "intervals" in r),
+        "standing_intervals": int(sum(r.get("intervals", 0) for r in results)),
         "passes_computed": int(sum(r["passes"] for r in results)),
         "bvh_builds_per_worker": builds,
         "created_utc": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
@@ -282,8 +297,15 @@ def _write_manifest(cfg, year, run_dir, checksums, timings, results, builds) -> 
 
 
 def _summary_line(s: dict) -> str:
-    return (f"annual yield {s['kwh_per_kwp_allsky']:.0f} kWh/kWp all-sky, "
-            f"{s['kwh_per_kwp_clearsky']:.0f} clear-sky; shading loss {100 * s['shading_loss_allsky']:.1f} %; "
+    def yield_of(key):
+        return "not computed" if s.get(key) is None else f"{s[key]:.0f} kWh/kWp"
+
+    return (f"annual yield (all-sky) driving {s['kwh_per_kwp_allsky']:.0f} kWh/kWp "
+            f"({s['kwh_per_kwp_clearsky']:.0f} clear-sky), in service {yield_of('kwh_per_kwp_in_service')}, "
+            f"whole day {yield_of('kwh_per_kwp_whole_day')}; "
+            f"shading loss {100 * s['shading_loss_allsky']:.1f} % on the road; "
+            f"the battery takes {s['pv_kwh_usable'] / 1000:.1f} MWh "
+            f"({s['pv_kwh_curtailed'] / 1000:.1f} MWh curtailed): "
             f"PV covers {100 * s['coverage']:.2f} % of {s['fleet_demand_mwh']:.0f} MWh; "
             f"{s['avoided_charging_cycles_per_bus']:.1f} charging cycles avoided per bus; "
             f"payback {s['payback_years']:.1f} years")

@@ -437,3 +437,212 @@ def date_of(value) -> dt.date:
     if isinstance(value, str) and len(value) == 8 and value.isdigit():
         return dt.datetime.strptime(value, "%Y%m%d").date()
     return pd.Timestamp(value).date()
+
+
+# ---------------------------------------------------------------------------------------------
+# the whole day of a vehicle block: trips, layovers, parked
+
+TIMELINE_KINDS = ("layover", "parked")
+#: block id of the buses without a block on a day (parked all day at the depot)
+IDLE_BLOCK = "(idle)"
+
+
+def stop_positions(data_dir, shape_dist: pd.DataFrame) -> pd.DataFrame:
+    """Roof points (m, projected CRS) of stops at distances along their shapes.
+
+    Parameters
+    ----------
+    data_dir : path with ``gtfs/segments.parquet``
+    shape_dist : DataFrame with ``shape_id`` and ``dist_m`` (m along the shape)
+
+    Returns
+    -------
+    DataFrame indexed like *shape_dist*: ``x, y, z`` (the roof point on the road, as the
+    segments' points: the road's height plus the roof height) and ``tile`` (the segment's).
+    """
+    seg = _read(data_dir, "segments.parquet", columns=["shape_id", "cum_dist_m", "length_m", "x", "y",
+                                                       "z", "x_end", "y_end", "z_end", "tile"])
+    seg = seg.sort_values(["shape_id", "cum_dist_m"], kind="stable").reset_index(drop=True)
+    out = pd.DataFrame(index=shape_dist.index, columns=["x", "y", "z"], dtype=float)
+    out["tile"] = ""
+    for shape, group in shape_dist.groupby("shape_id", sort=False):
+        s = seg[seg["shape_id"].astype(str) == str(shape)]
+        if s.empty:
+            raise KeyError(f"shape {shape!r} has no segments")
+        cum = s["cum_dist_m"].to_numpy(float)
+        d = group["dist_m"].to_numpy(float)
+        i = np.clip(np.searchsorted(cum, d, side="right") - 1, 0, len(s) - 1)
+        length = s["length_m"].to_numpy(float)[i]
+        frac = np.clip((d - cum[i]) / np.where(length > 0, length, 1.0), 0.0, 1.0)
+        for c in "xyz":
+            a, b = s[c].to_numpy(float)[i], s[f"{c}_end"].to_numpy(float)[i]
+            out.loc[group.index, c] = a + frac * (b - a)
+        out.loc[group.index, "tile"] = s["tile"].to_numpy()[i]
+    return out
+
+
+def block_timeline(data_dir, year: int, months=None, routes=None, depot=None,
+                   depot_shading: str = "city") -> dict:
+    """Every block-day of *year* cut into driving, layover and parked time (UTC).
+
+    A block-day (vehicle block x service date) owns the service day from the GTFS time origin
+    of its date to that of the next date (24 h; 23 h or 25 h when the clocks change),
+    stretched to its last arrival when the block runs past it and starting no earlier than
+    the end of the same block's previous block-day (a block past midnight owns its small
+    hours, the next day's block-day starts after them).  In it: the trips (driving, from
+    first departure to last arrival; the passes cover exactly this time); between two trips
+    the *layover* at the terminal where the first one arrived (its last stop); before the
+    first departure and after the last arrival the bus is *parked* at the depot.  So
+    ``driving + layover + parked`` is the block-day's window, with no instant counted twice
+    (trips of a block that overlap in the timetable are reported as ``overlap_s``).
+
+    Parameters
+    ----------
+    data_dir : path, scenario data directory (``gtfs/`` from :func:`ingest_gtfs`)
+    year : int
+    months : list of int, optional; block-days whose service date is in these months
+    routes : list of str, optional; only trips of these route ids
+    depot : (x, y, z, tile) of the depot in the projected CRS, optional; default the first
+        stop of each block-day's first trip
+    depot_shading : ``city`` (the depot's place in the city model), ``open`` or ``covered``
+
+    Returns
+    -------
+    dict of DataFrames
+        ``block_days``: ``block_id, service_date, month, trips, window_start_utc,
+        window_end_utc, first_departure_utc, last_arrival_utc, driving_s, overlap_s,
+        layover_s, parked_s``;
+        ``intervals``: ``block_id, service_date, month, kind`` (layover | parked), ``after_trip``
+        (position of the trip before it in the block-day; -1 before the first),
+        ``point_id, t0_utc, t1_utc, buses`` (1; for the idle rows, block id
+        :data:`IDLE_BLOCK`, the number of buses without a block that day: the fleet has as
+        many buses as the busiest day has blocks, the others stand at the depot, the
+        configured one or the commonest first stop, from the day's origin to the next);
+        ``points``: ``point_id, stop_id, x, y, z, tile, shading`` (tile ``open`` /
+        ``covered`` for a depot not in the city model); ``trip_runs``: ``trip_id,
+        service_date, block_id, position`` (the trip's place in its block-day); ``buses``.
+    """
+    from ..vehicle import infer_blocks
+
+    trips = _read(data_dir, "trips.parquet", columns=["trip_id", "route_id", "service_id", "block_id",
+                                                      "shape_id", "pattern_id", "start_s"])
+    if routes is not None:
+        trips = trips[trips["route_id"].astype(str).isin([str(r) for r in routes])]
+    ps = _read(data_dir, "pattern_stops.parquet").sort_values(["pattern_id", "stop_index"], kind="stable")
+    ends = ps.groupby("pattern_id", sort=True).agg(
+        first_stop_id=("stop_id", "first"), last_stop_id=("stop_id", "last"),
+        first_dist_m=("dist_m", "first"), last_dist_m=("dist_m", "last"), duration_s=("arr_s", "last"))
+    trips = trips.merge(ends, left_on="pattern_id", right_index=True, how="inner")
+    trips["end_s"] = trips["start_s"] + trips["duration_s"]
+    trips["block_id"] = infer_blocks(trips).to_numpy()
+
+    # points: the trips' first and last stops (by stop id) and the depot
+    shape_of = trips.drop_duplicates("pattern_id").set_index("pattern_id")["shape_id"]
+    stops = pd.concat([
+        pd.DataFrame({"stop_id": ends["first_stop_id"], "dist_m": ends["first_dist_m"]}),
+        pd.DataFrame({"stop_id": ends["last_stop_id"], "dist_m": ends["last_dist_m"]})])
+    stops = stops[stops.index.isin(shape_of.index)]
+    stops["shape_id"] = shape_of.loc[stops.index].to_numpy()
+    stops = stops.drop_duplicates("stop_id").reset_index(drop=True)
+    pts = pd.concat([stops[["stop_id"]], stop_positions(data_dir, stops)], axis=1)
+    pts["shading"] = "city"
+    if depot is not None:
+        pts = pd.concat([pts, pd.DataFrame({"stop_id": ["depot"], "x": [depot[0]], "y": [depot[1]],
+                                            "z": [depot[2]], "tile": [depot[3]],
+                                            "shading": ["city"]})], ignore_index=True)
+    if depot_shading != "city":
+        depots = pts[pts["stop_id"].isin(["depot"] if depot is not None else ends["first_stop_id"])].copy()
+        depots["shading"] = depot_shading
+        depots["tile"] = depot_shading
+        pts = pd.concat([pts, depots], ignore_index=True)
+    pts = pts.reset_index(drop=True)
+    pts.insert(0, "point_id", np.arange(len(pts), dtype=np.int64))
+    city = pts[pts["shading"] == "city"]
+    stop_point = dict(zip(city["stop_id"], city["point_id"]))
+    depot_point = dict(zip(pts.loc[pts["shading"] == depot_shading, "stop_id"],
+                           pts.loc[pts["shading"] == depot_shading, "point_id"]))
+
+    # runs of the year (months), in block, date and time order
+    # the run's months, and the day before each (its block past midnight moves the first
+    # day's start, as in a run of the whole year); the days before are dropped below
+    sd = service_dates(data_dir, year)
+    in_run = sd["date"].dt.month.isin(list(months)) if months is not None else pd.Series(True, sd.index)
+    before = (sd["date"] + pd.Timedelta(days=1)).dt.month.isin(list(months)) if months is not None else in_run
+    sd = sd.assign(in_run=in_run)[in_run | (before & (sd["date"] + pd.Timedelta(days=1)).dt.year.eq(year))]
+    runs = trips.merge(sd, on="service_id")
+    tz = _feed_info(data_dir)["timezone"]
+    udates = np.unique(runs["date"].to_numpy()) if len(runs) else np.zeros(0, "datetime64[ns]")
+    origin = service_day_origin_utc(udates, tz)
+    next_origin = service_day_origin_utc(udates + np.timedelta64(1, "D"), tz)
+    k = np.searchsorted(udates, runs["date"].to_numpy())
+    runs = runs.assign(t0=origin[k] + runs["start_s"].to_numpy(float),
+                       t1=origin[k] + runs["end_s"].to_numpy(float),
+                       day0=origin[k], day1=next_origin[k])
+    runs = runs.sort_values(["block_id", "date", "t0", "trip_id"], kind="stable").reset_index(drop=True)
+
+    key = ["block_id", "date"]
+    bd = runs.groupby(key, sort=True).agg(
+        trips=("trip_id", "size"), first_departure_utc=("t0", "min"), last_arrival_utc=("t1", "max"),
+        day0=("day0", "first"), day1=("day1", "first"),
+        first_stop_id=("first_stop_id", "first")).reset_index()
+    bd["window_end_utc"] = np.maximum(bd["day1"], bd["last_arrival_utc"])
+    prev_end = bd.groupby("block_id", sort=False)["window_end_utc"].shift(1)
+    start = np.maximum(bd["day0"], prev_end.fillna(-np.inf))
+    bd["window_start_utc"] = np.minimum(start, bd["first_departure_utc"])
+    keep = bd.set_index(key).index.isin(pd.MultiIndex.from_frame(runs.loc[runs["in_run"], key]))
+    bd = bd[keep].reset_index(drop=True)
+    runs = runs[runs["in_run"].to_numpy()].reset_index(drop=True)
+
+    # layovers: from a trip's arrival to the next trip's departure of the same block-day
+    same = ((runs["block_id"].to_numpy()[1:] == runs["block_id"].to_numpy()[:-1])
+            & (runs["date"].to_numpy()[1:] == runs["date"].to_numpy()[:-1]))
+    a = np.flatnonzero(same)
+    pos = runs.groupby(key, sort=False).cumcount().to_numpy()
+    gap = runs["t0"].to_numpy()[a + 1] - runs["t1"].to_numpy()[a]
+    lay = pd.DataFrame({"block_id": runs["block_id"].to_numpy()[a], "date": runs["date"].to_numpy()[a],
+                        "kind": "layover", "after_trip": pos[a],
+                        "point_id": runs["last_stop_id"].map(stop_point).to_numpy()[a],
+                        "t0_utc": runs["t1"].to_numpy()[a], "t1_utc": runs["t0"].to_numpy()[a + 1]})
+    over = pd.DataFrame({"block_id": lay["block_id"], "date": lay["date"],
+                         "overlap_s": np.maximum(-gap, 0.0)})
+    lay = lay[gap > 0]
+    dp = bd["first_stop_id"].map(depot_point) if depot is None else pd.Series(
+        depot_point["depot"], index=bd.index)
+    am = pd.DataFrame({"block_id": bd["block_id"], "date": bd["date"], "kind": "parked", "after_trip": -1,
+                       "point_id": dp, "t0_utc": bd["window_start_utc"], "t1_utc": bd["first_departure_utc"]})
+    pm = pd.DataFrame({"block_id": bd["block_id"], "date": bd["date"], "kind": "parked",
+                       "after_trip": bd["trips"] - 1, "point_id": dp, "t0_utc": bd["last_arrival_utc"],
+                       "t1_utc": bd["window_end_utc"]})
+    # idle buses: on a day with fewer blocks than the fleet has buses (the most blocks of
+    # any day), the others stand parked at the depot from the day's origin to the next
+    per_day = bd.groupby("date").size()
+    n_buses = int(per_day.max()) if len(per_day) else 0
+    days = pd.DatetimeIndex(sorted({d for d in pd.date_range(f"{year}-01-01", f"{year}-12-31", freq="D")
+                                    if months is None or d.month in set(months)})).astype("datetime64[ns]")
+    idle_n = n_buses - per_day.reindex(days, fill_value=0).to_numpy()
+    fleet_depot = (depot_point["depot"] if depot is not None
+                   else int(dp.mode().iloc[0]) if len(dp) else -1)
+    d0, d1 = service_day_origin_utc(days, tz), service_day_origin_utc(days + pd.Timedelta(days=1), tz)
+    idle = pd.DataFrame({"block_id": IDLE_BLOCK, "date": days, "kind": "parked", "after_trip": -1,
+                         "point_id": fleet_depot, "t0_utc": d0, "t1_utc": d1, "buses": idle_n})
+    idle = idle[idle["buses"] > 0]
+    iv = pd.concat([am.assign(buses=1), lay.assign(buses=1), pm.assign(buses=1), idle], ignore_index=True)
+    iv = iv[iv["t1_utc"] > iv["t0_utc"]]
+    iv = iv.sort_values(key + ["t0_utc"], kind="stable").reset_index(drop=True)
+    iv = iv.rename(columns={"date": "service_date"}).astype({"point_id": np.int64, "after_trip": np.int64,
+                                                             "buses": np.int64})
+    iv["month"] = iv["service_date"].dt.strftime("%Y-%m")
+
+    driving = runs.assign(s=runs["t1"] - runs["t0"]).groupby(key, sort=True)["s"].sum()
+    bd["driving_s"] = driving.to_numpy()
+    bd["overlap_s"] = over.groupby(key, sort=True)["overlap_s"].sum().reindex(
+        pd.MultiIndex.from_frame(bd[key]), fill_value=0.0).to_numpy() if len(over) else 0.0
+    own = iv[iv["block_id"] != IDLE_BLOCK].assign(s=iv["t1_utc"] - iv["t0_utc"])
+    for kind in TIMELINE_KINDS:
+        bd[f"{kind}_s"] = own[own["kind"] == kind].groupby(["block_id", "service_date"])["s"].sum().reindex(
+            pd.MultiIndex.from_frame(bd[key]), fill_value=0.0).to_numpy()
+    bd = bd.rename(columns={"date": "service_date"}).drop(columns=["day0", "day1", "first_stop_id"])
+    bd["month"] = bd["service_date"].dt.strftime("%Y-%m")
+    trip_runs = pd.DataFrame({"trip_id": runs["trip_id"].astype(str), "service_date": runs["date"],
+                              "block_id": runs["block_id"].astype(str), "position": pos})
+    return {"block_days": bd, "intervals": iv, "points": pts, "trip_runs": trip_runs, "buses": n_buses}

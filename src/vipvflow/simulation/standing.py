@@ -1,0 +1,241 @@
+"""A bus standing still: layovers at terminals and parking at the depot.
+
+A standing roof is a fixed point, so it goes through the same irradiance kernel as a road
+segment: its geometry factors (sky view factor, reflector groups) once per point with
+:func:`vipvflow.irradiance.segment_geometry` (a flat roof: no gradient), then
+:func:`vipvflow.irradiance.evaluate_passes` at the middle of every minute the point's
+intervals span (the radiation table's own grid: CAMS minute means at minute centres).  The
+minute values are summed into a running total per point, and an interval ``[t0, t1)`` takes
+the difference of that total at its ends, interpolated within a minute: the exact integral
+of the minute-constant irradiance, whatever the interval's length, so splitting a span into
+intervals never changes its sum.
+
+``depot_shading``: ``city`` points are evaluated in their tile's city model, ``open`` points
+in an empty scene (no shade, no reflection: the roof of a bus in an open field, so the
+all-sky ``total`` is ``DNI cos(zenith) + DHI``), ``covered`` points receive nothing.
+"""
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from ..config import IrradianceCfg
+from .storage import partition_path, write_parquet
+
+#: energy (kWh) columns of an interval and the irradiance component each integrates
+PV_SOURCE = {"pv_kwh": "total", "pv_kwh_clear": "total_clear", "pv_kwh_unshaded": "total_unshaded",
+             "pv_kwh_clear_unshaded": "total_clear_unshaded", "pv_kwh_direct": "direct",
+             "pv_kwh_diffuse": "diffuse", "pv_kwh_reflected": "reflected"}
+H_COMPONENTS = ("direct", "diffuse", "reflected", "total", "total_unshaded", "direct_clear",
+                "diffuse_clear", "reflected_clear", "total_clear", "total_clear_unshaded", "ghi",
+                "ghi_clear")
+_MINUTE = 60.0
+
+
+def timeline_dir(run_dir) -> Path:
+    return Path(run_dir) / "parts" / "timeline"
+
+
+def open_scene():
+    """A scene without any surface: an open field."""
+    from ..shading import Scene, box_mesh
+
+    return Scene(box_mesh([]))
+
+
+def point_geometry(scene, points: pd.DataFrame, cfg: IrradianceCfg) -> pd.DataFrame:
+    """Geometry factors of standing roof points (``point_id, x, y, z``, m): a flat roof."""
+    from ..irradiance import segment_geometry
+
+    seg = pd.DataFrame({"segment_id": points["point_id"].to_numpy(np.int64),
+                        "x": points["x"].to_numpy(float), "y": points["y"].to_numpy(float),
+                        "z": points["z"].to_numpy(float), "heading_deg": 0.0, "gradient": 0.0})
+    return segment_geometry(scene, seg, cfg)
+
+
+def interval_integrals(intervals: pd.DataFrame, geometry: pd.DataFrame, radiation, scene,
+                       cfg: IrradianceCfg, energy_kwh, ground_albedo: float = 0.20,
+                       dark: bool = False) -> pd.DataFrame:
+    """Irradiation and PV energy of standing intervals.
+
+    Parameters
+    ----------
+    intervals : DataFrame with ``point_id`` and ``t0_utc, t1_utc`` (Unix s)
+    geometry : :func:`point_geometry` of the points (``segment_id`` = ``point_id``)
+    radiation : vipvflow.radiation.RadiationTable
+    scene : vipvflow.shading.Scene
+    cfg : IrradianceCfg
+    energy_kwh : callable ``(poa_wm2, dt_s) -> kWh`` per minute (the run's PV model, still)
+    ground_albedo : float
+    dark : bool, a covered depot: no light at all
+
+    Returns
+    -------
+    DataFrame indexed like *intervals*: ``seconds``, :data:`PV_SOURCE` columns (kWh) and
+    ``h_<component>`` (Wh/m2) for :data:`H_COMPONENTS`.
+    """
+    from ..irradiance import evaluate_passes
+
+    n = len(intervals)
+    out = {"seconds": (intervals["t1_utc"] - intervals["t0_utc"]).to_numpy(float)}
+    for c in PV_SOURCE:
+        out[c] = np.zeros(n)
+    for c in H_COMPONENTS:
+        out[f"h_{c}"] = np.zeros(n)
+    if dark or not n:
+        return pd.DataFrame(out, index=intervals.index)
+    pid = intervals["point_id"].to_numpy(np.int64)
+    t0 = intervals["t0_utc"].to_numpy(float)
+    t1 = intervals["t1_utc"].to_numpy(float)
+    for p in np.unique(pid):
+        sel = np.flatnonzero(pid == p)
+        lo = np.floor(t0[sel].min() / _MINUTE) * _MINUTE
+        hi = np.ceil(t1[sel].max() / _MINUTE) * _MINUTE
+        edges = np.arange(lo, hi + _MINUTE / 2, _MINUTE)
+        minutes = pd.DataFrame({"segment_id": np.full(len(edges) - 1, p, np.int64),
+                                "t_utc": edges[:-1], "dt_s": np.full(len(edges) - 1, _MINUTE, np.float32)})
+        irr = evaluate_passes(minutes, None, geometry, radiation, scene, cfg,
+                              ground_albedo=ground_albedo, time_at="mid")
+        dt = minutes["dt_s"].to_numpy(np.float64)
+        names = list(PV_SOURCE) + [f"h_{c}" for c in H_COMPONENTS]
+        per_minute = np.empty((len(names), len(dt) + 1))      # running totals from 0
+        per_minute[:, 0] = 0.0
+        for j, comp in enumerate(PV_SOURCE.values()):
+            per_minute[j, 1:] = energy_kwh(irr[comp].to_numpy(np.float64), dt)
+        for j, c in enumerate(H_COMPONENTS, start=len(PV_SOURCE)):
+            per_minute[j, 1:] = irr[c].to_numpy(np.float64) * dt / 3600.0
+        total = np.cumsum(per_minute, axis=1)
+
+        def at(t):      # the running totals at times t, linear within a minute
+            f = np.clip((t - lo) / _MINUTE, 0, len(dt))
+            i = np.minimum(f.astype(np.int64), len(dt) - 1)
+            return total[:, i] + (f - i) * (total[:, i + 1] - total[:, i])
+
+        sums = at(t1[sel]) - at(t0[sel])
+        for j, name in enumerate(names):
+            out[name][sel] = sums[j]
+    return pd.DataFrame(out, index=intervals.index)
+
+
+#: the ``month`` of a standing partition: one per tile holds all the run's months (a tile
+#: has only a few standing points; per month, loading the tile's scene cost more than them)
+ALL_MONTHS = "all"
+
+
+def run_standing(ctx, tile: str) -> dict:
+    """Evaluate the layover and parked intervals at the points of *tile* (``open`` and
+    ``covered``: the depot outside the city model) of the run's block-days; writes
+    ``parts/standing/tile=T/month=all.parquet``, one row per interval (``seconds`` and the
+    sums are per bus times ``buses``: more than 1 only for the idle buses of a day)."""
+    from .partition import _radiation, _scene, pv_energy_kwh, tune_malloc
+
+    tune_malloc()
+    t_start = time.perf_counter()
+    tdir = timeline_dir(ctx.run_dir)
+    points = pd.read_parquet(tdir / "points.parquet")
+    points = points[points["tile"] == tile]
+    iv = pd.read_parquet(tdir / "intervals.parquet")
+    iv = iv[iv["point_id"].isin(points["point_id"])].reset_index(drop=True)
+    cfg = IrradianceCfg(**ctx.irradiance)
+    dark = tile == "covered" or not len(iv)
+    timings = {"standing_load_s": time.perf_counter() - t_start}
+    if not dark:
+        t = time.perf_counter()
+        scene = open_scene() if tile == "open" else _scene(ctx, tile)
+        _radiation(ctx.data_dir, ctx.year)
+        timings["standing_scene_s"] = time.perf_counter() - t
+        t = time.perf_counter()
+        geom = point_geometry(scene, points, cfg)
+        timings["standing_geometry_s"] = time.perf_counter() - t
+    t_eval = time.perf_counter()
+    parts = []
+    for month, group in iv.groupby("month", sort=True):
+        m = int(month[5:7])
+
+        def energy(poa, dt, m=m):        # the run's PV model, standing still (no cooling by speed)
+            return pv_energy_kwh(poa, dt, np.zeros(len(poa)), m, ctx)
+
+        if dark:
+            parts.append(interval_integrals(group, None, None, None, cfg, energy, dark=True))
+        else:
+            parts.append(interval_integrals(group, geom, _radiation(ctx.data_dir, ctx.year), scene, cfg,
+                                            energy, ground_albedo=ctx.ground_albedo))
+    res = (pd.concat(parts).reindex(iv.index) if parts
+           else interval_integrals(iv, None, None, None, cfg, None, dark=True))
+    timings["standing_eval_s"] = time.perf_counter() - t_eval
+    # idle rows stand for several buses: their sums are per bus times the buses
+    res = res.mul(iv["buses"].to_numpy(np.float64), axis=0)
+    table = pd.concat([iv[["block_id", "service_date", "kind", "after_trip", "point_id", "t0_utc",
+                           "t1_utc", "buses"]].astype({"block_id": str, "kind": str}), res], axis=1)
+    table["tile"] = tile
+    write_parquet(table, partition_path(Path(ctx.run_dir), "standing", tile, ALL_MONTHS))
+    elapsed = time.perf_counter() - t_start
+    # standing_s in all; its parts: reading the timeline, the tile's scene and radiation table
+    # (cached per worker), the points' geometry factors, the minutes through the kernel
+    return {"tile": tile, "month": ALL_MONTHS, "passes": 0, "trips": 0, "kwh": float(res["pv_kwh"].sum()),
+            "kwh_by_route": {}, "timings": {"standing_s": elapsed, **timings}, "intervals": int(len(iv)),
+            "elapsed_s": elapsed}
+
+
+def depot_point(cfg, data_dir) -> tuple | None:
+    """The configured depot (``fleet.depot``, WGS84) as ``(x, y, z, tile)`` in the run's CRS:
+    the roof height above the road nearest to it; ``None`` when no depot is configured.
+
+    Raises
+    ------
+    InputError
+        With ``depot_shading: city`` when the city model has no mesh at the depot.
+    """
+    import json
+
+    from pyproj import Transformer
+
+    from ..errors import InputError
+    from ..tiles import tile_names
+
+    depot = cfg.fleet.depot
+    if depot is None:
+        return None
+    feed = json.loads((Path(data_dir) / "gtfs" / "feed.json").read_text())
+    x, y = Transformer.from_crs("EPSG:4326", feed["crs"], always_xy=True).transform(depot.lon, depot.lat)
+    seg = pd.read_parquet(Path(data_dir) / "gtfs" / "segments.parquet", columns=["x", "y", "z"])
+    near = int(np.argmin(np.hypot(seg["x"].to_numpy() - x, seg["y"].to_numpy() - y)))
+    tile = str(tile_names([x], [y], float(feed.get("tile_size_m", 500.0)))[0])
+    mesh = Path(data_dir) / "city" / "meshes" / f"{tile}.npz"
+    if cfg.fleet.depot_shading == "city" and not mesh.exists():
+        raise InputError(f"{cfg._source}: fleet.depot ({depot.lat}, {depot.lon}) lies outside the city "
+                         f"model (no mesh for tile {tile}); set fleet.depot_shading to open or covered")
+    return float(x), float(y), float(seg["z"].to_numpy()[near]), tile
+
+
+def write_timeline(cfg, year: int, run_dir, routes=None) -> list[tuple[str, str]]:
+    """Cut the run's block-days into driving, layover and parked time
+    (:func:`vipvflow.trajectory.schedule.block_timeline`), keep the kinds ``fleet.harvest``
+    counts, write ``parts/timeline/{block_days,intervals,points,trip_runs}.parquet`` once per
+    run and return the tiles that have standing intervals (one ``standing`` task each)."""
+    from ..trajectory.schedule import block_timeline
+
+    tdir = timeline_dir(run_dir)
+    if not (tdir / "points.parquet").exists():
+        tl = block_timeline(cfg.data_dir, year, months=cfg.run.months, routes=routes,
+                            depot=depot_point(cfg, cfg.data_dir), depot_shading=cfg.fleet.depot_shading)
+        iv = tl["intervals"]
+        if cfg.fleet.harvest == "in_service":
+            iv = iv[iv["kind"] == "layover"]
+        elif cfg.fleet.harvest == "driving":
+            iv = iv.iloc[:0]
+        write_parquet(tl["block_days"].reset_index(drop=True), tdir / "block_days.parquet")
+        write_parquet(iv.astype({"kind": str}).reset_index(drop=True), tdir / "intervals.parquet")
+        write_parquet(tl["trip_runs"], tdir / "trip_runs.parquet")
+        write_parquet(tl["points"].astype({"stop_id": str, "tile": str, "shading": str}),
+                      tdir / "points.parquet")
+    iv = pd.read_parquet(tdir / "intervals.parquet", columns=["point_id"])
+    tiles = pd.read_parquet(tdir / "points.parquet").set_index("point_id")["tile"]
+    return sorted(set(tiles.reindex(iv["point_id"].unique()).astype(str)))
+
+
+def standing_done(run_dir, tile: str) -> bool:
+    return partition_path(Path(run_dir), "standing", tile, ALL_MONTHS).exists()
