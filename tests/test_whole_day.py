@@ -267,7 +267,7 @@ def test_paper_scenario_is_the_papers_accounting():
 
     from vipvflow.config import load_config
 
-    cfg = load_config(Path(__file__).parents[1] / "conf" / "paper.yaml")
+    cfg = load_config("paper")
     assert (cfg.fleet.harvest, cfg.irradiance.diffuse_model, cfg.pv.mode) == ("driving", "isotropic", "paper")
 
 

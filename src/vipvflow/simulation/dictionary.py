@@ -56,6 +56,10 @@ _PV = {
     "pv_kwh_layover": "PV energy while standing at terminals between trips (whole-day model)",
     "pv_kwh_parked": "PV energy while parked out of service, e.g. at the depot (whole-day model)",
     "pv_kwh_curtailed": "PV energy the battery could not take (full), lost (whole-day model)",
+    "pv_kwh_whole_day": "PV energy over the whole day: driving + layover + parked (whole-day model)",
+    "pv_kwh_usable": "PV energy the battery takes: pv_kwh_whole_day - pv_kwh_curtailed (whole-day model)",
+    "pv_kwh_clear_layover": "clear-sky PV energy while standing at terminals between trips",
+    "pv_kwh_clear_parked": "clear-sky PV energy while parked out of service",
 }
 
 _COMPONENTS = ["direct", "diffuse", "reflected", "total", "total_unshaded",
@@ -101,6 +105,22 @@ COLUMNS: dict[str, Column] = {
     "shading_loss_clear": Column("fraction", "shading_loss under clear sky"),
     "reflection_gain": Column("fraction", "reflected / total_unshaded, all-sky: light the buildings add"),
     "avoided_charging_cycles": Column("cycles", "pv_kwh / (battery capacity x usable SoC window), fleet"),
+    "layover_aux_kwh": Column("kWh", "auxiliaries and HVAC drawn from the battery during the layovers "
+                                     "(month's mean temperature, discharge efficiency)"),
+    "demand_kwh": Column("kWh", "battery energy the block-day needs: trips' consumption_kwh + layover_aux_kwh"),
+    "soc_end_pv": Column("fraction", "battery state of charge at the end of the block-day with PV "
+                                     "(starting full at the SoC ceiling; below soc_min: the block overruns "
+                                     "the battery's window)"),
+    "window_start_utc": Column("s (Unix)", "start of the block-day's time window (its GTFS service day)"),
+    "window_end_utc": Column("s (Unix)", "end of the block-day's time window (stretched to the last "
+                                         "arrival past the service day)"),
+    "window_s": Column("s", "length of the block-day's window: seconds_driving + seconds_layover + seconds_parked"),
+    "first_departure_utc": Column("s (Unix)", "first departure of the block-day"),
+    "last_arrival_utc": Column("s (Unix)", "last arrival of the block-day"),
+    "overlap_s": Column("s", "time two trips of the block overlap in the timetable (counted once, as driving)"),
+    "seconds_driving": Column("s", "time on trips (first departure to last arrival of each trip)"),
+    "seconds_layover": Column("s", "time standing at terminals between the block's trips"),
+    "seconds_parked": Column("s", "time parked at the depot before the first and after the last trip"),
     "kwh_per_kwp_allsky": Column("kWh/kWp", "all-sky PV energy per installed kWp of the fleet (specific yield)"),
     "kwh_per_kwp_clearsky": Column("kWh/kWp", "clear-sky PV energy per installed kWp of the fleet"),
     # segment geometry (gtfs/segments.parquet)
@@ -183,10 +203,15 @@ OUTPUTS: dict[str, Output] = {
         f"consumption_kwh coverage shading_loss"),
     "block_day": _out(
         "Vehicles per day", "one row per vehicle block and service date",
-        f"block_id service_date trips pv_kwh pv_kwh_clear {_WHOLE_DAY} consumption_kwh first_departure_s"),
+        f"block_id service_date month trips window_start_utc window_end_utc first_departure_utc "
+        f"last_arrival_utc overlap_s pv_kwh pv_kwh_clear consumption_kwh first_departure_s "
+        f"pv_kwh_driving seconds_driving pv_kwh_layover pv_kwh_clear_layover seconds_layover "
+        f"pv_kwh_parked pv_kwh_clear_parked seconds_parked pv_kwh_whole_day window_s layover_aux_kwh "
+        f"demand_kwh pv_kwh_curtailed pv_kwh_usable soc_end_pv"),
     "monthly": _out(
         "The fleet per month", "one row per month, the whole fleet",
-        f"month trips {_PVS} {_WHOLE_DAY} consumption_kwh shading_loss avoided_charging_cycles "
+        f"month trips {_PVS} {_WHOLE_DAY} pv_kwh_whole_day pv_kwh_usable layover_aux_kwh "
+        f"consumption_kwh shading_loss avoided_charging_cycles "
         f"kwh_per_kwp_allsky kwh_per_kwp_clearsky"),
     "hourly_pattern": _out(
         "Daily pattern by hour and month", "one row per month and local clock hour, the whole fleet",
@@ -239,6 +264,26 @@ SUMMARY: dict[str, Column] = {
     "avoided_charging_cycles_per_bus": Column("cycles per year", "the same per bus"),
     "system_cost_eur_per_bus": Column("EUR", "PV system cost per bus"),
     "payback_years": Column("years", "simple payback of one bus's PV system at the configured tariff"),
+    # the whole day (docs/whole_day.md)
+    "harvest": Column("", "fleet.harvest: which time counts (driving | in_service | whole_day)"),
+    "depot_shading": Column("", "fleet.depot_shading: open | covered | city"),
+    "pv_kwh_driving": Column("kWh", "fleet PV energy on trips over the simulated months (= pv_kwh_allsky)"),
+    "pv_kwh_layover": Column("kWh", "fleet PV energy at terminals between trips"),
+    "pv_kwh_parked": Column("kWh", "fleet PV energy parked at the depot (idle buses included)"),
+    "pv_kwh_in_service": Column("kWh", "driving + layover"),
+    "pv_kwh_whole_day": Column("kWh", "driving + layover + parked"),
+    "kwh_per_kwp_driving": Column("kWh/kWp per year", "specific yield counting the trips only (the paper's accounting)"),
+    "kwh_per_kwp_in_service": Column("kWh/kWp per year", "specific yield of driving + layovers"),
+    "kwh_per_kwp_whole_day": Column("kWh/kWp per year", "specific yield of the whole day (driving, layovers, parked)"),
+    "pv_kwh_usable": Column("kWh", "PV energy the batteries take (coverage, cycles and payback use it)"),
+    "pv_kwh_curtailed": Column("kWh", "PV energy beyond the SoC ceiling, lost"),
+    "idle_bus_days": Column("count", "bus-days without a block (parked all day)"),
+    "layover_hours": Column("h", "fleet time standing at terminals over the simulated months"),
+    "parked_hours": Column("h", "fleet time parked at the depot over the simulated months"),
+    "layover_aux_kwh": Column("kWh", "auxiliaries and HVAC during the layovers (in the demand)"),
+    "radiation_gaps_interpolated": Column("count", "gaps in the radiation data within the run's months, "
+                                                   "interpolated (each shorter than radiation.max_gap_minutes)"),
+    "radiation_gap_minutes_interpolated": Column("min", "minutes of those gaps"),
 }
 
 
