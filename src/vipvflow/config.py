@@ -80,7 +80,9 @@ class TrajectoryCfg(_Model):
 
 
 class IrradianceCfg(_Model):
-    diffuse_model: Literal["isotropic", "sky_view_factor"] = "isotropic"
+    # sky_view_factor: DHI x the roof point's cosine-weighted sky view (the default);
+    # isotropic: the paper's DHI (1 + cos tilt) / 2, an upper bound in streets
+    diffuse_model: Literal["isotropic", "sky_view_factor"] = "sky_view_factor"
     reflection: bool = True
     reflection_rays: int = Field(64, ge=0)
     svf_rays: int = Field(128, gt=0)

@@ -303,7 +303,7 @@ def run_partition(ctx: RunContext, tile: str, month: str, geometry: pd.DataFrame
     ``parts/hourly/...`` (per local hour: irradiation and pass time, for the daily pattern).
     Returns a small summary for the progress view.
     """
-    from ..irradiance import evaluate_passes, stage_seconds
+    from ..irradiance import evaluate_passes
     from ..trajectory import iter_passes
 
     tune_malloc()
@@ -317,15 +317,15 @@ def run_partition(ctx: RunContext, tile: str, month: str, geometry: pd.DataFrame
     seg = _segments(ctx.data_dir)
     if n:
         t1 = time.perf_counter()
-        before = dict(stage_seconds())
+        stages: dict = {}
         scene = _scene(ctx, tile)
         irr = evaluate_passes(passes, seg, geometry, _radiation(ctx.data_dir, ctx.year),
                               scene, IrradianceCfg(**ctx.irradiance),
                               ground_albedo=ctx.ground_albedo,
-                              packed=_packed_geometry(ctx, tile, geometry, scene))
+                              packed=_packed_geometry(ctx, tile, geometry, scene), timings=stages)
         timings["irradiance_s"] = time.perf_counter() - t1
         # the irradiance time split by stage (lookup, ray setup, rays, components, pack)
-        timings.update({f"irradiance_{k}": v - before[k] for k, v in stage_seconds().items()})
+        timings.update({f"irradiance_{k}": v for k, v in stages.items()})
     else:
         irr = pd.DataFrame({c: np.zeros(0, np.float32) for c in COMPONENTS})
     t2 = time.perf_counter()
