@@ -84,12 +84,12 @@ class IrradianceCfg(_Model):
     # isotropic: the paper's DHI (1 + cos tilt) / 2, an upper bound in streets
     diffuse_model: Literal["isotropic", "sky_view_factor"] = "sky_view_factor"
     reflection: bool = True
-    reflection_rays: int = Field(64, ge=0)
-    svf_rays: int = Field(128, gt=0)
+    reflection_rays: int = Field(256, ge=0)
+    svf_rays: int = Field(512, gt=0)
     ray_length_m: float = Field(300.0, gt=0)
     ray_offset_m: float = Field(0.05, ge=0)
-    max_reflector_groups: int = Field(3, ge=0)
-    reflector_points: int = Field(4, ge=1)
+    max_reflector_groups: int = Field(4, ge=0)
+    reflector_points: int = Field(16, ge=1)
     reflector_sampling: Literal["rotate", "all"] = "rotate"
     reflector_sky_rays: int = Field(32, ge=1)
     seed: int = 7

@@ -49,6 +49,7 @@ from .mesh import SURFACE_CODE
 _GOLDEN = (np.sqrt(5.0) - 1.0) / 2.0
 _CHUNK = 1 << 20        # passes per chunk in evaluate_passes
 _MIN_REFLECTOR_LIFT = 0.02   # m: a reflector's sun ray starts off its own surface
+_DENSE_SVF, _DENSE_RAYS = 0.75, 4   # below this sky view factor, 4x the reflection rays
 _GROUND_CODES = [SURFACE_CODE["ground"], SURFACE_CODE["terrain"]]   # lit like open ground
 
 
@@ -295,7 +296,14 @@ def segment_geometry(scene, segments: pd.DataFrame, cfg: IrradianceCfg | None = 
         group's lit fraction, each an equal share of its weight; m), ``r{g}_sky`` (the
         group's own cosine-weighted sky view factor), ``r{g}_gnd`` (albedo-weighted view
         factor of the modelled ground and terrain it sees), ``r{g}_open`` (view factor of
-        open ground beyond the mesh, below the horizon).  Points are lifted off their
+        open ground beyond the mesh, below the horizon), ``r{g}_wall`` (albedo-weighted view
+        factor of facades and roofs it sees), ``r{g}_nlen`` (length of the group's
+        weighted mean normal, <= 1: the beam on a group of several orientations is
+        ``w x nlen x max(s . n, 0)``), ``r{g}_surface`` (index into the tile mesh's
+        ``surface_ids`` of the surface holding most of the group's weight, -1 for none);
+        the street the groups see: ``st_nx, st_ny, st_nz`` (normal), ``st_p{k}_x, _y, _z``
+        (sample points), ``st_sky`` (its sky view), ``st_wall`` (albedo-weighted view of
+        facades).  Points are lifted off their
         surface by ``max(ray_offset_m, 0.02 m)``.  Unused groups have weight 0.
     """
     cfg = cfg or IrradianceCfg()
@@ -318,6 +326,7 @@ def segment_geometry(scene, segments: pd.DataFrame, cfg: IrradianceCfg | None = 
     ggnd = np.zeros((n_seg, G))
     gopen = np.zeros((n_seg, G))
     gwall = np.zeros((n_seg, G))
+    glen = np.ones((n_seg, G))
     gsurf = np.full((n_seg, G), -1, np.int64)
     street = {"n": np.tile([0.0, 0.0, 1.0], (n_seg, 1)), "pts": np.repeat(origin[:, None], P, axis=1),
               "sky": np.zeros(n_seg), "wall": np.zeros(n_seg)}
@@ -340,67 +349,75 @@ def segment_geometry(scene, segments: pd.DataFrame, cfg: IrradianceCfg | None = 
         svf[sl] = sky.reshape(m, cfg.svf_rays).mean(axis=1)
         if not (cfg.reflection and cfg.reflection_rays > 0 and G > 0):
             continue
-        N = cfg.reflection_rays
-        d = cosine_directions(nrm, N, segment_uniforms(cfg.seed, 1, keys, N + 1)).reshape(-1, 3)
-        oo = np.repeat(o, N, axis=0)
-        tri, dist = scene.first_hit(oo, d, cfg.ray_length_m)
-        hit = tri >= 0
-        seg_of = np.repeat(np.arange(m), N)
-        x = np.zeros(len(tri))
-        x[hit] = tri_albedo[tri[hit]]
-        xs = x.reshape(m, N)
-        refl_vf[sl] = xs.mean(axis=1)
-        refl_se[sl] = xs.std(axis=1, ddof=1) / np.sqrt(N) if N > 1 else 0.0
-        hit &= x > 0
-        if not hit.any():
-            continue
-        hs, hd = seg_of[hit], d[hit]
-        hn = tri_normal[tri[hit]]
-        hn = np.where(((hn * hd).sum(1) > 0)[:, None], -hn, hn)     # the face the roof sees
-        hp = oo[hit] + dist[hit, None].astype(np.float64) * hd
-        w = x[hit] / N
-        cls = _orientation_class(hn)
-        C = 10
-        key = hs * C + cls
-        cw = np.bincount(key, w, m * C).reshape(m, C)
-        cn = np.stack([np.bincount(key, w * hn[:, j], m * C) for j in range(3)], -1).reshape(m, C, 3)
-        # keep the G heaviest classes; merge every other class into the kept one nearest
-        # in orientation
-        order = np.argsort(-cw, axis=1, kind="stable")
-        kept = order[:, :G]
-        rank = np.empty_like(order)
-        np.put_along_axis(rank, order, np.arange(C)[None].repeat(m, 0), axis=1)
-        kn = np.take_along_axis(cn, kept[..., None], axis=1)           # (m, G, 3)
-        kn_u = kn / np.maximum(np.linalg.norm(kn, axis=2, keepdims=True), 1e-12)
-        cn_u = cn / np.maximum(np.linalg.norm(cn, axis=2, keepdims=True), 1e-12)
-        kw = np.take_along_axis(cw, kept, axis=1)
-        sim = np.einsum("mcj,mgj->mcg", cn_u, kn_u) - 10.0 * (kw[:, None, :] <= 0)
-        target = np.where(rank < G, rank, np.argmax(sim, axis=2))      # (m, C) -> group
-        grp = target[hs, cls]
-        gkey = hs * G + grp
-        w_g = np.bincount(gkey, w, m * G).reshape(m, G)
-        n_g = np.stack([np.bincount(gkey, w * hn[:, j], m * G) for j in range(3)], -1).reshape(m, G, 3)
-        p_g = np.stack([np.bincount(gkey, w * hp[:, j], m * G) for j in range(3)], -1).reshape(m, G, 3)
-        nz = w_g > 0
-        n_g = np.where(nz[..., None], n_g / np.maximum(np.linalg.norm(n_g, axis=2, keepdims=True),
-                                                        1e-12), [0.0, 0.0, 1.0])
-        mean_p = p_g / np.maximum(w_g, 1e-300)[..., None]
-        # representative point: the group's hit point nearest its weighted mean
-        dev = np.linalg.norm(hp - mean_p.reshape(-1, 3)[gkey], axis=1)
-        srt = np.lexsort((dev, gkey))
-        first = srt[np.unique(gkey[srt], return_index=True)[1]]
-        rep = np.repeat(o[:, None], G, axis=1).reshape(-1, 3)
-        rep[gkey[first]] = hp[first]
-        # the surface holding most of each group's weight (for the export)
-        gsurf[sl] = _dominant_surface(gkey, tri_surface[tri[hit]], w, m * G).reshape(m, G)
-        # sample points (lit fraction) and the groups' own surroundings (sky, street, facades)
-        pts, pn = _group_points(o, hs, gkey, w, hp, hn, w_g, n_g, P, lift)
-        around = _reflector_surroundings(scene, keys, pts, pn, nz, cfg)
-        gsky[sl], ggnd[sl], gopen[sl], gwall[sl] = (around[k] for k in ("sky", "gnd", "open", "wall"))
-        gw[sl], gn[sl], gp[sl], gpts[sl] = w_g, n_g, rep.reshape(m, G, 3), pts
-        st = _street(o, w_g, around, keys, cfg, scene, lift)
-        for k in street:
-            street[k][sl] = st[k]
+        # more rays where the sky view is small: reflections matter most there
+        dense = svf[sl] < _DENSE_SVF
+        for part, N in ((~dense, cfg.reflection_rays), (dense, _DENSE_RAYS * cfg.reflection_rays)):
+            idx = np.arange(sl.start, sl.stop)[part]
+            if not len(idx):
+                continue
+            m = len(idx)
+            o, nrm, keys = origin[idx], normal[idx], seg_ids[idx]
+            d = cosine_directions(nrm, N, segment_uniforms(cfg.seed, 1, keys, N + 1)).reshape(-1, 3)
+            oo = np.repeat(o, N, axis=0)
+            tri, dist = scene.first_hit(oo, d, cfg.ray_length_m)
+            hit = tri >= 0
+            seg_of = np.repeat(np.arange(m), N)
+            x = np.zeros(len(tri))
+            x[hit] = tri_albedo[tri[hit]]
+            xs = x.reshape(m, N)
+            refl_vf[idx] = xs.mean(axis=1)
+            refl_se[idx] = xs.std(axis=1, ddof=1) / np.sqrt(N) if N > 1 else 0.0
+            hit &= x > 0
+            if not hit.any():
+                continue
+            hs, hd = seg_of[hit], d[hit]
+            hn = tri_normal[tri[hit]]
+            hn = np.where(((hn * hd).sum(1) > 0)[:, None], -hn, hn)     # the face the roof sees
+            hp = oo[hit] + dist[hit, None].astype(np.float64) * hd
+            w = x[hit] / N
+            cls = _orientation_class(hn)
+            C = 10
+            key = hs * C + cls
+            cw = np.bincount(key, w, m * C).reshape(m, C)
+            cn = np.stack([np.bincount(key, w * hn[:, j], m * C) for j in range(3)], -1).reshape(m, C, 3)
+            # keep the G heaviest classes; merge every other class into the kept one nearest
+            # in orientation
+            order = np.argsort(-cw, axis=1, kind="stable")
+            kept = order[:, :G]
+            rank = np.empty_like(order)
+            np.put_along_axis(rank, order, np.arange(C)[None].repeat(m, 0), axis=1)
+            kn = np.take_along_axis(cn, kept[..., None], axis=1)           # (m, G, 3)
+            kn_u = kn / np.maximum(np.linalg.norm(kn, axis=2, keepdims=True), 1e-12)
+            cn_u = cn / np.maximum(np.linalg.norm(cn, axis=2, keepdims=True), 1e-12)
+            kw = np.take_along_axis(cw, kept, axis=1)
+            sim = np.einsum("mcj,mgj->mcg", cn_u, kn_u) - 10.0 * (kw[:, None, :] <= 0)
+            target = np.where(rank < G, rank, np.argmax(sim, axis=2))      # (m, C) -> group
+            grp = target[hs, cls]
+            gkey = hs * G + grp
+            w_g = np.bincount(gkey, w, m * G).reshape(m, G)
+            n_g = np.stack([np.bincount(gkey, w * hn[:, j], m * G) for j in range(3)], -1).reshape(m, G, 3)
+            p_g = np.stack([np.bincount(gkey, w * hp[:, j], m * G) for j in range(3)], -1).reshape(m, G, 3)
+            nz = w_g > 0
+            norm = np.linalg.norm(n_g, axis=2)
+            glen[idx] = np.where(nz, norm / np.maximum(w_g, 1e-300), 1.0)
+            n_g = np.where(nz[..., None], n_g / np.maximum(norm, 1e-12)[..., None], [0.0, 0.0, 1.0])
+            mean_p = p_g / np.maximum(w_g, 1e-300)[..., None]
+            # representative point: the group's hit point nearest its weighted mean
+            dev = np.linalg.norm(hp - mean_p.reshape(-1, 3)[gkey], axis=1)
+            srt = np.lexsort((dev, gkey))
+            first = srt[np.unique(gkey[srt], return_index=True)[1]]
+            rep = np.repeat(o[:, None], G, axis=1).reshape(-1, 3)
+            rep[gkey[first]] = hp[first]
+            # the surface holding most of each group's weight (for the export)
+            gsurf[idx] = _dominant_surface(gkey, tri_surface[tri[hit]], w, m * G).reshape(m, G)
+            # sample points (lit fraction) and the groups' own surroundings (sky, street, facades)
+            pts, pn = _group_points(o, hs, gkey, w, hp, hn, w_g, n_g, P, lift)
+            around = _reflector_surroundings(scene, keys, pts, pn, nz, cfg)
+            gsky[idx], ggnd[idx], gopen[idx], gwall[idx] = (around[k] for k in ("sky", "gnd", "open", "wall"))
+            gw[idx], gn[idx], gp[idx], gpts[idx] = w_g, n_g, rep.reshape(m, G, 3), pts
+            st = _street(o, w_g, around, keys, cfg, scene, lift)
+            for k in street:
+                street[k][idx] = st[k]
     f32 = np.float32
     out = {"segment_id": seg_ids,
            "px": origin[:, 0], "py": origin[:, 1], "pz": origin[:, 2],
@@ -421,6 +438,7 @@ def segment_geometry(scene, segments: pd.DataFrame, cfg: IrradianceCfg | None = 
         out[f"r{g}_gnd"] = ggnd[:, g].astype(f32)
         out[f"r{g}_open"] = gopen[:, g].astype(f32)
         out[f"r{g}_wall"] = gwall[:, g].astype(f32)
+        out[f"r{g}_nlen"] = glen[:, g].astype(f32)
         out[f"r{g}_surface"] = gsurf[:, g].astype(np.int32)
     if G:
         for j, c in enumerate("xyz"):
@@ -516,6 +534,7 @@ def pack_geometry(geometry: pd.DataFrame, cfg: IrradianceCfg, ground_albedo: flo
     nrm = np.zeros((s, J, 3))
     pts = np.zeros((s, J, max(P, 1), 3), np.float64)
     f_s, f_g, f_o, f_w = (np.zeros((s, G)) for _ in range(4))
+    beam_len = np.ones((s, J))
     for g in range(G):
         for j, c in enumerate("xyz"):
             nrm[:, g, j] = col(f"r{g}_n{c}")
@@ -530,6 +549,8 @@ def pack_geometry(geometry: pd.DataFrame, cfg: IrradianceCfg, ground_albedo: flo
             f_s[:, g], f_o[:, g] = (1 + nrm[:, g, 2]) / 2, (1 - nrm[:, g, 2]) / 2
         if f"r{g}_wall" in cols:
             f_w[:, g] = col(f"r{g}_wall")
+        if f"r{g}_nlen" in cols:
+            beam_len[:, g] = col(f"r{g}_nlen")
     src_sky, src_ghi = f_s, ground_albedo * f_o
     if street:
         for j, c in enumerate("xyz"):
@@ -547,7 +568,7 @@ def pack_geometry(geometry: pd.DataFrame, cfg: IrradianceCfg, ground_albedo: flo
            "n": np.ascontiguousarray(geometry[["nx", "ny", "nz"]].to_numpy(f32)),
            "svf": geometry["svf"].to_numpy(f32),
            "refl_sky": (m * src_sky).sum(1).astype(f32), "refl_ghi": (m * src_ghi).sum(1).astype(f32),
-           "wn": (m[..., None] * nrm).astype(f32), "group_p": pts.reshape(s * J, -1, 3)}
+           "wn": ((m * beam_len)[..., None] * nrm).astype(f32), "group_p": pts.reshape(s * J, -1, 3)}
     if scene is not None:
         geo["scene_origin"] = np.asarray(scene.origin, np.float64).copy()
         geo["p_local"] = scene.to_local(geo["p"])
