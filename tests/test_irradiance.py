@@ -168,7 +168,7 @@ def test_reflection_from_large_wall_matches_view_factor():
     pz = geometry[[f"r0_p{k}_z" for k in range(cfg.reflector_points)]].to_numpy()
     px = geometry[[f"r0_p{k}_x" for k in range(cfg.reflector_points)]].to_numpy()
     assert (np.diff(pz) >= 0).all() and (pz > zr).all() and (pz < zr + H).all()
-    np.testing.assert_allclose(px, D - 0.02, atol=1e-9)      # on the face, lifted 2 cm
+    np.testing.assert_allclose(px, D - 0.02, atol=1e-5)      # on the face, lifted 2 cm
     # sun in the west at 30 deg elevation lights the wall face (normal -x) at cos = 0.866
     zen, az = np.array([60.0]), np.array([270.0])
     dni, dhi = 700.0, 120.0
