@@ -14,6 +14,8 @@ import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 from matplotlib.collections import LineCollection  # noqa: E402
 
+from ..irradiance import shading_loss  # noqa: E402
+
 
 def _save(fig, run_dir: Path, name: str) -> str:
     out = run_dir / "figures"
@@ -48,8 +50,8 @@ def fig_map(smg, column: str, label: str, cmap: str):
         h_direct=("h_direct", "sum"), h_diffuse=("h_diffuse", "sum"),
         h_total_unshaded=("h_total_unshaded", "sum"), n_passes=("n_passes", "sum"),
         pv_kwh=("pv_kwh", "sum"))
-    annual["shading_loss"] = 1 - (annual["h_direct"] + annual["h_diffuse"]) / annual["h_total_unshaded"].where(
-        annual["h_total_unshaded"] > 0)
+    annual["shading_loss"] = shading_loss(annual["h_direct"], annual["h_diffuse"],
+                                          annual["h_total_unshaded"])
     annual["yield_wh_per_pass"] = 1000 * annual["pv_kwh"] / annual["n_passes"].where(annual["n_passes"] > 0)
     lines = [np.asarray(g.coords)[:, :2] for g in annual["geometry"]]
     fig, ax = plt.subplots(figsize=(7, 6))
@@ -94,7 +96,7 @@ def fig_routes(rm: pd.DataFrame):
     fig, ax = plt.subplots(1, 2, figsize=(10, 3.8))
     ax[0].bar(labels, 100 * r["pv_kwh"] / r["consumption_kwh"], color="#4285f4")
     ax[0].set_ylabel("PV share of consumption (%)")
-    ax[1].bar(labels, 100 * (1 - (r["pv_kwh_direct"] + r["pv_kwh_diffuse"]) / r["pv_kwh_unshaded"]),
+    ax[1].bar(labels, 100 * shading_loss(r["pv_kwh_direct"], r["pv_kwh_diffuse"], r["pv_kwh_unshaded"]),
               color="#db4437")
     ax[1].set_ylabel("shading loss (%)")
     for a in ax:
@@ -123,10 +125,23 @@ def write_report(run_dir: Path, summary: dict, monthly, smg, hp, rm) -> Path:
 <style>body{{font-family:sans-serif;max-width:1000px;margin:2em auto}}img{{max-width:100%}}
 td,th{{text-align:left;padding:2px 8px}}</style></head><body>
 <h1>VIPV fleet-year: {html.escape(summary['scenario'])} {summary['year']}</h1>
+<p>{html.escape(_model_note(summary))}</p>
 <table>{rows}</table>{''.join(parts)}</body></html>"""
     path = run_dir / "report.html"
     path.write_text(doc, encoding="utf-8")
     return path
+
+
+def _model_note(summary: dict) -> str:
+    """What the figures mean: the diffuse model of the run and the shading-loss definition."""
+    model = summary.get("diffuse_model", "sky_view_factor")
+    diffuse = ("diffuse light = DHI x the sky view factor of each roof point (the sky the "
+               "buildings leave open)" if model == "sky_view_factor" else
+               "diffuse light = DHI (1 + cos tilt) / 2, the paper's isotropic sky: the sky the "
+               "buildings hide is counted as open (an upper bound in streets)")
+    return (f"Diffuse model: {model}: {diffuse}. Shading loss = 1 - (direct + diffuse) / "
+            "unshaded (sun and sky the buildings take away); the light they reflect onto the "
+            "roof is reported apart (reflection gain).")
 
 
 def _fmt(v) -> str:
