@@ -14,7 +14,9 @@ casting:
   sun and CAMS radiation from :class:`vipvflow.radiation.RadiationTable`, and the run's
   components summed by the simulation's own :func:`vipvflow.irradiance.roof_components`:
   direct ``DNI max(cos AOI, 0)`` when the sun's elevation exceeds the segment's horizon
-  profile interpolated at the sun's azimuth (:mod:`vipvflow.horizon`); diffuse with the
+  profile interpolated at the sun's azimuth (:mod:`vipvflow.horizon`), the simulation's own
+  occlusion ray deciding where the profile cannot (within 1 deg of it, or at a building's
+  edge between two azimuth bins); diffuse with the
   run's model (``DHI x SVF`` or the paper's isotropic ``DHI (1 + cos tilt) / 2``); reflected
   from the stored reflectors (:func:`vipvflow.irradiance.pack_geometry`: the facade groups and
   the street, their exchange folded in), each lit in the fraction of its stored sample points
@@ -59,6 +61,11 @@ TECHNOLOGIES = {
     "a-Si": {"gamma_pdc_per_k": -0.0020, "efficiency": 0.09,
              "temperature_model": "sapm_open_rack_glass_glass"},
 }
+
+
+#: degrees: within this of the horizon profile, or where it jumps by more between two
+#: azimuth bins, the app asks the occlusion ray instead of the profile
+HORIZON_BAND_DEG = 1.0
 
 
 @dataclass(frozen=True)
@@ -140,7 +147,8 @@ def _minutes(value) -> float:
 
 
 class TripModel:
-    """A finished run, loaded once, recomputing trips for the web app (no ray casting).
+    """A finished run, loaded once, recomputing trips for the web app (a few occlusion rays
+    per trip against the run's city meshes, no view-factor rays).
 
     Parameters
     ----------
@@ -293,6 +301,39 @@ class TripModel:
             lit[pi[sel], gi[sel]] = (P - occ.reshape(-1, P).sum(1)) / np.float32(P)
         return lit
 
+    def sun_visible(self, rows, sun, elevation_deg, azimuth_deg, in_front) -> np.ndarray:
+        """Whether the sun reaches the roof point, (n,) bool: from the stored horizon profile
+        (:func:`vipvflow.horizon.sun_visible`), and where the profile cannot tell (the sun
+        within ``HORIZON_BAND_DEG`` of it, or in an azimuth bin where it jumps by more than
+        that: a building's edge) from the simulation's own occlusion ray, so the app's direct
+        light is the run's.
+
+        Parameters
+        ----------
+        rows : (n,) int, rows of the stored geometry
+        sun : (n, 3) float32, unit vectors towards the sun
+        elevation_deg, azimuth_deg : (n,) sun position (deg)
+        in_front : (n,) bool, passes with the sun up and in front of the roof (the others
+            get no direct light whatever the answer)
+        """
+        from ..horizon import horizon_at
+
+        prof = self._horizon[rows]
+        h = horizon_at(prof, azimuth_deg)
+        visible = (elevation_deg > 0) & (elevation_deg > h)
+        k = prof.shape[1]
+        j = np.floor((np.asarray(azimuth_deg) % 360.0) * k / 360.0).astype(np.int64) % k
+        r = np.arange(len(rows))
+        jump = np.abs(prof[r, j] - prof[r, (j + 1) % k]) > HORIZON_BAND_DEG
+        unsure = np.flatnonzero(in_front & ((np.abs(elevation_deg - h) < HORIZON_BAND_DEG) | jump))
+        tiles = self._tile[rows[unsure]]
+        for tile in np.unique(tiles):
+            sel = unsure[tiles == tile]
+            visible[sel] = ~self._scene(tile).occluded(self._packed["p"][rows[sel]], sun[sel],
+                                                       self.cfg.irradiance.ray_length_m)
+        self.rays_for_direct = len(unsure)
+        return visible
+
     def irradiance(self, segment_ids, t_utc) -> dict:
         """Roof irradiance components (W/m2) of segments at times, from stored factors.
 
@@ -308,7 +349,6 @@ class TripModel:
         estimate of the reflected beam for that pass), ``sun_visible`` (bool),
         ``elevation, azimuth`` (deg), ``ghi, dni, dhi`` (W/m2).
         """
-        from ..horizon import sun_visible
         from ..irradiance import isotropic_sky_view, roof_components
 
         f32 = np.float32
@@ -324,7 +364,7 @@ class TripModel:
         up = sun[:, 2] > 0
         nrm = geo["n"][rows]
         cos_aoi = np.where(up, np.maximum(np.einsum("ij,ij->i", nrm, sun), 0), 0).astype(f32)
-        visible = up & sun_visible(self._horizon[rows], elev, np.nan_to_num(rad["azimuth"]))
+        visible = self.sun_visible(rows, sun, elev, np.nan_to_num(rad["azimuth"]), up & (cos_aoi > 0))
         iso = isotropic_sky_view(nrm[:, 2])
         sky = geo["svf"][rows] if self.cfg.irradiance.diffuse_model == "sky_view_factor" else iso
         cfg = self.cfg.irradiance
@@ -450,6 +490,7 @@ class TripModel:
             "shading_loss": float(shading_loss(parts["direct"].sum(), parts["diffuse"].sum(), uns)),
             "soc_end": float(end["soc_end"].iloc[0]), "soc_end_pv": float(end["soc_end_pv"].iloc[0]),
             "soc_min": params.soc_min, "kwp": pv.peak_kw,
+            "diffuse_model": self.cfg.irradiance.diffuse_model,
             "distance_km": float(cons["distance_km"]), "duration_min": float(cons["duration_s"]) / 60.0,
         }
         departure = pd.Timestamp(origin, unit="s", tz="UTC").tz_convert(tz).tz_localize(None)
