@@ -316,131 +316,148 @@ def segment_geometry(scene, segments: pd.DataFrame, cfg: IrradianceCfg | None = 
     origin = _roof_points(segments) + cfg.ray_offset_m * normal
     G, P = cfg.max_reflector_groups, cfg.reflector_points
     svf = np.ones(n_seg, np.float64)
-    refl_vf = np.zeros(n_seg)
-    refl_se = np.zeros(n_seg)
-    gw = np.zeros((n_seg, G))
-    gn = np.tile(np.array([0.0, 0.0, 1.0]), (n_seg, G, 1)) if G else np.zeros((n_seg, 0, 3))
-    gp = np.repeat(origin[:, None], G, axis=1)
-    gpts = np.repeat(np.repeat(origin[:, None, None], G, axis=1), P, axis=2)
-    gsky = np.zeros((n_seg, G))
-    ggnd = np.zeros((n_seg, G))
-    gopen = np.zeros((n_seg, G))
-    gwall = np.zeros((n_seg, G))
-    glen = np.ones((n_seg, G))
-    gsurf = np.full((n_seg, G), -1, np.int64)
-    street = {"n": np.tile([0.0, 0.0, 1.0], (n_seg, 1)), "pts": np.repeat(origin[:, None], P, axis=1),
-              "sky": np.zeros(n_seg), "wall": np.zeros(n_seg)}
-    mesh = scene.mesh
-    tri_normal = np.asarray(mesh.normals, np.float64)
-    tri_albedo = np.asarray(mesh.albedo, np.float64)
-    tri_surface = np.asarray(mesh.surface_index, np.int64)
-    lift = max(cfg.ray_offset_m, _MIN_REFLECTOR_LIFT)
+    acc = _no_reflectors(origin, G, P)
     for a in range(0, n_seg, chunk):
         sl = slice(a, min(n_seg, a + chunk))
-        m = sl.stop - sl.start
-        o, nrm = origin[sl], normal[sl]
-        # sky view factor
-        keys = seg_ids[sl]
-        d = cosine_directions(nrm, cfg.svf_rays,
-                              segment_uniforms(cfg.seed, 0, keys, cfg.svf_rays + 1)).reshape(-1, 3)
-        oo = np.repeat(o, cfg.svf_rays, axis=0)
-        blocked = scene.occluded(oo, d, cfg.ray_length_m)
-        sky = (~blocked) & (d[:, 2] > 0)
-        svf[sl] = sky.reshape(m, cfg.svf_rays).mean(axis=1)
+        svf[sl] = _sky_view_factor(scene, origin[sl], normal[sl], seg_ids[sl], cfg)
         if not (cfg.reflection and cfg.reflection_rays > 0 and G > 0):
             continue
         # more rays where the sky view is small: reflections matter most there
         dense = svf[sl] < _DENSE_SVF
         for part, N in ((~dense, cfg.reflection_rays), (dense, _DENSE_RAYS * cfg.reflection_rays)):
             idx = np.arange(sl.start, sl.stop)[part]
-            if not len(idx):
-                continue
-            m = len(idx)
-            o, nrm, keys = origin[idx], normal[idx], seg_ids[idx]
-            d = cosine_directions(nrm, N, segment_uniforms(cfg.seed, 1, keys, N + 1)).reshape(-1, 3)
-            oo = np.repeat(o, N, axis=0)
-            tri, dist = scene.first_hit(oo, d, cfg.ray_length_m)
-            hit = tri >= 0
-            seg_of = np.repeat(np.arange(m), N)
-            x = np.zeros(len(tri))
-            x[hit] = tri_albedo[tri[hit]]
-            xs = x.reshape(m, N)
-            refl_vf[idx] = xs.mean(axis=1)
-            refl_se[idx] = xs.std(axis=1, ddof=1) / np.sqrt(N) if N > 1 else 0.0
-            hit &= x > 0
-            if not hit.any():
-                continue
-            hs, hd = seg_of[hit], d[hit]
-            hn = tri_normal[tri[hit]]
-            hn = np.where(((hn * hd).sum(1) > 0)[:, None], -hn, hn)     # the face the roof sees
-            hp = oo[hit] + dist[hit, None].astype(np.float64) * hd
-            w = x[hit] / N
-            cls = _orientation_class(hn)
-            C = 10
-            key = hs * C + cls
-            cw = np.bincount(key, w, m * C).reshape(m, C)
-            cn = np.stack([np.bincount(key, w * hn[:, j], m * C) for j in range(3)], -1).reshape(m, C, 3)
-            # keep the G heaviest classes; merge every other class into the kept one nearest
-            # in orientation
-            order = np.argsort(-cw, axis=1, kind="stable")
-            kept = order[:, :G]
-            rank = np.empty_like(order)
-            np.put_along_axis(rank, order, np.arange(C)[None].repeat(m, 0), axis=1)
-            kn = np.take_along_axis(cn, kept[..., None], axis=1)           # (m, G, 3)
-            kn_u = kn / np.maximum(np.linalg.norm(kn, axis=2, keepdims=True), 1e-12)
-            cn_u = cn / np.maximum(np.linalg.norm(cn, axis=2, keepdims=True), 1e-12)
-            kw = np.take_along_axis(cw, kept, axis=1)
-            sim = np.einsum("mcj,mgj->mcg", cn_u, kn_u) - 10.0 * (kw[:, None, :] <= 0)
-            target = np.where(rank < G, rank, np.argmax(sim, axis=2))      # (m, C) -> group
-            grp = target[hs, cls]
-            gkey = hs * G + grp
-            w_g = np.bincount(gkey, w, m * G).reshape(m, G)
-            n_g = np.stack([np.bincount(gkey, w * hn[:, j], m * G) for j in range(3)], -1).reshape(m, G, 3)
-            p_g = np.stack([np.bincount(gkey, w * hp[:, j], m * G) for j in range(3)], -1).reshape(m, G, 3)
-            nz = w_g > 0
-            norm = np.linalg.norm(n_g, axis=2)
-            glen[idx] = np.where(nz, norm / np.maximum(w_g, 1e-300), 1.0)
-            n_g = np.where(nz[..., None], n_g / np.maximum(norm, 1e-12)[..., None], [0.0, 0.0, 1.0])
-            mean_p = p_g / np.maximum(w_g, 1e-300)[..., None]
-            # representative point: the group's hit point nearest its weighted mean
-            dev = np.linalg.norm(hp - mean_p.reshape(-1, 3)[gkey], axis=1)
-            srt = np.lexsort((dev, gkey))
-            first = srt[np.unique(gkey[srt], return_index=True)[1]]
-            rep = np.repeat(o[:, None], G, axis=1).reshape(-1, 3)
-            rep[gkey[first]] = hp[first]
-            # the surface holding most of each group's weight (for the export)
-            gsurf[idx] = _dominant_surface(gkey, tri_surface[tri[hit]], w, m * G).reshape(m, G)
-            # sample points (lit fraction) and the groups' own surroundings (sky, street, facades)
-            pts, pn = _group_points(o, hs, gkey, w, hp, hn, w_g, n_g, P, lift)
-            around = _reflector_surroundings(scene, keys, pts, pn, nz, cfg)
-            gsky[idx], ggnd[idx], gopen[idx], gwall[idx] = (around[k] for k in ("sky", "gnd", "open", "wall"))
-            gw[idx], gn[idx], gp[idx], gpts[idx] = w_g, n_g, rep.reshape(m, G, 3), pts
-            st = _street(o, w_g, around, keys, cfg, scene, lift)
-            for k in street:
-                street[k][idx] = st[k]
+            if len(idx):
+                _reflectors(scene, origin[idx], normal[idx], seg_ids[idx], N, cfg, acc, idx)
+    return _geometry_frame(seg_ids, origin, tilt, azim, normal, svf, acc, G, P)
+
+
+def _no_reflectors(origin, G: int, P: int) -> dict:
+    """Per-segment reflector arrays of segments that see nothing (filled by :func:`_reflectors`)."""
+    n = len(origin)
+    return {"refl_vf": np.zeros(n), "refl_se": np.zeros(n), "w": np.zeros((n, G)),
+            "n": np.tile(np.array([0.0, 0.0, 1.0]), (n, G, 1)) if G else np.zeros((n, 0, 3)),
+            "rep": np.repeat(origin[:, None], G, axis=1),
+            "pts": np.repeat(np.repeat(origin[:, None, None], G, axis=1), P, axis=2),
+            **{k: np.zeros((n, G)) for k in ("sky", "gnd", "open", "wall")},
+            "nlen": np.ones((n, G)), "surface": np.full((n, G), -1, np.int64),
+            "street": {"n": np.tile([0.0, 0.0, 1.0], (n, 1)),
+                       "pts": np.repeat(origin[:, None], P, axis=1),
+                       "sky": np.zeros(n), "wall": np.zeros(n)}}
+
+
+def _sky_view_factor(scene, o, nrm, keys, cfg: IrradianceCfg) -> np.ndarray:
+    """Cosine-weighted sky view factor of roof points (m,): the share of ``cfg.svf_rays``
+    stratified cosine-weighted rays that escape upwards.
+
+    References
+    ----------
+    T. R. Oke (1988), Street design and urban canopy layer climate, Energy and Buildings 11,
+    103-113.
+    """
+    R = cfg.svf_rays
+    d = cosine_directions(nrm, R, segment_uniforms(cfg.seed, 0, keys, R + 1)).reshape(-1, 3)
+    blocked = scene.occluded(np.repeat(o, R, axis=0), d, cfg.ray_length_m)
+    return ((~blocked) & (d[:, 2] > 0)).reshape(len(o), R).mean(axis=1)
+
+
+def _merge_groups(hs, hn, w, m: int, G: int) -> np.ndarray:
+    """Reflector group (0..G-1) of each hit: the hits' orientation classes by weight, the G
+    heaviest kept, every other class merged into the kept one nearest in orientation."""
+    cls = _orientation_class(hn)
+    C = 10
+    key = hs * C + cls
+    cw = np.bincount(key, w, m * C).reshape(m, C)
+    cn = np.stack([np.bincount(key, w * hn[:, j], m * C) for j in range(3)], -1).reshape(m, C, 3)
+    order = np.argsort(-cw, axis=1, kind="stable")
+    kept = order[:, :G]
+    rank = np.empty_like(order)
+    np.put_along_axis(rank, order, np.arange(C)[None].repeat(m, 0), axis=1)
+    kn = np.take_along_axis(cn, kept[..., None], axis=1)           # (m, G, 3)
+    kn_u = kn / np.maximum(np.linalg.norm(kn, axis=2, keepdims=True), 1e-12)
+    cn_u = cn / np.maximum(np.linalg.norm(cn, axis=2, keepdims=True), 1e-12)
+    kw = np.take_along_axis(cw, kept, axis=1)
+    sim = np.einsum("mcj,mgj->mcg", cn_u, kn_u) - 10.0 * (kw[:, None, :] <= 0)
+    target = np.where(rank < G, rank, np.argmax(sim, axis=2))      # (m, C) -> group
+    return target[hs, cls]
+
+
+def _reflectors(scene, o, nrm, keys, N: int, cfg: IrradianceCfg, acc: dict, idx) -> None:
+    """Reflector groups of the roof points *o* (m, 3) with normals *nrm*, from *N*
+    cosine-weighted rays each; written into the rows *idx* of *acc* (see
+    :func:`segment_geometry` for what each array holds)."""
+    mesh = scene.mesh
+    G, P = cfg.max_reflector_groups, cfg.reflector_points
+    m = len(o)
+    d = cosine_directions(nrm, N, segment_uniforms(cfg.seed, 1, keys, N + 1)).reshape(-1, 3)
+    oo = np.repeat(o, N, axis=0)
+    tri, dist = scene.first_hit(oo, d, cfg.ray_length_m)
+    hit = tri >= 0
+    x = np.zeros(len(tri))
+    x[hit] = np.asarray(mesh.albedo, np.float64)[tri[hit]]
+    xs = x.reshape(m, N)
+    acc["refl_vf"][idx] = xs.mean(axis=1)
+    acc["refl_se"][idx] = xs.std(axis=1, ddof=1) / np.sqrt(N) if N > 1 else 0.0
+    hit &= x > 0
+    if not hit.any():
+        return
+    hs, hd = np.repeat(np.arange(m), N)[hit], d[hit]
+    hn = np.asarray(mesh.normals, np.float64)[tri[hit]]
+    hn = np.where(((hn * hd).sum(1) > 0)[:, None], -hn, hn)     # the face the roof sees
+    hp = oo[hit] + dist[hit, None].astype(np.float64) * hd
+    w = x[hit] / N
+    gkey = hs * G + _merge_groups(hs, hn, w, m, G)
+    w_g = np.bincount(gkey, w, m * G).reshape(m, G)
+    n_g = np.stack([np.bincount(gkey, w * hn[:, j], m * G) for j in range(3)], -1).reshape(m, G, 3)
+    p_g = np.stack([np.bincount(gkey, w * hp[:, j], m * G) for j in range(3)], -1).reshape(m, G, 3)
+    nz = w_g > 0
+    norm = np.linalg.norm(n_g, axis=2)
+    acc["nlen"][idx] = np.where(nz, norm / np.maximum(w_g, 1e-300), 1.0)
+    n_g = np.where(nz[..., None], n_g / np.maximum(norm, 1e-12)[..., None], [0.0, 0.0, 1.0])
+    mean_p = p_g / np.maximum(w_g, 1e-300)[..., None]
+    # representative point: the group's hit point nearest its weighted mean
+    dev = np.linalg.norm(hp - mean_p.reshape(-1, 3)[gkey], axis=1)
+    srt = np.lexsort((dev, gkey))
+    first = srt[np.unique(gkey[srt], return_index=True)[1]]
+    rep = np.repeat(o[:, None], G, axis=1).reshape(-1, 3)
+    rep[gkey[first]] = hp[first]
+    # the surface holding most of each group's weight (for the export)
+    acc["surface"][idx] = _dominant_surface(gkey, np.asarray(mesh.surface_index, np.int64)[tri[hit]],
+                                            w, m * G).reshape(m, G)
+    # sample points (lit fraction) and the groups' own surroundings (sky, street, facades)
+    lift = max(cfg.ray_offset_m, _MIN_REFLECTOR_LIFT)
+    pts, pn = _group_points(o, hs, gkey, w, hp, hn, w_g, n_g, P, lift)
+    around = _reflector_surroundings(scene, keys, pts, pn, nz, cfg)
+    for k in ("sky", "gnd", "open", "wall"):
+        acc[k][idx] = around[k]
+    acc["w"][idx], acc["n"][idx], acc["rep"][idx], acc["pts"][idx] = w_g, n_g, rep.reshape(m, G, 3), pts
+    st = _street(o, w_g, around, keys, cfg, scene, lift)
+    for k in acc["street"]:
+        acc["street"][k][idx] = st[k]
+
+
+def _geometry_frame(seg_ids, origin, tilt, azim, normal, svf, acc: dict, G: int, P: int) -> pd.DataFrame:
+    """The stored geometry table (plain numeric columns, see :func:`segment_geometry`)."""
     f32 = np.float32
     out = {"segment_id": seg_ids,
            "px": origin[:, 0], "py": origin[:, 1], "pz": origin[:, 2],
            "tilt_deg": tilt.astype(f32), "azimuth_deg": azim.astype(f32),
            "nx": normal[:, 0].astype(f32), "ny": normal[:, 1].astype(f32),
            "nz": normal[:, 2].astype(f32), "svf": svf.astype(f32),
-           "refl_vf": refl_vf.astype(f32), "refl_vf_se": refl_se.astype(f32)}
+           "refl_vf": acc["refl_vf"].astype(f32), "refl_vf_se": acc["refl_se"].astype(f32)}
     for g in range(G):
-        out[f"r{g}_w"] = gw[:, g].astype(f32)
+        out[f"r{g}_w"] = acc["w"][:, g].astype(f32)
         for j, c in enumerate("xyz"):
-            out[f"r{g}_n{c}"] = gn[:, g, j].astype(f32)
+            out[f"r{g}_n{c}"] = acc["n"][:, g, j].astype(f32)
         for j, c in enumerate("xyz"):
-            out[f"r{g}_{c}"] = gp[:, g, j]
+            out[f"r{g}_{c}"] = acc["rep"][:, g, j]
         for k in range(P):
             for j, c in enumerate("xyz"):
-                out[f"r{g}_p{k}_{c}"] = gpts[:, g, k, j]
-        out[f"r{g}_sky"] = gsky[:, g].astype(f32)
-        out[f"r{g}_gnd"] = ggnd[:, g].astype(f32)
-        out[f"r{g}_open"] = gopen[:, g].astype(f32)
-        out[f"r{g}_wall"] = gwall[:, g].astype(f32)
-        out[f"r{g}_nlen"] = glen[:, g].astype(f32)
-        out[f"r{g}_surface"] = gsurf[:, g].astype(np.int32)
+                out[f"r{g}_p{k}_{c}"] = acc["pts"][:, g, k, j]
+        for k in ("sky", "gnd", "open", "wall", "nlen"):
+            out[f"r{g}_{k}"] = acc[k][:, g].astype(f32)
+        out[f"r{g}_surface"] = acc["surface"][:, g].astype(np.int32)
     if G:
+        street = acc["street"]
         for j, c in enumerate("xyz"):
             out[f"st_n{c}"] = street["n"][:, j].astype(f32)
         for k in range(P):
