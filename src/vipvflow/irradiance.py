@@ -644,7 +644,9 @@ def roof_components(dni_wm2, dhi_wm2, ghi_wm2, cos_aoi, sun_visible, sky_view,
     reflector_beam : (n, J) per reflector ``j``: its weight at the roof (albedo x view factor,
         inter-reflections folded in, see :func:`pack_geometry`) x the cosine of the sun on it,
         clipped at 0; dimensionless
-    reflector_lit : (n, J) sunlit fraction of each reflector's sample points (0..1)
+    reflector_lit : (n, J) sunlit fraction of each reflector's sample points (0..1); a
+        caller that has already summed ``weight x cos x lit`` over its reflectors (the
+        kernel, from sparse pairs) passes that sum as one column with ``lit = 1``
     reflector_sky, reflector_ghi : (n,) the reflectors' weight of DHI (their own sky views)
         and of GHI (open ground beyond the city model, lit as an open field); dimensionless
     isotropic_view : (n,) ``(1 + cos tilt) / 2`` (:func:`isotropic_sky_view`), for the
@@ -686,6 +688,30 @@ def shading_loss(direct, diffuse, unshaded):
     with np.errstate(divide="ignore", invalid="ignore"):
         out = np.where(u > 0, 1.0 - np.asarray(shaded, np.float64) / np.where(u > 0, u, 1.0), np.nan)
     return out[()] if out.ndim == 0 else out
+
+
+#: reflectors weighing less than this at the roof (weight x cos of the sun on them) are
+#: traced in ``rotate`` sampling with probability weight / this, and then count this much
+#: (Russian roulette: unbiased, fewer rays for the faint ones)
+ROULETTE_WEIGHT = 0.02
+
+
+def _roulette(pi, gi, weight, key):
+    """Which (pass, reflector) pairs cast their ray, and the beam weight each then carries.
+
+    Pairs of weight >= :data:`ROULETTE_WEIGHT` always do, with their weight; fainter ones
+    with probability ``weight / ROULETTE_WEIGHT`` (a uniform from the pass's sample key and
+    the reflector, independent of the sample point taken in turn) and carry
+    ``ROULETTE_WEIGHT``: the expected beam is unchanged.
+    """
+    small = np.flatnonzero(weight < ROULETTE_WEIGHT)
+    if not len(small):
+        return pi, gi, weight
+    k = (key[pi[small]] >> 4) * 0x2545F491 + gi[small] * 0x9E3779B1
+    u = ((k ^ (k >> 29)) & 0xFFFFFF).astype(np.float32) * np.float32(1.0 / (1 << 24))
+    keep = np.ones(len(pi), bool)
+    keep[small] = u * np.float32(ROULETTE_WEIGHT) < weight[small]
+    return pi[keep], gi[keep], np.maximum(weight[keep], np.float32(ROULETTE_WEIGHT))
 
 
 def roof_irradiance(geometry, rows, sun: np.ndarray, rad: dict, scene, cfg: IrradianceCfg,
@@ -750,11 +776,15 @@ def roof_irradiance(geometry, rows, sun: np.ndarray, rad: dict, scene, cfg: Irra
     else:
         pi = gi = np.zeros(0, np.int64)
     rotate = cfg.reflector_sampling == "rotate" and P > 1
+    if rotate:
+        base = np.arange(n, dtype=np.int64) if sample is None else np.asarray(sample, np.int64)
+        pi, gi, beam_w = _roulette(pi, gi, wc[pi, gi] if len(pi) else np.zeros(0, f32), base[lit])
+    elif len(pi):
+        beam_w = wc[pi, gi]
     per_pair = 1 if rotate else P
     nr = nd + per_pair * len(pi)
     visible = np.zeros(n, bool)
-    reflector_beam = np.zeros((n, G), f32)
-    reflector_lit = np.zeros((n, G), f32)
+    beam_sum = np.zeros(n, f32)           # sum over reflectors of weight x cos x lit
     if nr:
         o = np.empty((nr, 3), f32 if local else np.float64)
         d = np.empty((nr, 3), f32)
@@ -763,7 +793,6 @@ def roof_irradiance(geometry, rows, sun: np.ndarray, rad: dict, scene, cfg: Irra
         if len(pi):
             pair = rows_lit[pi] * G + gi
             if rotate:
-                base = np.arange(n, dtype=np.int64) if sample is None else np.asarray(sample, np.int64)
                 k = (base[lit][pi] + gi) % P
                 o[nd:] = gp[pair, k]
                 np.take(sl, pi, axis=0, out=d[nd:])
@@ -784,17 +813,16 @@ def roof_irradiance(geometry, rows, sun: np.ndarray, rad: dict, scene, cfg: Irra
                 share = (~occ[nd:]).astype(f32)
             else:
                 share = (P - occ[nd:].reshape(-1, P).sum(1, dtype=np.int32)) * f32(1.0 / P)
-            reflector_beam[lit[pi], gi] = wc[pi, gi]
-            reflector_lit[lit[pi], gi] = share
+            beam_sum[lit] = np.bincount(pi, beam_w * share, len(lit))
     iso = isotropic_sky_view(nrm[:, 2])
     sky = geo["svf"][rows] if cfg.diffuse_model == "sky_view_factor" else iso
-    zero = np.zeros(n, f32)
+    zero, one = np.zeros(n, f32), np.ones(n, f32)
     r_sky, r_ghi = (geo["refl_sky"][rows], geo["refl_ghi"][rows]) if G else (zero, zero)
     out = {}
     for sfx, (b, dh, gh) in (("", (dni, dhi, ghi)), ("_clear", (dnic, dhic, ghic))):
         (out["direct" + sfx], out["diffuse" + sfx], out["reflected" + sfx],
-         unshaded) = roof_components(b, dh, gh, cos_aoi, visible, sky, reflector_beam,
-                                     reflector_lit, r_sky, r_ghi, iso)
+         unshaded) = roof_components(b, dh, gh, cos_aoi, visible, sky, beam_sum[:, None],
+                                     one[:, None], r_sky, r_ghi, iso)
         out["total" + sfx] = out["direct" + sfx] + out["diffuse" + sfx] + out["reflected" + sfx]
         out[f"total{sfx}_unshaded"] = unshaded
     out["sun_visible"] = visible

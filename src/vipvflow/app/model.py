@@ -349,7 +349,7 @@ class TripModel:
         estimate of the reflected beam for that pass), ``sun_visible`` (bool),
         ``elevation, azimuth`` (deg), ``ghi, dni, dhi`` (W/m2).
         """
-        from ..irradiance import isotropic_sky_view, roof_components
+        from ..irradiance import ROULETTE_WEIGHT, isotropic_sky_view, roof_components
 
         f32 = np.float32
         rows = self._row[np.asarray(segment_ids, np.int64)]
@@ -379,7 +379,11 @@ class TripModel:
         lit = self.reflector_lit(rows, sun, beam > 0)
         direct, diffuse, reflected, unshaded = roof_components(
             dni, dhi, ghi, cos_aoi, visible, sky, beam, lit, r_sky, r_ghi, iso)
-        sd = dni * np.sqrt((beam ** 2 * lit * (1 - lit)).sum(1)) if J else np.zeros(len(rows), f32)
+        # the run's estimate of a reflector's beam, per pass: one sample point (0 or 1),
+        # faint reflectors traced only now and then at a larger weight (irradiance._roulette):
+        # variance b max(b, ROULETTE_WEIGHT) L - b^2 L^2 each
+        var = beam * np.maximum(beam, ROULETTE_WEIGHT) * lit - (beam * lit) ** 2
+        sd = dni * np.sqrt(np.maximum(var, 0).sum(1)) if J else np.zeros(len(rows), f32)
         return {"direct": direct, "diffuse": diffuse, "reflected": reflected,
                 "total": direct + diffuse + reflected, "unshaded": unshaded, "reflected_sd": sd,
                 "sun_visible": visible, "elevation": elev, "azimuth": rad["azimuth"],
