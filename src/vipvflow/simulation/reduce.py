@@ -7,6 +7,7 @@ and day; and the fleet-year summary with coverage, avoided charging cycles and p
 from __future__ import annotations
 
 import logging
+import re
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
@@ -143,7 +144,9 @@ def reduce_run(cfg: Config, year: int, run_dir: Path, say=print) -> dict:
     geo = _part_table(run_dir, "geometry", "tile=*.parquet")
     if geo is not None:
         geo = geo.to_pandas()
-        keep = [c for c in geo.columns if c == "segment_id" or geo[c].dtype.kind in "fiub"]
+        # the factors, not the reflectors' sample points (the app reads those from parts/)
+        keep = [c for c in geo.columns if c == "segment_id" or (
+            geo[c].dtype.kind in "fiub" and not re.search(r"_p\d+_[xyz]$", c))]
         segments = segments.merge(geo[keep], on="segment_id", how="left")
     write_parquet(segments, run_dir / "segments.parquet")
 
