@@ -309,6 +309,13 @@ def segment_geometry(scene, segments: pd.DataFrame, cfg: IrradianceCfg | None = 
         (sample points), ``st_sky`` (its sky view), ``st_wall`` (albedo-weighted view of
         facades).  Points are lifted off their
         surface by ``max(ray_offset_m, 0.02 m)``.  Unused groups have weight 0.
+
+    References
+    ----------
+    T. R. Oke (1988), Street design and urban canopy layer climate, Energy and Buildings 11,
+    103-113 (sky view factor).  Cosine-weighted hemisphere sampling by Malley's method
+    (concentric disk projected to the hemisphere): M. Pharr, W. Jakob, G. Humphreys,
+    Physically Based Rendering, 3rd ed., section 13.6.3.
     """
     cfg = cfg or IrradianceCfg()
     n_seg = len(segments)
@@ -541,6 +548,11 @@ def pack_geometry(geometry: pd.DataFrame, cfg: IrradianceCfg, ground_albedo: flo
     With *scene*, the ray origins are also stored in that scene's float32 frame
     (:meth:`vipvflow.shading.Scene.to_local`), so the hot path builds its rays without
     converting them per pass.
+
+    References
+    ----------
+    C. M. Goral, K. E. Torrance, D. P. Greenberg, B. Battaile (1984), Modeling the
+    interaction of light between diffuse surfaces, SIGGRAPH 84 (the radiosity equation).
     """
     f32 = np.float32
     cols = set(geometry.columns)
