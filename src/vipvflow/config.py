@@ -91,7 +91,7 @@ class IrradianceCfg(_Model):
     max_reflector_groups: int = Field(4, ge=0)
     reflector_points: int = Field(16, ge=1)
     reflector_sampling: Literal["rotate", "all"] = "rotate"
-    reflector_sky_rays: int = Field(32, ge=1)
+    reflector_sky_rays: int = Field(16, ge=1)
     seed: int = 7
 
 
