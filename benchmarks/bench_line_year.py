@@ -8,7 +8,7 @@ Figures: wall time of the run (cluster start, per-tile geometry, 12 months x til
 partitions, reduce, report, manifest), segment passes and passes per second, peak RSS of
 the whole process tree (this process + nanny + workers), BVH builds, and where the
 workers' time goes: the per-partition timings of the manifest, with the irradiance time
-split by :func:`vipvflow.irradiance.stage_seconds` (radiation lookup, ray setup, Embree
+split by the ``timings`` of :func:`vipvflow.irradiance.evaluate_passes` (radiation lookup, ray setup, Embree
 rays, component arithmetic incl. reflection, packing) next to pass generation, the
 per-trip/segment/hour aggregation and the writing of the partition files.
 

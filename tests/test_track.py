@@ -56,5 +56,10 @@ def test_track_command(tmp_path, test_data, capsys):
     minute = ((t - pd.Timestamp("2020-06-01 12:00", tz="UTC")).total_seconds() // 60).astype(int)
     ghi = raw[2].to_numpy()[minute] * 60
     np.testing.assert_allclose(res["total_unshaded"][open_], ghi[open_], rtol=0.01)
-    np.testing.assert_allclose((res["direct"] + res["diffuse"])[open_], ghi[open_], rtol=0.01)
+    # direct + diffuse there: GHI less the sky the canyon's 40 m end walls hide (sky view
+    # factor diffuse, the default): at most a few percent near the canyon's mouth, none far off
+    dd = (res["direct"] + res["diffuse"]).to_numpy()
+    assert (dd[open_] <= ghi[open_] * 1.001).all() and (dd[open_] >= 0.97 * ghi[open_]).all()
+    far = (x < X0 + 40) | (x > X0 + 360)
+    np.testing.assert_allclose(dd[far], ghi[far], rtol=0.01)
     assert (res["total"][inside] < 0.5 * res["total_unshaded"][inside]).all()

@@ -106,16 +106,18 @@ class TrajectoryCfg(_Model):
 
 
 class IrradianceCfg(_Model):
-    diffuse_model: Literal["isotropic", "sky_view_factor"] = "isotropic"
+    # sky_view_factor: DHI x the roof point's cosine-weighted sky view (the default);
+    # isotropic: the paper's DHI (1 + cos tilt) / 2, an upper bound in streets
+    diffuse_model: Literal["isotropic", "sky_view_factor"] = "sky_view_factor"
     reflection: bool = True
-    reflection_rays: int = Field(64, ge=0, le=65_536)
-    svf_rays: int = Field(128, gt=0, le=65_536)
+    reflection_rays: int = Field(256, ge=0, le=65_536)
+    svf_rays: int = Field(512, gt=0, le=65_536)
     ray_length_m: float = Field(300.0, gt=0, le=100_000)
     ray_offset_m: float = Field(0.05, ge=0)
-    max_reflector_groups: int = Field(3, ge=0)
-    reflector_points: int = Field(4, ge=1)
+    max_reflector_groups: int = Field(4, ge=0)
+    reflector_points: int = Field(16, ge=1)
     reflector_sampling: Literal["rotate", "all"] = "rotate"
-    reflector_sky_rays: int = Field(32, ge=1)
+    reflector_sky_rays: int = Field(16, ge=1)
     seed: int = 7
 
 

@@ -9,13 +9,23 @@ losses and the PVWatts inverter (``pvlib.inverter.pvwatts``).
 from __future__ import annotations
 
 import numpy as np
-import pvlib
 
 from .config import PVSystem
 
 
+def paper_kw_per_wm2(kwp, performance_ratio=0.75):
+    """Output of the paper's model per unit of plane-of-array irradiance:
+    ``kWp x PR / 1000 W/m2`` (kW per W/m2, or kWh per Wh/m2 of irradiation).
+
+    References
+    ----------
+    Paper section 3.3; IEC 61724-1 (performance ratio).
+    """
+    return kwp * performance_ratio / 1000.0
+
+
 def energy_paper(poa_wm2, dt_s, kwp, performance_ratio=0.75):
-    """Energy with a constant performance ratio.
+    """Energy with a constant performance ratio, ``kWp x POA / 1000 x PR x dt``.
 
     Parameters
     ----------
@@ -28,7 +38,7 @@ def energy_paper(poa_wm2, dt_s, kwp, performance_ratio=0.75):
     -------
     array, kWh
     """
-    return (kwp * np.asarray(poa_wm2, np.float64) / 1000.0 * performance_ratio
+    return (paper_kw_per_wm2(kwp, performance_ratio) * np.asarray(poa_wm2, np.float64)
             * np.asarray(dt_s, np.float64) / 3600.0)
 
 
@@ -37,6 +47,8 @@ def cell_temperature(poa_wm2, temp_air_c, wind_mps, model: str = "sapm_open_rack
 
     ``model`` is ``sapm_<mounting>`` (a key of pvlib's SAPM parameter table) or ``faiman``.
     """
+    import pvlib  # here and below imported where used: paper mode never needs it
+
     if model == "faiman":
         return pvlib.temperature.faiman(poa_wm2, temp_air_c, wind_mps)
     if model.startswith("sapm_"):
@@ -64,6 +76,8 @@ def power_pvlib(poa_wm2, system: PVSystem, temp_air_c=15.0, vehicle_speed_mps=0.
     -------
     p_ac_w, temp_cell_c : arrays
     """
+    import pvlib
+
     poa = np.asarray(poa_wm2, np.float64)
     wind = np.abs(np.asarray(vehicle_speed_mps, np.float64)) + np.abs(np.asarray(wind_mps, np.float64))
     tcell = np.asarray(cell_temperature(poa, temp_air_c, wind, system.temperature_model), np.float64)
@@ -81,10 +95,35 @@ def energy_pvlib(poa_wm2, dt_s, system: PVSystem, temp_air_c=15.0, vehicle_speed
     return pac * np.asarray(dt_s, np.float64) / 3.6e6
 
 
-def energy(poa_wm2, dt_s, system: PVSystem, mode: str = "paper", **kwargs):
-    """kWh in the configured mode (``'paper'`` or ``'pvlib'``; kwargs go to pvlib mode)."""
+def energy(poa_wm2, dt_s, system: PVSystem, mode: str = "paper", temp_air_c=15.0,
+           vehicle_speed_mps=0.0, wind_mps=0.0):
+    """PV energy (kWh) in the configured mode: the one dispatcher of the simulation and the
+    web app.
+
+    Parameters
+    ----------
+    poa_wm2 : array, plane-of-array irradiance (W/m2)
+    dt_s : array, time at that irradiance (s)
+    system : PVSystem
+    mode : ``'paper'`` (``kWp x POA / 1000 x PR x dt``, :func:`energy_paper`) or
+        ``'pvlib'`` (PVWatts at a cell temperature cooled by the bus's speed plus the
+        ambient wind, :func:`energy_pvlib`)
+    temp_air_c : array or float, ambient temperature (degC; pvlib mode)
+    vehicle_speed_mps, wind_mps : array or float, the bus's speed and the ambient wind
+        (m/s; pvlib mode)
+
+    Returns
+    -------
+    array, kWh
+
+    References
+    ----------
+    Paper section 3.3; pvlib ``pvsystem.pvwatts_dc``, ``temperature.sapm_cell``,
+    ``inverter.pvwatts``.
+    """
     if mode == "paper":
         return energy_paper(poa_wm2, dt_s, system.kwp, system.performance_ratio)
     if mode == "pvlib":
-        return energy_pvlib(poa_wm2, dt_s, system, **kwargs)
+        return energy_pvlib(poa_wm2, dt_s, system, temp_air_c=temp_air_c,
+                            vehicle_speed_mps=vehicle_speed_mps, wind_mps=wind_mps)
     raise ValueError(f"unknown PV mode {mode!r}")

@@ -132,8 +132,9 @@ def numbers_html(res, fleet: dict | None = None) -> str:
         f'{share:.{DECIMALS["share_percent"]}f}</span> %</td>'
         f'<td>SoC at the end {100 * n["soc_end"]:.1f} % without PV, {100 * n["soc_end_pv"]:.1f} % with</td></tr>'
         f'</table>{fleet_html}'
-        f'<div class="compute">recomputed in {1000 * n["compute_s"]:.0f} ms, no ray casting '
-        f'(stored horizons and geometry factors)</div></div>')
+        f'<div class="compute">recomputed in {1000 * n["compute_s"]:.0f} ms with the run\'s physics '
+        f'(diffuse model {n.get("diffuse_model", "")}; stored horizons and geometry factors, '
+        f'occlusion rays for the reflectors)</div></div>')
 
 
 def build_document(model: TripModel, doc) -> None:

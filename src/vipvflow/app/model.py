@@ -11,17 +11,22 @@ casting:
   requested time on the chosen date (the last one of the day when none leaves later; a
   trip of another service day, placed on the date, when the route does not run that day);
 * per segment, at the middle of the time the bus spends on it (as the simulation does):
-  sun and CAMS radiation from :class:`vipvflow.radiation.RadiationTable`;
+  sun and CAMS radiation from :class:`vipvflow.radiation.RadiationTable`, and the run's
+  components summed by the simulation's own :func:`vipvflow.irradiance.roof_components`:
   direct ``DNI max(cos AOI, 0)`` when the sun's elevation exceeds the segment's horizon
-  profile interpolated at the sun's azimuth (:mod:`vipvflow.horizon`); diffuse isotropic
-  ``DHI (1 + cos tilt) / 2`` or ``DHI x SVF`` as configured for the run; reflected from the
-  stored reflector groups (:func:`vipvflow.irradiance.pack_geometry`):
-  ``DHI sum w F_s + GHI sum w F_g + DNI sum max(s . w n, 0)`` — the beam part takes every
-  reflector group facing the sun as sunlit (the simulation casts a ray per sample point
-  instead, so the app's reflected light is an upper bound of the run's);
-  the unshaded reference ``DNI max(cos AOI, 0) + DHI (1 + cos tilt) / 2``;
-* PV: paper mode ``kWp x POA / 1000 x PR x dt / 3600`` or pvlib mode (PVWatts at a SAPM
-  cell temperature cooled by the bus's speed, :func:`vipvflow.pv.energy_pvlib`);
+  profile interpolated at the sun's azimuth (:mod:`vipvflow.horizon`), the simulation's own
+  occlusion ray deciding where the profile cannot (within 1 deg of it, or at a building's
+  edge between two azimuth bins); diffuse with the
+  run's model (``DHI x SVF`` or the paper's isotropic ``DHI (1 + cos tilt) / 2``); reflected
+  from the stored reflectors (:func:`vipvflow.irradiance.pack_geometry`: the facade groups and
+  the street, their exchange folded in), each lit in the fraction of its stored sample points
+  that see the sun: one occlusion query per trip against the tile meshes of the run's data
+  directory (about 1e5 rays, milliseconds), the expectation of the simulation's one point
+  per pass, whose per-pass standard deviation is given as ``reflected_sd``; the unshaded
+  reference ``DNI max(cos AOI, 0) + DHI (1 + cos tilt) / 2``;
+* PV: the simulation's dispatcher :func:`vipvflow.pv.energy` (paper mode ``kWp x POA / 1000
+  x PR x dt / 3600`` or pvlib mode, PVWatts at a SAPM cell temperature cooled by the bus's
+  speed);
 * consumption: the pattern's 2 s driving cycle (:func:`vipvflow.trajectory.pattern_cycle`)
   through :func:`vipvflow.vehicle.simulate_cycle` with the chosen auxiliary base load
   (HVAC at the month's mean temperature on top), and the state of charge over the trip
@@ -31,7 +36,7 @@ from __future__ import annotations
 
 import json
 import time
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from functools import lru_cache
 from pathlib import Path
 
@@ -39,6 +44,7 @@ import numpy as np
 import pandas as pd
 
 from ..config import Config, PVSystem
+from ..irradiance import shading_loss
 
 #: PV technologies offered: PVWatts temperature coefficient of power (1/K, typical datasheet
 #: values), module efficiency at STC (for sizing by area) and the pvlib SAPM mounting of the
@@ -55,6 +61,11 @@ TECHNOLOGIES = {
     "a-Si": {"gamma_pdc_per_k": -0.0020, "efficiency": 0.09,
              "temperature_model": "sapm_open_rack_glass_glass"},
 }
+
+
+#: degrees: within this of the horizon profile, or where it jumps by more between two
+#: azimuth bins, the app asks the occlusion ray instead of the profile
+HORIZON_BAND_DEG = 1.0
 
 
 @dataclass(frozen=True)
@@ -94,7 +105,9 @@ class PVChoice:
         """kW per kW/m2 of POA, for rescaling stored energies (paper: kWp x PR; pvlib:
         kWp x (1 - losses) x inverter efficiency, temperature effects not rescaled)."""
         if self.mode == "paper":
-            return self.peak_kw * self.performance_ratio
+            from ..pv import paper_kw_per_wm2
+
+            return 1000.0 * paper_kw_per_wm2(self.peak_kw, self.performance_ratio)
         return self.peak_kw * (1 - self.losses_percent / 100.0) * self.inverter_efficiency
 
 
@@ -134,7 +147,8 @@ def _minutes(value) -> float:
 
 
 class TripModel:
-    """A finished run, loaded once, recomputing trips for the web app (no ray casting).
+    """A finished run, loaded once, recomputing trips for the web app (a few occlusion rays
+    per trip against the run's city meshes, no view-factor rays).
 
     Parameters
     ----------
@@ -186,6 +200,7 @@ class TripModel:
         self._horizon = geo[horizon_columns(sum(c.startswith("h") and c[1:].isdigit()
                                                 for c in hor.columns))].to_numpy(np.float32)
         self._loc = geo["rad_location"].to_numpy(np.int64) if "rad_location" in geo else None
+        self._tile = geo["tile"].astype(str).to_numpy()
         self.radiation = RadiationTable.load(self.data_dir, self.year)
 
         # timetable
@@ -251,6 +266,74 @@ class TripModel:
 
         return float(service_day_origin_utc([pd.Timestamp(date)], self.timezone)[0])
 
+    def _scene(self, tile: str):
+        from ..shading import get_scene
+
+        return get_scene(self.data_dir, tile, cache_size=64)
+
+    def reflector_lit(self, rows, sun, facing) -> np.ndarray:
+        """Sunlit fraction (0..1) of each stored reflector's sample points, (n, J).
+
+        Parameters
+        ----------
+        rows : (n,) int, rows of the stored geometry
+        sun : (n, 3) float32, unit vectors towards the sun
+        facing : (n, J) bool, reflectors facing the sun (the others stay 0)
+
+        One occlusion ray per sample point, from the same origins as the simulation's
+        (``reflector_sampling: all``): the mean of its one-point-per-pass estimate.
+        """
+        geo = self._packed
+        J = geo["wn"].shape[1]
+        gp = geo["group_p"]
+        P = gp.shape[1]
+        lit = np.zeros(facing.shape, np.float32)
+        pi, gi = np.nonzero(facing)
+        if not len(pi):
+            return lit
+        pair = rows[pi] * J + gi
+        tiles = self._tile[rows[pi]]
+        for tile in np.unique(tiles):
+            sel = np.flatnonzero(tiles == tile)
+            o = gp[pair[sel]].reshape(-1, 3)
+            d = np.repeat(sun[pi[sel]], P, axis=0)
+            occ = self._scene(tile).occluded(o, d, self.cfg.irradiance.ray_length_m)
+            lit[pi[sel], gi[sel]] = (P - occ.reshape(-1, P).sum(1)) / np.float32(P)
+        return lit
+
+    def sun_visible(self, rows, sun, elevation_deg, azimuth_deg, in_front) -> np.ndarray:
+        """Whether the sun reaches the roof point, (n,) bool: from the stored horizon profile
+        (:func:`vipvflow.horizon.sun_visible`), and where the profile cannot tell (the sun
+        within ``HORIZON_BAND_DEG`` of it, or in an azimuth bin where it jumps by more than
+        that: a building's edge) from the simulation's own occlusion ray, so the app's direct
+        light is the run's.
+
+        Parameters
+        ----------
+        rows : (n,) int, rows of the stored geometry
+        sun : (n, 3) float32, unit vectors towards the sun
+        elevation_deg, azimuth_deg : (n,) sun position (deg)
+        in_front : (n,) bool, passes with the sun up and in front of the roof (the others
+            get no direct light whatever the answer)
+        """
+        from ..horizon import horizon_at
+
+        prof = self._horizon[rows]
+        h = horizon_at(prof, azimuth_deg)
+        visible = (elevation_deg > 0) & (elevation_deg > h)
+        k = prof.shape[1]
+        j = np.floor((np.asarray(azimuth_deg) % 360.0) * k / 360.0).astype(np.int64) % k
+        r = np.arange(len(rows))
+        jump = np.abs(prof[r, j] - prof[r, (j + 1) % k]) > HORIZON_BAND_DEG
+        unsure = np.flatnonzero(in_front & ((np.abs(elevation_deg - h) < HORIZON_BAND_DEG) | jump))
+        tiles = self._tile[rows[unsure]]
+        for tile in np.unique(tiles):
+            sel = unsure[tiles == tile]
+            visible[sel] = ~self._scene(tile).occluded(self._packed["p"][rows[sel]], sun[sel],
+                                                       self.cfg.irradiance.ray_length_m)
+        self.rays_for_direct = len(unsure)
+        return visible
+
     def irradiance(self, segment_ids, t_utc) -> dict:
         """Roof irradiance components (W/m2) of segments at times, from stored factors.
 
@@ -262,47 +345,58 @@ class TripModel:
         Returns
         -------
         dict of (n,) arrays: ``direct, diffuse, reflected, total, unshaded`` (W/m2),
-        ``sun_visible`` (bool), ``elevation, azimuth`` (deg), ``ghi, dni, dhi`` (W/m2).
+        ``reflected_sd`` (W/m2: standard deviation of the simulation's one-sample-point
+        estimate of the reflected beam for that pass), ``sun_visible`` (bool),
+        ``elevation, azimuth`` (deg), ``ghi, dni, dhi`` (W/m2).
         """
-        from ..horizon import sun_visible
+        from ..irradiance import ROULETTE_WEIGHT, isotropic_sky_view, roof_components
 
+        f32 = np.float32
         rows = self._row[np.asarray(segment_ids, np.int64)]
         if (rows < 0).any():
             raise KeyError("segments without stored geometry")
         loc = None if self._loc is None else self._loc[rows]
         rad = self.radiation.lookup(np.asarray(t_utc, np.float64), location=loc, angles=True)
         geo = self._packed
-        dni, dhi, ghi = (np.nan_to_num(rad[c]).astype(np.float64) for c in ("dni", "dhi", "ghi"))
-        sun = np.stack([rad["sun_x"], rad["sun_y"], rad["sun_z"]], 1).astype(np.float64)
-        sun = np.nan_to_num(sun)
+        dni, dhi, ghi = (np.nan_to_num(np.asarray(rad[c], f32)) for c in ("dni", "dhi", "ghi"))
+        sun = np.nan_to_num(np.stack([rad["sun_x"], rad["sun_y"], rad["sun_z"]], 1).astype(f32))
         elev = 90.0 - np.nan_to_num(rad["zenith"], nan=180.0).astype(np.float64)
-        nrm = geo["n"][rows].astype(np.float64)
-        cos_aoi = np.where(elev > 0, np.maximum((nrm * sun).sum(1), 0.0), 0.0)
-        visible = sun_visible(self._horizon[rows], elev, np.nan_to_num(rad["azimuth"]))
-        iso = (1.0 + nrm[:, 2]) / 2.0
-        sky = (geo["svf"][rows].astype(np.float64)
-               if self.cfg.irradiance.diffuse_model == "sky_view_factor" else iso)
-        direct = dni * cos_aoi * visible
-        diffuse = dhi * sky
-        reflected = np.zeros(len(rows))
-        if self.cfg.irradiance.reflection and geo["wn"].shape[1]:
-            facing = np.maximum(np.einsum("igj,ij->ig", geo["wn"][rows].astype(np.float64), sun), 0.0)
-            reflected = (dhi * geo["refl_sky"][rows] + ghi * geo["refl_gnd"][rows]
-                         + np.where(elev > 0, dni * facing.sum(1), 0.0))
+        up = sun[:, 2] > 0
+        nrm = geo["n"][rows]
+        cos_aoi = np.where(up, np.maximum(np.einsum("ij,ij->i", nrm, sun), 0), 0).astype(f32)
+        visible = self.sun_visible(rows, sun, elev, np.nan_to_num(rad["azimuth"]), up & (cos_aoi > 0))
+        iso = isotropic_sky_view(nrm[:, 2])
+        sky = geo["svf"][rows] if self.cfg.irradiance.diffuse_model == "sky_view_factor" else iso
+        cfg = self.cfg.irradiance
+        J = geo["wn"].shape[1] if (cfg.reflection and cfg.max_reflector_groups) else 0
+        beam = np.zeros((len(rows), J), f32)
+        if J:
+            beam[up] = np.einsum("igj,ij->ig", geo["wn"][rows[up]], sun[up])
+            beam = np.maximum(beam, 0)
+            r_sky, r_ghi = geo["refl_sky"][rows], geo["refl_ghi"][rows]
+        else:
+            r_sky = r_ghi = np.zeros(len(rows), f32)
+        lit = self.reflector_lit(rows, sun, beam > 0)
+        direct, diffuse, reflected, unshaded = roof_components(
+            dni, dhi, ghi, cos_aoi, visible, sky, beam, lit, r_sky, r_ghi, iso)
+        # the run's estimate of a reflector's beam, per pass: one sample point (0 or 1),
+        # faint reflectors traced only now and then at a larger weight (irradiance._roulette):
+        # variance b max(b, ROULETTE_WEIGHT) L - b^2 L^2 each
+        var = beam * np.maximum(beam, ROULETTE_WEIGHT) * lit - (beam * lit) ** 2
+        sd = dni * np.sqrt(np.maximum(var, 0).sum(1)) if J else np.zeros(len(rows), f32)
         return {"direct": direct, "diffuse": diffuse, "reflected": reflected,
-                "total": direct + diffuse + reflected, "unshaded": dni * cos_aoi + dhi * iso,
+                "total": direct + diffuse + reflected, "unshaded": unshaded, "reflected_sd": sd,
                 "sun_visible": visible, "elevation": elev, "azimuth": rad["azimuth"],
                 "ghi": ghi, "dni": dni, "dhi": dhi}
 
     def pv_energy(self, poa, dt_s, speed_mps, month: int, pv: PVChoice) -> np.ndarray:
-        """PV energy (kWh) of each pass at POA irradiance *poa* (W/m2) for *dt_s* (s)."""
+        """PV energy (kWh) of each pass at POA irradiance *poa* (W/m2) for *dt_s* (s), with
+        the simulation's dispatcher :func:`vipvflow.pv.energy`."""
         from .. import pv as pvmod
 
-        if pv.mode == "paper":
-            return pvmod.energy_paper(poa, dt_s, pv.peak_kw, pv.performance_ratio)
-        return pvmod.energy_pvlib(poa, dt_s, pv.system(),
-                                  temp_air_c=self.cfg.climate.monthly_mean_temperature_c[month - 1],
-                                  vehicle_speed_mps=speed_mps, wind_mps=self.cfg.climate.wind_speed_mps)
+        return pvmod.energy(poa, dt_s, pv.system(), pv.mode,
+                            temp_air_c=self.cfg.climate.monthly_mean_temperature_c[month - 1],
+                            vehicle_speed_mps=speed_mps, wind_mps=self.cfg.climate.wind_speed_mps)
 
     def trip(self, route_id, direction_id, date, depart="08:00", pv: PVChoice | None = None,
              aux_kw: float | None = None, soc_start: float | None = None,
@@ -338,7 +432,8 @@ class TripModel:
         month = int(date.month)
         energy = self.pv_energy(irr["total"], dt, speed, month, pv)
         energy_uns = self.pv_energy(irr["unshaded"], dt, speed, month, pv)
-        energy_dd = self.pv_energy(irr["direct"] + irr["diffuse"], dt, speed, month, pv)
+        parts = {c: self.pv_energy(irr[c], dt, speed, month, pv)
+                 for c in ("direct", "diffuse", "reflected", "reflected_sd")}
         g = self.geometry.iloc[self._row[sid]]
         tz = self.timezone
         segs = pd.DataFrame({
@@ -390,9 +485,16 @@ class TripModel:
         numbers = {
             "pv_kwh": pv_kwh, "pv_kwh_unshaded": uns, "consumption_kwh": use,
             "share": pv_kwh / use if use > 0 else float("nan"),
-            "shading_loss": 1.0 - float(energy_dd.sum()) / uns if uns > 0 else float("nan"),
+            "pv_kwh_direct": float(parts["direct"].sum()),
+            "pv_kwh_diffuse": float(parts["diffuse"].sum()),
+            "pv_kwh_reflected": float(parts["reflected"].sum()),
+            # the run's reflected kWh of this trip varies by this much (its one sample point
+            # per reflector and pass), independent passes
+            "pv_kwh_reflected_se": float(np.sqrt((parts["reflected_sd"] ** 2).sum())),
+            "shading_loss": float(shading_loss(parts["direct"].sum(), parts["diffuse"].sum(), uns)),
             "soc_end": float(end["soc_end"].iloc[0]), "soc_end_pv": float(end["soc_end_pv"].iloc[0]),
             "soc_min": params.soc_min, "kwp": pv.peak_kw,
+            "diffuse_model": self.cfg.irradiance.diffuse_model,
             "distance_km": float(cons["distance_km"]), "duration_min": float(cons["duration_s"]) / 60.0,
         }
         departure = pd.Timestamp(origin, unit="s", tz="UTC").tz_convert(tz).tz_localize(None)
@@ -436,13 +538,9 @@ class TripModel:
                             "allsky_unshaded": agg["pv_kwh_unshaded"].to_numpy() * f,
                             "clearsky_unshaded": agg["pv_kwh_clear_unshaded"].to_numpy() * f,
                             "consumption": agg["consumption_kwh"].to_numpy()})
-        uns = agg["pv_kwh_unshaded"].to_numpy()
-        dd = (agg["pv_kwh_direct"] + agg["pv_kwh_diffuse"]).to_numpy()
-        out["shading_loss"] = np.where(uns > 0, 1 - dd / np.where(uns > 0, uns, 1), np.nan)
+        out["shading_loss"] = shading_loss(agg["pv_kwh_direct"].to_numpy(),
+                                           agg["pv_kwh_diffuse"].to_numpy(),
+                                           agg["pv_kwh_unshaded"].to_numpy())
         out["share"] = out["allsky"] / out["consumption"].where(out["consumption"] > 0)
         return out
 
-
-def with_pv(choice: PVChoice, **changes) -> PVChoice:
-    """A copy of *choice* with fields changed."""
-    return replace(choice, **changes)

@@ -17,6 +17,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from ..irradiance import shading_loss
+
 #: geometry factors of ``parts/geometry`` that a map reader needs (the rest is the irradiance
 #: model's internal reflector geometry and stays in parts/)
 PUBLIC_FACTORS = ["tilt_deg", "azimuth_deg", "svf", "refl_vf"]
@@ -61,7 +63,7 @@ def segment_year(segments, geometry: pd.DataFrame | None, segment_month: pd.Data
     unshaded = out["h_total_unshaded"].where(out["h_total_unshaded"] > 0)
     out["g_total_in_service"] = out["h_total"] / hours
     out["g_total_unshaded_in_service"] = out["h_total_unshaded"] / hours
-    out["shading_loss"] = 1.0 - (out["h_direct"] + out["h_diffuse"]) / unshaded
+    out["shading_loss"] = shading_loss(out["h_direct"], out["h_diffuse"], out["h_total_unshaded"])
     out["reflection_gain"] = out["h_reflected"] / unshaded
     out["kwh_per_kwp_year"] = out["pv_kwh"] / kwp / hours * hours_per_bus
     out["irradiation_kwh_m2_year"] = out["g_total_in_service"] * hours_per_bus / 1000.0

@@ -146,16 +146,13 @@ def tile_geometry(ctx: RunContext, tile: str) -> pd.DataFrame:
 
 def pv_energy_kwh(poa_wm2: np.ndarray, dt_s: np.ndarray, speed_mps: np.ndarray, month: int,
                   ctx: RunContext) -> np.ndarray:
-    """PV energy per pass (kWh) in the run's PV mode: paper (linear in POA) or pvlib
-    (PVWatts with a cell temperature cooled by the bus's own speed plus the ambient wind)."""
+    """PV energy per pass (kWh) in the run's PV mode (:func:`vipvflow.pv.energy`), at the
+    month's mean temperature and the run's wind."""
     from .. import pv
 
-    system = PVSystem(**ctx.pv_system)
-    if ctx.pv_mode == "paper":
-        return pv.energy_paper(poa_wm2, dt_s, system.kwp, system.performance_ratio)
-    temp = ctx.monthly_temperature_c[month - 1]
-    return pv.energy_pvlib(poa_wm2, dt_s, system, temp_air_c=temp,
-                           vehicle_speed_mps=speed_mps, wind_mps=ctx.wind_speed_mps)
+    return pv.energy(poa_wm2, dt_s, PVSystem(**ctx.pv_system), ctx.pv_mode,
+                     temp_air_c=ctx.monthly_temperature_c[month - 1],
+                     vehicle_speed_mps=speed_mps, wind_mps=ctx.wind_speed_mps)
 
 
 def _local_hours(t_utc: np.ndarray, timezone: str) -> np.ndarray:
@@ -256,7 +253,9 @@ def aggregate_partition(passes: pd.DataFrame, irr: pd.DataFrame, month: int, ctx
         sums["trip"][f"h_{c}"] = per_run[j]
     if linear:
         # paper mode is linear in the irradiation: kWh = kWp x PR x H / 1000 (H in Wh/m2)
-        k = system.kwp * system.performance_ratio / 1000.0
+        from ..pv import paper_kw_per_wm2
+
+        k = paper_kw_per_wm2(system.kwp, system.performance_ratio)
         for g in ("trip", "seg"):
             for name, col in pv_source.items():
                 sums[g][name] = k * sums[g][f"h_{col}"]
@@ -303,7 +302,7 @@ def run_partition(ctx: RunContext, tile: str, month: str, geometry: pd.DataFrame
     ``parts/hourly/...`` (per local hour: irradiation and pass time, for the daily pattern).
     Returns a small summary for the progress view.
     """
-    from ..irradiance import evaluate_passes, stage_seconds
+    from ..irradiance import evaluate_passes
     from ..trajectory import iter_passes
 
     tune_malloc()
@@ -317,15 +316,15 @@ def run_partition(ctx: RunContext, tile: str, month: str, geometry: pd.DataFrame
     seg = _segments(ctx.data_dir)
     if n:
         t1 = time.perf_counter()
-        before = dict(stage_seconds())
+        stages: dict = {}
         scene = _scene(ctx, tile)
         irr = evaluate_passes(passes, seg, geometry, _radiation(ctx.data_dir, ctx.year),
                               scene, IrradianceCfg(**ctx.irradiance),
                               ground_albedo=ctx.ground_albedo,
-                              packed=_packed_geometry(ctx, tile, geometry, scene))
+                              packed=_packed_geometry(ctx, tile, geometry, scene), timings=stages)
         timings["irradiance_s"] = time.perf_counter() - t1
         # the irradiance time split by stage (lookup, ray setup, rays, components, pack)
-        timings.update({f"irradiance_{k}": v - before[k] for k, v in stage_seconds().items()})
+        timings.update({f"irradiance_{k}": v for k, v in stages.items()})
     else:
         irr = pd.DataFrame({c: np.zeros(0, np.float32) for c in COMPONENTS})
     t2 = time.perf_counter()

@@ -7,6 +7,7 @@ and day; and the fleet-year summary with coverage, avoided charging cycles and p
 from __future__ import annotations
 
 import logging
+import re
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
@@ -19,6 +20,7 @@ import pyarrow.parquet as pq
 
 from ..config import Config
 from ..errors import InputError
+from ..irradiance import shading_loss
 from .storage import write_json, write_parquet
 
 log = logging.getLogger(__name__)
@@ -67,12 +69,6 @@ def _trip_totals(run_dir: Path) -> pd.DataFrame:
     summed = summed.select(keys + [f"{c}_sum" for c in cols]).rename_columns(keys + cols)
     summed = summed.sort_by([(k, "ascending") for k in keys])
     return summed.to_pandas()
-
-
-def shading_loss(shaded, unshaded):
-    """1 - shaded / unshaded irradiation (or energy); NaN where nothing was received unshaded."""
-    unshaded = unshaded.where(unshaded > 0) if hasattr(unshaded, "where") else (unshaded if unshaded > 0 else np.nan)
-    return 1.0 - shaded / unshaded
 
 
 def trip_consumption(cfg: Config, data_dir: Path, year: int, pattern_ids, vecto_dir: Path | None = None,
@@ -296,8 +292,8 @@ def reduce_run(cfg: Config, year: int, run_dir: Path, say=print) -> dict:
     sm = _read_parts(run_dir, "segment_month")
     # shading loss: sky and sun light the buildings take away (1 - (direct + diffuse) / unshaded);
     # the reflected light they add is reported apart as reflection gain
-    sm["shading_loss"] = shading_loss(sm["h_direct"] + sm["h_diffuse"], sm["h_total_unshaded"])
-    sm["shading_loss_clear"] = shading_loss(sm["h_direct_clear"] + sm["h_diffuse_clear"],
+    sm["shading_loss"] = shading_loss(sm["h_direct"], sm["h_diffuse"], sm["h_total_unshaded"])
+    sm["shading_loss_clear"] = shading_loss(sm["h_direct_clear"], sm["h_diffuse_clear"],
                                             sm["h_total_clear_unshaded"])
     sm["reflection_gain"] = sm["h_reflected"] / sm["h_total_unshaded"].where(sm["h_total_unshaded"] > 0)
     shape_route = (trips_meta.drop_duplicates("shape_id")[["shape_id", "route_short_name", "direction_id"]])
@@ -317,7 +313,7 @@ def reduce_run(cfg: Config, year: int, run_dir: Path, say=print) -> dict:
     rm = (trip.groupby(["route_id", "route_short_name", "direction_id", "month"], sort=True)
           .agg(trips=("trip_id", "size"), **{c: (c, "sum") for c in agg}).reset_index())
     rm["coverage"] = rm["pv_kwh"] / rm["consumption_kwh"]
-    rm["shading_loss"] = shading_loss(rm["pv_kwh_direct"] + rm["pv_kwh_diffuse"], rm["pv_kwh_unshaded"])
+    rm["shading_loss"] = shading_loss(rm["pv_kwh_direct"], rm["pv_kwh_diffuse"], rm["pv_kwh_unshaded"])
     write_parquet(rm, run_dir / "route_month.parquet")
 
     # --- vehicle block per day
@@ -378,7 +374,7 @@ def reduce_run(cfg: Config, year: int, run_dir: Path, say=print) -> dict:
                     pv_kwh_direct=("pv_kwh_direct", "sum"), pv_kwh_diffuse=("pv_kwh_diffuse", "sum"),
                     pv_kwh_reflected=("pv_kwh_reflected", "sum"),
                     consumption_kwh=("consumption_kwh", "sum")).reset_index())
-    monthly["shading_loss"] = shading_loss(monthly["pv_kwh_direct"] + monthly["pv_kwh_diffuse"],
+    monthly["shading_loss"] = shading_loss(monthly["pv_kwh_direct"], monthly["pv_kwh_diffuse"],
                                            monthly["pv_kwh_unshaded"])
     split = bd.groupby("month", sort=True)[
         ["pv_kwh_driving", "pv_kwh_layover", "pv_kwh_parked", "pv_kwh_usable", "pv_kwh_curtailed",
@@ -407,8 +403,8 @@ def reduce_run(cfg: Config, year: int, run_dir: Path, say=print) -> dict:
         "kwh_per_kwp_allsky": float(trip["pv_kwh"].sum() * annualise / (pv.kwp * n_buses)),
         "kwh_per_kwp_clearsky": float(trip["pv_kwh_clear"].sum() * annualise / (pv.kwp * n_buses)),
         "irradiation_kwh_m2": {k[2:]: float(v) / 1000.0 for k, v in tot.items()},
-        "shading_loss_allsky": float(shading_loss(tot["h_direct"] + tot["h_diffuse"], tot["h_total_unshaded"])),
-        "shading_loss_clearsky": float(shading_loss(tot["h_direct_clear"] + tot["h_diffuse_clear"],
+        "shading_loss_allsky": float(shading_loss(tot["h_direct"], tot["h_diffuse"], tot["h_total_unshaded"])),
+        "shading_loss_clearsky": float(shading_loss(tot["h_direct_clear"], tot["h_diffuse_clear"],
                                                     tot["h_total_clear_unshaded"])),
         "reflection_gain_allsky": float(tot["h_reflected"] / tot["h_total_unshaded"]),
         "net_building_effect_allsky": float(tot["h_total"] / tot["h_total_unshaded"] - 1),

@@ -21,6 +21,7 @@ import pandas as pd  # noqa: E402
 from matplotlib.collections import LineCollection, PolyCollection  # noqa: E402
 from matplotlib.patches import Rectangle  # noqa: E402
 
+from ..irradiance import shading_loss  # noqa: E402
 from .dictionary import SUMMARY  # noqa: E402
 
 #: colour limits of the maps: these percentiles of the segments' values (a few segments with
@@ -29,6 +30,7 @@ MAP_PERCENTILES = (2.0, 98.0)
 
 #: side of the close-up map (m)
 CLOSE_UP_M = 1200.0
+
 
 
 def _save(fig, run_dir: Path, name: str) -> str:
@@ -160,7 +162,7 @@ def fig_routes(rm: pd.DataFrame):
     fig, ax = plt.subplots(1, 2, figsize=(10, 3.8))
     ax[0].bar(labels, 100 * r["pv_kwh"] / r["consumption_kwh"], color="#4285f4")
     ax[0].set_ylabel("PV share of consumption (%)")
-    ax[1].bar(labels, 100 * (1 - (r["pv_kwh_direct"] + r["pv_kwh_diffuse"]) / r["pv_kwh_unshaded"]),
+    ax[1].bar(labels, 100 * shading_loss(r["pv_kwh_direct"], r["pv_kwh_diffuse"], r["pv_kwh_unshaded"]),
               color="#db4437")
     ax[1].set_ylabel("shading loss (%)")
     for a in ax:
@@ -346,6 +348,7 @@ td,th{{text-align:left;padding:2px 10px}}td.num{{text-align:right;font-variant-n
 th.sec{{padding-top:10px;border-bottom:1px solid #ccc}}tr[title]:hover{{background:#f4f4f4}}
 p{{line-height:1.45;max-width:900px}}</style></head><body>
 <h1>Bus-roof PV, fleet-year: {html.escape(title)}</h1>
+<p>{html.escape(_model_note(summary))}</p>
 <h2>How to read this</h2>{_how_to_read(summary)}
 <h2>Summary</h2>{summary_table(summary)}
 <h2>Inputs</h2>{_inputs_table(cfg, crs, len(tiles) if tiles else None)}
@@ -353,3 +356,16 @@ p{{line-height:1.45;max-width:900px}}</style></head><body>
     path = run_dir / "report.html"
     path.write_text(doc, encoding="utf-8")
     return path
+
+
+def _model_note(summary: dict) -> str:
+    """What the figures mean: the diffuse model of the run and the shading-loss definition."""
+    model = summary.get("diffuse_model", "sky_view_factor")
+    diffuse = ("diffuse light = DHI x the sky view factor of each roof point (the sky the "
+               "buildings leave open)" if model == "sky_view_factor" else
+               "diffuse light = DHI (1 + cos tilt) / 2, the paper's isotropic sky: the sky the "
+               "buildings hide is counted as open (an upper bound in streets)")
+    return (f"Diffuse model: {model}: {diffuse}. Shading loss = 1 - (direct + diffuse) / "
+            "unshaded (sun and sky the buildings take away); the light they reflect onto the "
+            "roof is reported apart (reflection gain).")
+
