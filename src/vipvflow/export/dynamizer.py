@@ -151,7 +151,9 @@ def load_run(run_dir: str | Path) -> RunData:
     missing = [n for n in need if not (run_dir / n).exists()]
     if missing:
         raise InputError(f"{run_dir}: not a finished run (missing {', '.join(missing)})")
-    manifest = json.loads((run_dir / "manifest.json").read_text())
+    from ..simulation.rundir import open_run
+
+    manifest = open_run(run_dir).manifest       # with its data dir found from anywhere
     segments = gpd.read_parquet(run_dir / "segments.parquet")
     sm = pd.read_parquet(run_dir / "segment_month.parquet",
                          columns=["segment_id", "month", *SEGMENT_SERIES, "pv_kwh_reflected"])
