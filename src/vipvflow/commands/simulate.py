@@ -15,6 +15,9 @@ def register(sub):
                    help="address of a running Dask scheduler (tcp://host:8786); default: a LocalCluster")
     p.add_argument("--workers", type=int, default=None, help="LocalCluster worker processes (default: cores)")
     p.add_argument("--db", default=None, help="PostgreSQL DSN: mirror the finished run into PostGIS/Citus")
+    p.add_argument("--force", action="store_true",
+                   help="replace a run of another configuration in the run directory (refused "
+                   "without: the two configuration digests are named)")
     p.set_defaults(func=run)
 
 
@@ -23,7 +26,8 @@ def run(args):
 
     overrides = {"db": {"dsn": args.db}} if args.db else None
     cfg = load_config(args.config, overrides=overrides)
-    run_dir = run_simulation(cfg, args.year, scheduler=args.scheduler, n_workers=args.workers)
+    run_dir = run_simulation(cfg, args.year, scheduler=args.scheduler, n_workers=args.workers,
+                             force=args.force)
     if cfg.db.dsn and (run_dir / "summary.json").exists():
         from ..db import mirror_run
 

@@ -101,7 +101,10 @@ def make_client(cfg: Config, scheduler: str | None, n_workers: int | None):
     if scheduler:
         return Client(scheduler), None
     n = n_workers or cfg.dask.n_workers or os.cpu_count() or 1
-    settings = {**LOCAL_CLUSTER_DASK_CONFIG, "distributed.worker.profile.enabled": cfg.dask.worker_profile}
+    settings = {**LOCAL_CLUSTER_DASK_CONFIG, "distributed.worker.profile.enabled": cfg.dask.worker_profile,
+                # workers ignore Ctrl-C and leave a task's failure for this process to report
+                "distributed.worker.preload": ["vipvflow.simulation.worker_setup"],
+                "vipvflow.worker-failure-log": log.isEnabledFor(logging.INFO)}
     with dask.config.set(settings):     # the nannies hand this configuration to their workers
         cluster = LocalCluster(n_workers=n, threads_per_worker=cfg.dask.threads_per_worker or 1,
                                processes=True, memory_limit=cfg.dask.memory_limit,
