@@ -68,7 +68,7 @@ def dsn(pg):
     name = f"t{os.getpid()}_{next(_db_counter)}"
     with psycopg.connect(pg.admin_dsn, autocommit=True) as conn:
         conn.execute(f"CREATE DATABASE {name}")
-    yield pg.dsn.rsplit("/", 1)[0] + "/" + name
+    yield pg.dsn_of(name)
     with psycopg.connect(pg.admin_dsn, autocommit=True) as conn:
         conn.execute(f"DROP DATABASE {name} WITH (FORCE)")
 
@@ -293,7 +293,7 @@ def test_interrupted_mirror_resumes_without_duplicates_or_gaps(dsn, run_dir):
 def test_bad_dsn_is_one_clear_line_and_leaves_the_run_untouched(pg, run_dir):
     before = checksums(run_dir)
     bad = ["this is not a dsn = =", f"postgresql://postgres@127.0.0.1:{pgserver.free_port()}/vipvflow",
-           pg.dsn.rsplit("/", 1)[0] + "/no_such_database"]
+           pg.dsn_of("no_such_database")]
     for dsn in bad:
         with pytest.raises(DatabaseError) as err:
             mirror_run(dsn, run_dir, log=lambda m: None)
