@@ -140,7 +140,8 @@ def mask_dsn(dsn: str | None) -> str | None:
     forms): ``postgresql://u:***@h/db``."""
     if not dsn:
         return dsn
-    for pattern in (_URI_PASSWORD, _QUERY_PASSWORD, _KV_PASSWORD):
+    patterns = (_URI_PASSWORD, _QUERY_PASSWORD) if "://" in dsn else (_KV_PASSWORD,)
+    for pattern in patterns:
         dsn = pattern.sub(lambda m: m.group("head") + "***", dsn)
     return dsn
 
