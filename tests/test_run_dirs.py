@@ -198,3 +198,21 @@ def test_changed_configuration_is_refused_or_replaced_whole(small_config, tmp_pa
     manifest = json.loads((run_dir / "manifest.json").read_text())
     assert manifest["config_digest"] == changed.digest()
     assert manifest["partitions_computed"] == 24 - done
+
+
+def test_track_on_a_copied_run_from_root(copied_run, small_config, tmp_path):
+    """``vipvflow track --city RUN_DIR``: the city of the run's data dir (the copy's)."""
+    import pandas as pd
+
+    road = pd.read_parquet(copied_run.parents[2] / "data" / "gtfs" / "segments.parquet").head(5)
+    n = len(road)
+    t = pd.date_range("2024-06-15 11:00", periods=n, freq="1min", tz="UTC")
+    track = pd.DataFrame({"time": t.strftime("%Y-%m-%dT%H:%M:%SZ"), "x": road["x"], "y": road["y"]})
+    track.to_csv(tmp_path / "track.csv", index=False)
+    cams = yaml.safe_load(Path(small_config).read_text())["inputs"]["cams"][0]
+    rel = lambda p: Path(p).relative_to("/")                       # noqa: E731 - paths from /
+    proc = _cli("track", rel(tmp_path / "track.csv"), "--city", rel(copied_run), "--cams", cams,
+                "--out", rel(tmp_path / "out.csv"))
+    assert proc.returncode == 0, proc.stderr
+    res = pd.read_csv(tmp_path / "out.csv")
+    assert len(res) == n and (res["total_unshaded"] > 0).all()
