@@ -204,10 +204,15 @@ def test_track_on_a_copied_run_from_root(copied_run, small_config, tmp_path):
     """``vipvflow track --city RUN_DIR``: the city of the run's data dir (the copy's)."""
     import pandas as pd
 
-    road = pd.read_parquet(copied_run.parents[2] / "data" / "gtfs" / "segments.parquet").head(5)
-    n = len(road)
+    data = copied_run.parents[2] / "data"
+    road = pd.read_parquet(data / "gtfs" / "segments.parquet").head(5)
+    # and points across the first tile, some beyond the terrain model (no ground height)
+    x0, y0, x1, y1 = next(iter(json.loads((data / "city" / "tiles.json").read_text())["tiles"].values()))["bounds"]
+    x = list(road["x"]) + [x0 + (x1 - x0) * f for f in (0.3, 0.4, 0.5)]
+    y = list(road["y"]) + [(y0 + y1) / 2] * 3
+    n = len(x)
     t = pd.date_range("2024-06-15 11:00", periods=n, freq="1min", tz="UTC")
-    track = pd.DataFrame({"time": t.strftime("%Y-%m-%dT%H:%M:%SZ"), "x": road["x"], "y": road["y"]})
+    track = pd.DataFrame({"time": t.strftime("%Y-%m-%dT%H:%M:%SZ"), "x": x, "y": y})
     track.to_csv(tmp_path / "track.csv", index=False)
     cams = yaml.safe_load(Path(small_config).read_text())["inputs"]["cams"][0]
     rel = lambda p: Path(p).relative_to("/")                       # noqa: E731 - paths from /
@@ -215,4 +220,4 @@ def test_track_on_a_copied_run_from_root(copied_run, small_config, tmp_path):
                 "--out", rel(tmp_path / "out.csv"))
     assert proc.returncode == 0, proc.stderr
     res = pd.read_csv(tmp_path / "out.csv")
-    assert len(res) == n and (res["total_unshaded"] > 0).all()
+    assert len(res) == n and (res["total_unshaded"] > 0).all()       # never NaN
