@@ -49,25 +49,11 @@ def data_dir_record(data_dir: Path | str, run_dir: Path | str) -> dict:
 
 def _candidates(run_dir: Path, manifest: dict) -> list[Path]:
     """Places the run's data dir may be, most likely first."""
-    out = []
     record = (manifest.get("paths") or {}).get("data_dir") or {}
-    if record.get("run_relative"):
-        out.append(run_dir / record["run_relative"])
-    if record.get("absolute"):
-        out.append(Path(record["absolute"]))
-    config = manifest.get("config") or {}
-    recorded = Path(config.get("data_dir") or "")
-    if recorded.is_absolute():
-        out.append(recorded)
-    elif str(recorded) not in ("", "."):
-        # a manifest without paths: data_dir was relative to where the run was made, which
-        # is above <out_dir>/<scenario>/<year> when out_dir was relative
-        out_dir = Path(config.get("out_dir") or "out")
-        if not out_dir.is_absolute():
-            depth = len(out_dir.parts) + 2
-            if len(run_dir.parts) > depth:
-                out.append(run_dir.parents[depth - 1] / recorded)
-        out.append(Path.cwd() / recorded)
+    out = [run_dir / record["run_relative"]] if record.get("run_relative") else []
+    out += [Path(record["absolute"])] if record.get("absolute") else []
+    if not out:
+        out = _candidates_before_paths(run_dir, manifest.get("config") or {})
     seen, unique = set(), []
     for c in out:
         key = os.path.normpath(c)
@@ -75,6 +61,22 @@ def _candidates(run_dir: Path, manifest: dict) -> list[Path]:
             seen.add(key)
             unique.append(Path(key))
     return unique
+
+
+def _candidates_before_paths(run_dir: Path, config: dict) -> list[Path]:
+    """A manifest without ``paths``: its ``data_dir`` was relative to the directory the run
+    was made in, which is above ``<out_dir>/<scenario>/<year>`` when out_dir was relative."""
+    recorded = Path(config.get("data_dir") or "")
+    if recorded.is_absolute():
+        return [recorded]
+    if str(recorded) in ("", "."):
+        return []
+    out = []
+    out_dir = Path(config.get("out_dir") or "out")
+    depth = len(out_dir.parts) + 2
+    if not out_dir.is_absolute() and len(run_dir.parts) > depth:
+        out.append(run_dir.parents[depth - 1] / recorded)
+    return out + [Path.cwd() / recorded]
 
 
 def open_run(run_dir: Path | str, needs: tuple[str, ...] = NEEDS) -> RunFolder:
