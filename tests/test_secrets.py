@@ -58,3 +58,18 @@ def test_password_dsn_written_nowhere(small_config, tmp_path):
     assert "postgresql://vipv:***@127.0.0.1" in manifest             # recorded, masked
     leaks = [p for p in out.rglob("*") if p.is_file() and b"secret" in p.read_bytes()]
     assert leaks == []                                                 # grep -r secret out/
+
+
+@pytest.mark.parametrize("dsn", [
+    "postgresql//vipv:secret@127.0.0.1/db",                     # a typo: not a URI, not key=value
+    "host=127.0.0.1 password=secret dbname",                    # key without a value
+    f"postgresql://vipv:secret@127.0.0.1:{free_port()}/db",     # nobody listening
+    "postgresql://vipv:secret@127.0.0.1:1/db?sslmode=bogus",
+])
+def test_database_errors_never_show_the_password(dsn):
+    from vipvflow.db.mirror import DatabaseError, connect
+
+    with pytest.raises(DatabaseError) as err:
+        connect(dsn)
+    message = str(err.value)
+    assert "secret" not in message and "\n" not in message and message

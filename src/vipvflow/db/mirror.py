@@ -24,7 +24,7 @@ import pyarrow.parquet as pq
 
 from ..errors import InputError, VipvError
 from ..files import sha256
-from ..simulation.rundir import masked_config
+from ..simulation.rundir import mask_text, masked_config
 from . import schema as S
 
 COPY_BLOCK = 1 << 20  # bytes handed to COPY per write
@@ -65,14 +65,14 @@ def connect(dsn: str):
 
     try:
         params = conninfo_to_dict(dsn)
-    except psycopg.Error as exc:
-        raise DatabaseError(f"invalid database DSN: {_one_line(exc)}") from None
+    except psycopg.Error as exc:         # the message may quote the DSN, password included
+        raise DatabaseError(f"invalid database DSN: {mask_text(_one_line(exc))}") from None
     kwargs = {} if "connect_timeout" in params else {"connect_timeout": 10}
     try:
         return psycopg.connect(dsn, autocommit=True, application_name="vipvflow-mirror", **kwargs)
     except psycopg.Error as exc:
         raise DatabaseError(f"cannot connect to PostgreSQL at {describe_dsn(dsn)}: "
-                            f"{_one_line(exc)}") from None
+                            f"{mask_text(_one_line(exc))}") from None
 
 
 # ---------------------------------------------------------------- set-up

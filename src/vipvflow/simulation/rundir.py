@@ -148,6 +148,18 @@ def mask_dsn(dsn: str | None) -> str | None:
     return dsn
 
 
+_LOOSE_USERINFO = re.compile(r"(?P<head>[^\s:/@\"']+:)(?P<pw>[^\s@/\"']*)(?=@)")
+_LOOSE_KV = re.compile(r"(?P<head>\bpassword\s*=\s*)(?P<pw>'(?:[^'\\]|\\.)*'|[^\s\"&]+)", re.I)
+
+
+def mask_text(text: str) -> str:
+    """*text* (an error message that may quote a DSN, even a malformed one) with anything
+    that looks like a password masked: ``user:***@``, ``password=***``."""
+    for pattern in (_LOOSE_USERINFO, _LOOSE_KV):
+        text = pattern.sub(lambda m: m.group("head") + "***", text)
+    return text
+
+
 def masked_config(config: dict) -> dict:
     """A copy of a configuration dump (``Config.model_dump``) with ``db.dsn`` masked."""
     config = copy.deepcopy(config)
