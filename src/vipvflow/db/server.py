@@ -53,7 +53,10 @@ class LocalServer:
 
 
 def _dsn(dir: Path, port: int, database: str) -> str:
-    return f"postgresql://{SERVER_USER}@127.0.0.1:{port}/{database}?passfile={dir / PASSFILE}"
+    from urllib.parse import quote
+
+    return (f"postgresql://{SERVER_USER}@127.0.0.1:{port}/{database}"
+            f"?passfile={quote(str(dir / PASSFILE), safe='/')}")
 
 
 #: the password file of a cluster folder (``.pgpass`` format)
