@@ -83,7 +83,8 @@ def main(argv: list[str] | None = None) -> int:
         print(f"vipvflow {args.command}: error: {disk_error_line(exc)}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
-        print("vipvflow: interrupted", file=sys.stderr)
+        # on a terminal, below a progress bar that is still drawing its line
+        print(("\n" if sys.stderr.isatty() else "") + "vipvflow: interrupted", file=sys.stderr)
         return 130
 
 
