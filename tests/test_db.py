@@ -64,7 +64,7 @@ def dsn(pg):
     name = f"t{os.getpid()}_{next(_db_counter)}"
     with psycopg.connect(pg.admin_dsn, autocommit=True) as conn:
         conn.execute(f"CREATE DATABASE {name}")
-    yield pg.dsn.rsplit("/", 1)[0] + "/" + name
+    yield pg.dsn_of(name)
     with psycopg.connect(pg.admin_dsn, autocommit=True) as conn:
         conn.execute(f"DROP DATABASE {name} WITH (FORCE)")
 
@@ -289,7 +289,7 @@ def test_interrupted_mirror_resumes_without_duplicates_or_gaps(dsn, run_dir):
 def test_bad_dsn_is_one_clear_line_and_leaves_the_run_untouched(pg, run_dir):
     before = checksums(run_dir)
     bad = ["this is not a dsn = =", f"postgresql://postgres@127.0.0.1:{pgserver.free_port()}/vipvflow",
-           pg.dsn.rsplit("/", 1)[0] + "/no_such_database"]
+           pg.dsn_of("no_such_database")]
     for dsn in bad:
         with pytest.raises(DatabaseError) as err:
             mirror_run(dsn, run_dir, log=lambda m: None)
@@ -327,3 +327,85 @@ def test_doc_sql_examples_run_as_written(dsn, run_dir):
     geojson = query(dsn, blocks[2])[0][0]
     assert geojson["type"] == "FeatureCollection"
     assert len(geojson["features"]) == file_rows(run_dir)["segments"]
+
+
+# ---------------------------------------------------------------- secrets, any directory
+
+def _cli(*args, cwd=None, env=None):
+    env = dict(os.environ if env is None else env, PYTHONPATH=str(ROOT / "src"))
+    return subprocess.run([sys.executable, "-m", "vipvflow.cli", *map(str, args)], cwd=cwd,
+                          env=env, capture_output=True, text=True, timeout=300)
+
+
+def _password(pg) -> str:
+    return (pg.dir / pgserver.PASSFILE).read_text().split("\n")[0].rsplit(":", 1)[1]
+
+
+def test_server_socket_is_private_and_tcp_asks_for_the_password(pg):
+    import stat
+
+    import psycopg
+
+    for private in (pg.dir, pg.dir / "socket"):
+        assert stat.S_IMODE(private.stat().st_mode) == 0o700, private
+    socket = next((pg.dir / "socket").glob(".s.PGSQL.*[0-9]"))
+    assert stat.S_IMODE(socket.stat().st_mode) & 0o077 == 0
+    assert stat.S_IMODE((pg.dir / pgserver.PASSFILE).stat().st_mode) == 0o600
+    password = _password(pg)
+    assert len(password) >= 24 and password not in pg.dsn
+    bare = f"postgresql://postgres@127.0.0.1:{pg.port}/postgres"
+    with pytest.raises(psycopg.OperationalError, match="password"):
+        psycopg.connect(bare, connect_timeout=5, passfile="/nonexistent")
+    with pytest.raises(psycopg.OperationalError, match="password authentication failed"):
+        psycopg.connect(bare + "?password=wrong", connect_timeout=5)
+    for dsn in (pg.dsn, f"postgresql://postgres:{password}@127.0.0.1:{pg.port}/postgres"):
+        with psycopg.connect(dsn, connect_timeout=5) as conn:
+            assert conn.execute("SELECT current_user").fetchone()[0] == "postgres"
+    with psycopg.connect(bare, connect_timeout=5, password=password) as conn:  # as $PGPASSWORD would
+        assert conn.execute("SELECT 1").fetchone()[0] == 1
+
+
+def test_db_start_prints_the_password_once():
+    folder = tempfile.mkdtemp(prefix="vipvflow-pg-cli-")   # under /tmp: reachable by 'postgres'
+    try:
+        first = _cli("db", "start", "--dir", folder)
+        assert first.returncode == 0, first.stderr
+        dsn = first.stdout.strip()
+        password = (Path(folder) / pgserver.PASSFILE).read_text().split("\n")[0].rsplit(":", 1)[1]
+        assert password in first.stderr and password not in dsn
+        assert first.stderr.count(password) == 1
+        again = _cli("db", "start", "--dir", folder)                       # already running
+        _cli("db", "stop", "--dir", folder)
+        restarted = _cli("db", "start", "--dir", folder)                   # stopped and started
+        assert again.returncode == restarted.returncode == 0
+        assert password not in again.stderr + restarted.stderr
+        import psycopg
+
+        with psycopg.connect(restarted.stdout.strip(), connect_timeout=5) as conn:
+            assert conn.execute("SELECT postgis_version()").fetchone()[0]
+    finally:
+        _cli("db", "stop", "--dir", folder)
+        shutil.rmtree(folder, ignore_errors=True)
+
+
+def test_mirror_from_root_keeps_no_password(dsn, pg, run_dir, tmp_path):
+    """A copy of the run whose manifest holds a password DSN (as written before masking),
+    mirrored from / with a DSN carrying the password: neither the runs table nor the log
+    holds it."""
+    run = tmp_path / "copy" / "out" / "small" / "2024"
+    shutil.copytree(run_dir, run, ignore=shutil.ignore_patterns("parts", "figures", "*.html"))
+    password = _password(pg)
+    with_password = dsn.split("?")[0].replace("postgres@", f"postgres:{password}@")
+    manifest = json.loads((run / "manifest.json").read_text())
+    manifest["config"]["db"] = {"dsn": with_password}
+    (run / "manifest.json").write_text(json.dumps(manifest))
+    env = {k: v for k, v in os.environ.items() if k not in ("PGPASSWORD", "PGPASSFILE")}
+    proc = _cli("mirror", "--db", with_password, run.relative_to("/"), cwd="/", env=env)
+    assert proc.returncode == 0, proc.stderr
+    assert password not in proc.stdout + proc.stderr
+    rid = run_id(run)
+    stored = query(dsn, "SELECT manifest::text, config::text, status FROM vipvflow.runs "
+                        "WHERE run_id = %s", (rid,))
+    assert stored and stored[0][2] == "complete"
+    assert password not in stored[0][0] + stored[0][1]
+    assert "postgres:***@127.0.0.1" in stored[0][1]

@@ -8,8 +8,10 @@ are printed as one line, never as a traceback.
 from __future__ import annotations
 
 import argparse
+import errno
 import importlib
 import logging
+import os
 import sys
 
 from . import __version__
@@ -86,10 +88,31 @@ def main(argv: list[str] | None = None) -> int:
         print(f"vipvflow {args.command}: error: needs the optional package '{exc.name}': "
               f"pip install 'vipvflow[{extra}]'", file=sys.stderr)
         return 2
+    except OSError as exc:
+        if exc.errno not in DISK_ERRORS:
+            raise
+        print(f"vipvflow {args.command}: error: {disk_error_line(exc)}", file=sys.stderr)
+        return 2
     except KeyboardInterrupt:
-        print("vipvflow: interrupted", file=sys.stderr)
+        # on a terminal, below a progress bar that is still drawing its line
+        print(("\n" if sys.stderr.isatty() else "") + "vipvflow: interrupted", file=sys.stderr)
         return 130
 
+
+#: errors of the disk a user points the command at: not writable, read-only, full, over quota,
+#: over the size limit
+DISK_ERRORS = {errno.EACCES, errno.EPERM, errno.EROFS, errno.ENOSPC, errno.EDQUOT, errno.EFBIG}
+
+
+def disk_error_line(exc: OSError) -> str:
+    """``<file>: <reason> (<what to do>)`` of an OSError of :data:`DISK_ERRORS`."""
+    where = f"{exc.filename}: " if exc.filename else ""
+    reason = " ".join(str(exc.strerror or os.strerror(exc.errno)).split())
+    if exc.errno in (errno.ENOSPC, errno.EDQUOT, errno.EFBIG):
+        hint = "free space or choose another out_dir / data_dir; the same command then resumes"
+    else:
+        hint = "choose a writable out_dir / data_dir, or check the file's permissions"
+    return f"{where}{reason} ({hint})"
 
 if __name__ == "__main__":  # pragma: no cover
     sys.exit(main())

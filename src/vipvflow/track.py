@@ -117,6 +117,9 @@ def model_track(track: pd.DataFrame, data_dir, radiation_table, cfg: IrradianceC
     heading = np.where(np.isnan(heading), headings(x, y), heading)
     dist = np.hypot(np.diff(x), np.diff(y))
     grad = np.where(dist > 1.0, np.diff(z) / np.maximum(dist, 1e-9), 0.0)
+    # a point without a height yet (outside the terrain model: the tile's lowest mesh point
+    # below) is taken as level, instead of making every component NaN
+    grad = np.where(np.isfinite(grad), grad, 0.0)
     grad = np.clip(np.append(grad, grad[-1] if len(grad) else 0.0), -0.3, 0.3)
     tiles = tile_names(x, y, float(meta["tile_size_m"]))
     loc = radiation_table.nearest_location(tr["lat"].to_numpy(), tr["lon"].to_numpy())

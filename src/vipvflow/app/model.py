@@ -38,7 +38,6 @@ import json
 import time
 from dataclasses import dataclass, field
 from functools import lru_cache
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -146,6 +145,11 @@ def _minutes(value) -> float:
     return float(value)
 
 
+#: files of the run's data dir the app reads
+APP_NEEDS = ("gtfs/feed.json", "gtfs/segments.parquet", "gtfs/trips.parquet",
+             "gtfs/patterns.parquet", "radiation/radiation.parquet")
+
+
 class TripModel:
     """A finished run, loaded once, recomputing trips for the web app (a few occlusion rays
     per trip against the run's city meshes, no view-factor rays).
@@ -161,12 +165,14 @@ class TripModel:
         from ..radiation import RadiationTable
         from ..trajectory import service_dates
 
-        self.run_dir = Path(run_dir)
-        manifest = json.loads((self.run_dir / "manifest.json").read_text())
+        from ..simulation.rundir import open_run
+
+        run = open_run(run_dir, APP_NEEDS)
+        self.run_dir, self.data_dir = run.path, run.data_dir
+        manifest = run.manifest
         self.manifest = manifest
         self.year = int(manifest["year"])
         self.cfg = Config.model_validate(manifest["config"])
-        self.data_dir = Path(self.cfg.data_dir)
         gdir = self.data_dir / "gtfs"
         self.timezone = json.loads((gdir / "feed.json").read_text())["timezone"]
         self.vehicle = self.cfg.vehicle_params()

@@ -1,8 +1,6 @@
 """``vipvflow app``: the interactive web app on a finished run."""
 from __future__ import annotations
 
-from pathlib import Path
-
 from ..errors import InputError
 
 
@@ -21,14 +19,13 @@ def register(sub):
 
 
 def run(args):
+    from ..app.model import APP_NEEDS
     from ..app.server import serve
+    from ..simulation.rundir import open_run
 
-    run_dir = Path(args.run_dir)
-    if not (run_dir / "manifest.json").is_file():
-        raise InputError(f"{run_dir}: not a finished run (no manifest.json); "
-                         "run 'vipvflow simulate' first")
-    if not (run_dir / "parts" / "horizon").is_dir():
-        raise InputError(f"{run_dir / 'parts' / 'horizon'}: no horizon profiles; the run predates "
+    run = open_run(args.run_dir, APP_NEEDS)       # from any working directory
+    if not (run.path / "parts" / "horizon").is_dir():
+        raise InputError(f"{run.path / 'parts' / 'horizon'}: no horizon profiles; the run predates "
                          "them: delete the run's parts/ and simulate again")
-    serve(run_dir, port=args.port, host=args.host, show=args.show)
+    serve(run.path, port=args.port, host=args.host, show=args.show)
     return 0

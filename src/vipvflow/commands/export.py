@@ -44,7 +44,9 @@ def register(sub):
 
 def run(args):
     from ..export import write_dynamizers
+    from ..simulation.rundir import open_run
 
+    open_run(args.run_dir)      # the run and its data dir, or one line saying what is missing
     res = write_dynamizers(args.run_dir, args.out, encoding=args.encoding, embed=args.embed,
                            max_segments=args.segments, aggregate=args.aggregate, routes=args.routes,
                            months=args.months, reflectors=args.reflectors)

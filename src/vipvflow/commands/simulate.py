@@ -24,6 +24,9 @@ def register(sub):
     p.add_argument("--db", default=None, help="PostgreSQL DSN: mirror the finished run into PostGIS/Citus")
     p.add_argument("--quiet", "-q", action="store_true",
                    help="no progress bars or progress lines")
+    p.add_argument("--force", action="store_true",
+                   help="replace a run of another configuration in the run directory (refused "
+                   "without: the two configuration digests are named)")
     p.set_defaults(func=run)
 
 
@@ -35,7 +38,8 @@ def run(args):
     cfg = load_config(args.config, overrides=overrides)
     if args.out is not None:
         cfg = load_config(args.config, overrides={**overrides, **under(cfg, args.out)})
-    run_dir = run_simulation(cfg, args.year, scheduler=args.scheduler, n_workers=args.workers)
+    run_dir = run_simulation(cfg, args.year, scheduler=args.scheduler, n_workers=args.workers,
+                             force=args.force)
     if cfg.db.dsn and (run_dir / "summary.json").exists():
         from ..db import mirror_run
 

@@ -15,7 +15,7 @@ def register(sub):
                     "track CSV (time, lat/lon or x/y, optional z, heading_deg, measured_wm2) "
                     "in an ingested city; with measured_wm2, print RMSE, MBE and R2.")
     p.add_argument("track", type=Path, help="track CSV")
-    p.add_argument("--city", type=Path, required=True, help="data dir holding city/ (tiles, meshes)")
+    p.add_argument("--city", type=Path, required=True, help="data dir holding city/ (tiles, meshes), or a run folder (its data dir)")
     p.add_argument("--cams", type=Path, nargs="+", required=True, help="CAMS CSV file(s) covering the track")
     p.add_argument("--crs", default=None, help="CRS of x/y columns (default: the city's)")
     p.add_argument("--out", type=Path, required=True, help="output CSV")
@@ -28,6 +28,10 @@ def run(args):
     from ..track import fit_stats, model_track, read_track
 
     cfg = load_config(args.config)
+    if (args.city / "manifest.json").is_file():      # a run folder: the city of its data dir
+        from ..simulation.rundir import open_run
+
+        args.city = open_run(args.city, needs=("city/tiles.json",)).data_dir
     tiles_json = args.city / "city" / "tiles.json"
     if not tiles_json.is_file():
         raise InputError(f"{tiles_json}: not found; run 'vipvflow ingest city' first")

@@ -24,6 +24,7 @@ import pyarrow.parquet as pq
 
 from ..errors import InputError, VipvError
 from ..files import sha256
+from ..simulation.rundir import mask_text, masked_config
 from . import schema as S
 
 COPY_BLOCK = 1 << 20  # bytes handed to COPY per write
@@ -64,14 +65,14 @@ def connect(dsn: str):
 
     try:
         params = conninfo_to_dict(dsn)
-    except psycopg.Error as exc:
-        raise DatabaseError(f"invalid database DSN: {_one_line(exc)}") from None
+    except psycopg.Error as exc:         # the message may quote the DSN, password included
+        raise DatabaseError(f"invalid database DSN: {mask_text(_one_line(exc))}") from None
     kwargs = {} if "connect_timeout" in params else {"connect_timeout": 10}
     try:
         return psycopg.connect(dsn, autocommit=True, application_name="vipvflow-mirror", **kwargs)
     except psycopg.Error as exc:
         raise DatabaseError(f"cannot connect to PostgreSQL at {describe_dsn(dsn)}: "
-                            f"{_one_line(exc)}") from None
+                            f"{mask_text(_one_line(exc))}") from None
 
 
 # ---------------------------------------------------------------- set-up
@@ -380,7 +381,10 @@ def mirror_run(dsn: str, run_dir, log=print, force: bool = False,
     import psycopg
 
     run_dir = Path(run_dir)
+    # a manifest written before DSNs were masked may hold a password: never stored
     manifest = read_json(run_dir / "manifest.json")
+    if isinstance(manifest.get("config"), dict):
+        manifest["config"] = masked_config(manifest["config"])
     summary = read_json(run_dir / "summary.json")
     run_id = run_id_of(manifest, run_dir / "manifest.json")
     epsg = geo_epsg(run_dir / "segments.parquet") if (run_dir / "segments.parquet").exists() \

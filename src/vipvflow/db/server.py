@@ -1,9 +1,12 @@
 """A local PostgreSQL + PostGIS cluster for mirroring runs (``make db``) and for the tests.
 
 The cluster lives in one folder: ``<dir>/pgdata`` (data), ``<dir>/socket`` (unix socket),
-``<dir>/postgresql.log`` and ``<dir>/server.json`` (port and DSN of the running server). It
-listens on 127.0.0.1 only, with ``trust`` authentication: a throwaway server for one machine,
-not a production database.
+``<dir>/pgpass`` (the password), ``<dir>/postgresql.log`` and ``<dir>/server.json`` (port and
+DSN of the running server).  Only the user running the server can open its unix socket (folder
+and socket mode 0700; connections there are trusted); on TCP it listens on 127.0.0.1 only and
+asks for the password of the ``postgres`` role, generated on first start, printed once and
+kept in ``<dir>/pgpass`` (``.pgpass`` format, mode 0600).  The DSN ``start`` returns names that
+file (``?passfile=``) instead of holding the password.
 
 PostgreSQL refuses to run as root: when this process is root, every server program runs as the
 ``postgres`` system user (``runuser -u postgres``) and the folder is given to that user.
@@ -14,6 +17,7 @@ import glob
 import json
 import os
 import pwd
+import secrets
 import shutil
 import socket
 import subprocess
@@ -39,9 +43,33 @@ class LocalServer:
     port: int
     dsn: str
 
+    def dsn_of(self, database: str) -> str:
+        """The DSN of *database* on this server (TCP, password from ``<dir>/pgpass``)."""
+        return _dsn(self.dir, self.port, database)
+
     @property
     def admin_dsn(self) -> str:
-        return f"postgresql://{SERVER_USER}@127.0.0.1:{self.port}/postgres"
+        return self.dsn_of("postgres")
+
+
+def _dsn(dir: Path, port: int, database: str) -> str:
+    from urllib.parse import quote
+
+    return (f"postgresql://{SERVER_USER}@127.0.0.1:{port}/{database}"
+            f"?passfile={quote(str(dir / PASSFILE), safe='/')}")
+
+
+#: the password file of a cluster folder (``.pgpass`` format)
+PASSFILE = "pgpass"
+
+#: client authentication: the unix socket (mode 0700) trusts the server's user, TCP asks for
+#: the password
+HBA = """\
+# written by vipvflow db start
+local   all  all                 trust
+host    all  all  127.0.0.1/32   scram-sha-256
+host    all  all  ::1/128        scram-sha-256
+"""
 
 
 def find_bindir() -> Path | None:
@@ -117,6 +145,8 @@ def _conf(port: int, socket_dir: Path, durable: bool) -> str:
         "listen_addresses = '127.0.0.1'",
         f"port = {port}",
         f"unix_socket_directories = '{socket_dir}'",
+        "unix_socket_permissions = 0700",
+        "password_encryption = 'scram-sha-256'",
         "max_connections = 30",
         "shared_buffers = 64MB",
         "max_wal_size = 1GB",
@@ -165,6 +195,8 @@ def start(dir: str | Path, port: int | None = None, durable: bool = True,
     pgdata, socket_dir = dir / "pgdata", dir / "socket"
     dir.mkdir(parents=True, exist_ok=True)
     socket_dir.mkdir(exist_ok=True)
+    for private in (dir, socket_dir):        # the socket and the password: the server's user only
+        os.chmod(private, 0o700)
     fresh = not (pgdata / "PG_VERSION").exists()
     if fresh:
         pgdata.mkdir(exist_ok=True)
@@ -177,6 +209,7 @@ def start(dir: str | Path, port: int | None = None, durable: bool = True,
     for attempt in range(3):
         use_port = port or free_port()
         (pgdata / "vipvflow.conf").write_text(_conf(use_port, socket_dir, durable))
+        (pgdata / "pg_hba.conf").write_text(HBA)
         _give_to_server_user(dir)
         try:
             _run([str(bindir / "pg_ctl"), "start", "-D", str(pgdata), "-w", "-t", "60",
@@ -186,8 +219,11 @@ def start(dir: str | Path, port: int | None = None, durable: bool = True,
             if port is not None or attempt == 2:  # a chosen port is not changed behind one's back
                 log_tail = _log_tail(dir)
                 raise ServerError(f"PostgreSQL did not start on port {use_port}: {log_tail}") from None
-    server = LocalServer(dir=dir, port=use_port,
-                         dsn=f"postgresql://{SERVER_USER}@127.0.0.1:{use_port}/{DATABASE}")
+    server = LocalServer(dir=dir, port=use_port, dsn=_dsn(dir, use_port, DATABASE))
+    password = _ensure_password(server)
+    if password:
+        say(f"password of the '{SERVER_USER}' role on 127.0.0.1 (shown once; kept in "
+            f"{dir / PASSFILE}, mode 0600, which the DSN names): {password}")
     _create_database(server)
     (dir / "server.json").write_text(json.dumps({"port": use_port, "dsn": server.dsn}))
     say(f"PostgreSQL {bindir.parent.name} + PostGIS running from {dir} on 127.0.0.1:{use_port}")
@@ -202,13 +238,42 @@ def _log_tail(dir: Path) -> str:
     return " | ".join(lines[-3:])
 
 
+def _socket(server: LocalServer, database: str) -> dict:
+    """Connection arguments of the unix socket (trusted: only the server's user opens it)."""
+    return {"host": str(server.dir / "socket"), "port": server.port, "user": SERVER_USER,
+            "dbname": database}
+
+
+def _ensure_password(server: LocalServer) -> str | None:
+    """Give the ``postgres`` role a generated password kept in ``<dir>/pgpass`` (mode 0600),
+    unless the file exists; returns the new password, or None."""
+    import psycopg
+    from psycopg import sql
+
+    passfile = server.dir / PASSFILE
+    if passfile.is_file():
+        return None
+    password = secrets.token_urlsafe(24)
+    fd = os.open(passfile, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
+    with os.fdopen(fd, "w") as f:
+        f.write(f"127.0.0.1:*:*:{SERVER_USER}:{password}\nlocalhost:*:*:{SERVER_USER}:{password}\n")
+    try:
+        with psycopg.connect(**_socket(server, "postgres"), autocommit=True, connect_timeout=10) as conn:
+            conn.execute(sql.SQL("ALTER ROLE {} PASSWORD {}").format(
+                sql.Identifier(SERVER_USER), sql.Literal(password)))
+    except BaseException:
+        passfile.unlink(missing_ok=True)
+        raise
+    return password
+
+
 def _create_database(server: LocalServer) -> None:
     import psycopg
 
     deadline = time.monotonic() + 30
     while True:
         try:
-            with psycopg.connect(server.admin_dsn, autocommit=True, connect_timeout=5) as conn:
+            with psycopg.connect(**_socket(server, "postgres"), autocommit=True, connect_timeout=5) as conn:
                 if not conn.execute("SELECT 1 FROM pg_database WHERE datname = %s",
                                     (DATABASE,)).fetchone():
                     conn.execute(f"CREATE DATABASE {DATABASE}")

@@ -171,11 +171,6 @@ class RunData:
         return self.run_dir / "segments.parquet"
 
 
-def _run_data_dir(run_dir: Path, manifest: dict) -> Path:
-    """The data directory of the run (as its configuration names it)."""
-    return Path(manifest.get("config", {}).get("data_dir", ""))
-
-
 def load_run(run_dir: str | Path) -> RunData:
     """The outputs of a finished run that the export needs (InputError names what is missing)."""
     run_dir = Path(run_dir)
@@ -185,8 +180,10 @@ def load_run(run_dir: str | Path) -> RunData:
     missing = [n for n in need if not (run_dir / n).exists()]
     if missing:
         raise InputError(f"{run_dir}: not a finished run (missing {', '.join(missing)})")
-    manifest = json.loads((run_dir / "manifest.json").read_text())
-    data_dir = _run_data_dir(run_dir, manifest)
+    from ..simulation.rundir import open_run
+
+    run = open_run(run_dir)          # the data dir found from anywhere (run folders travel)
+    manifest, data_dir = run.manifest, run.data_dir
     tz = "UTC"
     feed = data_dir / "gtfs" / "feed.json"
     if feed.exists():

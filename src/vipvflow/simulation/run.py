@@ -7,6 +7,8 @@ import importlib.util
 import json
 import logging
 import os
+import shutil
+import sys
 import threading
 import time
 from pathlib import Path
@@ -18,6 +20,7 @@ from ..errors import InputError
 from ..progress import FolderProgress, MapProgress
 from .partition import RunContext, partition_done, run_partition, tile_geometry, worker_bvh_builds
 from .standing import run_standing, standing_done, write_timeline
+from .rundir import data_dir_record, masked_config
 from .storage import write_json
 
 log = logging.getLogger(__name__)
@@ -31,15 +34,45 @@ def _months(cfg: Config, year: int) -> list[str]:
     return [f"{year}-{m:02d}" for m in cfg.run.months]
 
 
-def _reset_if_config_changed(run_dir: Path, digest: str) -> None:
-    """Partitions are reused only by a run of the same configuration."""
-    stamp = run_dir / "parts" / "config_digest.txt"
-    if stamp.exists() and stamp.read_text().strip() != digest:
-        import shutil
+CONFIG_STAMP = ("parts", "config_digest.txt")
 
-        shutil.rmtree(run_dir / "parts")
+
+def _digest_in(run_dir: Path) -> str | None:
+    """The configuration digest of the run (finished or partial) in *run_dir*, if any."""
+    stamp = run_dir.joinpath(*CONFIG_STAMP)
+    if stamp.is_file():
+        return stamp.read_text().strip()
+    try:
+        return json.loads((run_dir / "manifest.json").read_text()).get("config_digest")
+    except (OSError, ValueError, AttributeError):
+        return None
+
+
+def claim_run_dir(run_dir: Path, digest: str, force: bool = False, say=print) -> None:
+    """Make *run_dir* the folder of a run of configuration *digest*.
+
+    A folder holding a run (finished or partial) of another configuration is refused with
+    both digests named; with *force* it is replaced as a whole: renamed aside in one step,
+    then deleted, so that an interruption leaves either the old run or the new one, never
+    parts of both. Folders left aside by an interrupted replacement are removed.
+    """
+    for stale in run_dir.parent.glob(f".{run_dir.name}.replaced-*"):
+        shutil.rmtree(stale, ignore_errors=True)
+    other = _digest_in(run_dir)
+    if other is not None and other != digest:
+        if not force:
+            raise InputError(
+                f"{run_dir}: holds a run of another configuration (digest {other}; this "
+                f"configuration's digest is {digest}): pass --force to replace it, or set "
+                "another scenario or out_dir")
+        aside = run_dir.parent / f".{run_dir.name}.replaced-{other}-{os.getpid()}"
+        os.replace(run_dir, aside)
+        say(f"replacing the run of configuration {other} in {run_dir}")
+        shutil.rmtree(aside, ignore_errors=True)
+    stamp = run_dir.joinpath(*CONFIG_STAMP)
     stamp.parent.mkdir(parents=True, exist_ok=True)
-    stamp.write_text(digest)
+    if not stamp.is_file():
+        stamp.write_text(digest)
 
 
 #: Dask settings of a LocalCluster started by a run, whose processes share the machine's
@@ -71,7 +104,10 @@ def make_client(cfg: Config, scheduler: str | None, n_workers: int | None):
     if scheduler:
         return Client(scheduler), None
     n = n_workers or cfg.dask.n_workers or os.cpu_count() or 1
-    settings = {**LOCAL_CLUSTER_DASK_CONFIG, "distributed.worker.profile.enabled": cfg.dask.worker_profile}
+    settings = {**LOCAL_CLUSTER_DASK_CONFIG, "distributed.worker.profile.enabled": cfg.dask.worker_profile,
+                # workers ignore Ctrl-C and leave a task's failure for this process to report
+                "distributed.worker.preload": ["vipvflow.simulation.worker_setup"],
+                "vipvflow.worker-failure-log": log.isEnabledFor(logging.INFO)}
     with dask.config.set(settings):     # the nannies hand this configuration to their workers
         cluster = LocalCluster(n_workers=n, threads_per_worker=cfg.dask.threads_per_worker or 1,
                                processes=True, memory_limit=cfg.dask.memory_limit,
@@ -125,10 +161,13 @@ def plan(cfg: Config, year: int) -> pd.DataFrame:
 
 
 def run_simulation(cfg: Config, year: int, scheduler: str | None = None,
-                   n_workers: int | None = None, say=print, max_partitions: int | None = None) -> Path:
+                   n_workers: int | None = None, say=print, max_partitions: int | None = None,
+                   force: bool = False) -> Path:
     """Compute the scenario's fleet-year and write all outputs; returns the run directory.
 
     An interrupted run resumes: finished partitions (written atomically) are not recomputed.
+    A run directory holding a run of another configuration is refused (:class:`InputError`
+    naming both digests), or with *force* replaced as a whole (see :func:`claim_run_dir`).
     *max_partitions* stops after that many new partitions (for tests of resuming).
     """
     from .prepare import check_year, ensure_demo, ensure_ingested, preflight
@@ -140,12 +179,11 @@ def run_simulation(cfg: Config, year: int, scheduler: str | None = None,
     ensure_demo(cfg, year, say=say)
     checksums = ensure_ingested(cfg, say=say)
     preflight(cfg, year, say=say)
+    run_dir = run_dir_of(cfg, year)
+    claim_run_dir(run_dir, cfg.digest(), force=force, say=say)
     timings["prepare_s"] = time.perf_counter() - t_start
 
     data_dir = Path(cfg.data_dir)
-    run_dir = run_dir_of(cfg, year)
-    run_dir.mkdir(parents=True, exist_ok=True)
-    _reset_if_config_changed(run_dir, cfg.digest())
     feed = json.loads((data_dir / "gtfs" / "feed.json").read_text())
     trips, shapes, tiles = selected_network(cfg)
     routes = cfg.run.routes
@@ -282,7 +320,9 @@ def _write_manifest(cfg, year, run_dir, checksums, timings, results, builds) -> 
             stage[k] = stage.get(k, 0.0) + v
     manifest = {
         "scenario": cfg.scenario, "year": year, "config_digest": cfg.digest(),
-        "config": cfg.model_dump(mode="json"), "inputs_sha256": checksums, "versions": versions,
+        "config": masked_config(cfg.model_dump(mode="json")),
+        "paths": {"data_dir": data_dir_record(cfg.data_dir, run_dir)},
+        "inputs_sha256": checksums, "versions": versions,
         "timings_s": {k: round(v, 3) for k, v in timings.items()},
         "partition_timings_s": {k: round(v, 3) for k, v in stage.items()},
         "partitions_computed": sum(1 for r in results if "intervals" not in r),

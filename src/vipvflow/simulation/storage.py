@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import json
 import os
+from contextlib import contextmanager
 from pathlib import Path
 
 import pandas as pd
@@ -36,6 +37,23 @@ def _plain_table(df: pd.DataFrame):
     return pa.Table.from_arrays(arrays, names=[str(c) for c in df.columns])
 
 
+@contextmanager
+def _atomic(path: Path):
+    """The temporary name to write *path* under, renamed to *path* when the block ends; on
+    failure the temporary file is removed and an OSError names *path* (a full disk's
+    ``ENOSPC`` from a write names no file)."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    try:
+        yield tmp
+        os.replace(tmp, path)
+    except BaseException as exc:
+        tmp.unlink(missing_ok=True)
+        if isinstance(exc, OSError) and exc.errno and not exc.filename:
+            raise OSError(exc.errno, os.strerror(exc.errno), str(path)) from exc
+        raise
+
+
 def write_parquet(df: pd.DataFrame, path: Path) -> Path:
     """Write *df* (DataFrame or GeoDataFrame) to *path* atomically (temporary name, rename).
 
@@ -48,17 +66,15 @@ def write_parquet(df: pd.DataFrame, path: Path) -> Path:
 
     from .dictionary import OUTPUTS, annotate
 
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
     output = path.stem if path.suffix == ".parquet" and path.stem in OUTPUTS else None
-    table = _plain_table(df)
-    if table is None and output is not None:
-        table = _arrow_table(df)
-    if table is None:
-        df.to_parquet(tmp, index=False)
-    else:
-        pq.write_table(annotate(table, output) if output else table, tmp)
-    os.replace(tmp, path)
+    with _atomic(path) as tmp:
+        table = _plain_table(df)
+        if table is None and output is not None:
+            table = _arrow_table(df)
+        if table is None:
+            df.to_parquet(tmp, index=False)
+        else:
+            pq.write_table(annotate(table, output) if output else table, tmp)
     return path
 
 
@@ -76,10 +92,8 @@ def _arrow_table(df: pd.DataFrame):
 
 
 def write_json(obj, path: Path) -> Path:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    tmp.write_text(json.dumps(obj, indent=2, default=str))
-    os.replace(tmp, path)
+    with _atomic(path) as tmp:
+        tmp.write_text(json.dumps(obj, indent=2, default=str))
     return path
 
 

@@ -1,0 +1,28 @@
+"""Set-up of the worker processes of a run's LocalCluster (a Dask worker preload).
+
+The workers share the terminal's process group with the ``vipvflow`` command: Ctrl-C reaches
+them too. They ignore it (the command closes the cluster), instead of each printing a
+``KeyboardInterrupt`` traceback. A task's failure reaches the command, which prints it as one
+line (a :class:`vipvflow.errors.VipvError`) or with its traceback (a bug): the worker's own
+"Compute Failed ... Traceback" log of the same failure is left out unless the command runs
+with ``-v`` (Dask setting ``vipvflow.worker-failure-log``).
+"""
+from __future__ import annotations
+
+import logging
+import signal
+
+
+def _not_compute_failed(record: logging.LogRecord) -> bool:
+    return not (isinstance(record.msg, str) and record.msg.startswith("Compute Failed"))
+
+
+def dask_setup(worker) -> None:
+    import dask
+
+    try:
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+    except ValueError:      # not the process's main thread: a worker not started by a nanny
+        pass
+    if not dask.config.get("vipvflow.worker-failure-log", False):
+        logging.getLogger("distributed.worker").addFilter(_not_compute_failed)
