@@ -85,7 +85,7 @@ def test_scenarios_by_name_from_any_directory(tmp_path, monkeypatch):
     from vipvflow.config import scenario_path, shipped_scenarios
 
     monkeypatch.chdir(tmp_path)
-    assert shipped_scenarios() == ["demo", "luxembourg"]
+    assert shipped_scenarios() == ["demo", "luxembourg", "paper"]
     for name in ("demo", "demo.yaml", "conf/demo.yaml"):
         assert scenario_path(name) == CONF_DIR / "demo.yaml"
         assert load_config(name).scenario == "demo"

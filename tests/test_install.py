@@ -81,7 +81,7 @@ def test_installed_config_from_another_directory(installed, tmp_path):
                          env=installed["env"], capture_output=True, text=True)
     assert bad.returncode == 2 and "Traceback" not in bad.stderr
     assert bad.stderr.strip().splitlines() == [
-        "vipvflow config: error: nowhere: file not found (shipped scenarios by name: demo, luxembourg)"]
+        "vipvflow config: error: nowhere: file not found (shipped scenarios by name: demo, luxembourg, paper)"]
 
 
 def test_installed_small_simulation_writes_under_out(installed, tmp_path):

@@ -9,7 +9,7 @@ from ..config import load_config
 def register(sub):
     p = sub.add_parser("config", help="validate a scenario YAML and print the merged configuration")
     p.add_argument("--config", "-c", default=None, help="scenario YAML or a shipped scenario's name "
-                   "(demo, luxembourg); default: the defaults alone")
+                   "(demo, luxembourg, paper); default: the defaults alone")
     p.set_defaults(func=run)
 
 

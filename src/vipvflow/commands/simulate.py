@@ -13,7 +13,7 @@ def register(sub):
                        "every trip of the year per (tile, month) partition, reduce and write "
                        "out/<scenario>/<year>/. Re-running resumes an interrupted run.")
     p.add_argument("--config", "-c", default="demo",
-                   help="scenario YAML, or a shipped scenario's name: demo (default), luxembourg")
+                   help="scenario YAML, or a shipped scenario's name: demo (default), luxembourg, paper")
     p.add_argument("--year", type=int, required=True)
     p.add_argument("--out", type=Path, default=None,
                    help="folder for the scenario's relative data_dir and out_dir (and the demo's "
