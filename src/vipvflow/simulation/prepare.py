@@ -262,6 +262,11 @@ def preflight(cfg: Config, year: int, say=print) -> dict:
         first, last = loc["start_utc"] + 30, loc["end_utc"] - 30
         missing = (lo < first) | (hi > last)
         if missing.any():
+            # hours outside the data at night need none (every radiation value is 0 then):
+            # a service day running past the end of a calendar-year file, say
+            missing[missing] = ~_dark(np.maximum(lo[missing], last), hi[missing], loc) | \
+                ~_dark(lo[missing], np.minimum(hi[missing], first), loc)
+        if missing.any():
             raise InputError(
                 f"{report_path.parent / 'radiation.parquet'}: radiation at "
                 f"{loc['lat']:.4f}, {loc['lon']:.4f} covers {_day(loc['start_utc'])} to "
@@ -285,6 +290,23 @@ def preflight(cfg: Config, year: int, say=print) -> dict:
             "interpolated")
     return {"service_days": int(len(days)), "radiation_gaps_interpolated": n_short,
             "radiation_gap_minutes_interpolated": int(short_min)}
+
+
+def _dark(t0, t1, loc: dict, step_s: float = 300.0):
+    """Whether the sun stays below the horizon (apparent elevation < -1 deg) at the radiation
+    location from *t0* to *t1* (Unix s, arrays; an empty span is dark)."""
+    import numpy as np
+    import pandas as pd
+    import pvlib
+
+    out = np.ones(len(t0), bool)
+    for i, (a, b) in enumerate(zip(np.asarray(t0, float), np.asarray(t1, float))):
+        if b <= a:
+            continue
+        times = pd.to_datetime(np.append(np.arange(a, b, step_s), b), unit="s", utc=True)
+        sun = pvlib.solarposition.get_solarposition(times, loc["lat"], loc["lon"])
+        out[i] = bool((sun["apparent_elevation"] < -1.0).all())
+    return out
 
 
 def _calendar_range(gdir: Path) -> tuple[str, str]:
