@@ -59,7 +59,7 @@ def _finished(run_dir: Path) -> bool:
 
 
 def _demo_run(tiny: bool) -> tuple[Path, str]:
-    from .common import demo_config, prepare_demo, run_pipeline
+    from .common import demo_config, fresh_dir, prepare_demo, run_pipeline
 
     env = os.environ.get("VIPVFLOW_BENCH_EXPORT_RUN")
     if env and not tiny:
@@ -69,12 +69,24 @@ def _demo_run(tiny: bool) -> tuple[Path, str]:
         return local, "out/demo/2024"
     size = "small" if tiny else "full"
     prepare_demo(size)
-    cfg = demo_config(size, months=[6] if tiny else None, scenario=f"bench-export-{size}")
+    # a fresh output folder (deleted after the export): never a run of an older configuration
+    cfg = demo_config(size, months=[6] if tiny else None, scenario=f"bench-export-{size}",
+                      out_dir=fresh_dir(f"export-{size}"))
     return run_pipeline(cfg)["run_dir"], f"fresh {size} demo run"
 
 
 def run(tiny: bool = False) -> dict:
+    from .common import remove
+
     run_dir, source = _demo_run(tiny)
+    try:
+        return _measure(run_dir, source)
+    finally:
+        if source.startswith("fresh"):
+            remove(run_dir.parents[1])
+
+
+def _measure(run_dir: Path, source: str) -> dict:
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
         inline = _export(run_dir, tmp / "inline.gml", encoding="inline", aggregate="segment")
