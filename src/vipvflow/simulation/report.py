@@ -181,8 +181,16 @@ _ROWS = [
     ("Fleet and network", "passes", "segment passes evaluated", "", 0, False),
     ("Fleet and network", "service_hours_per_bus_year", "service time per bus", "h/year", 0, False),
     ("PV yield", "kwp_per_bus", "PV installed per bus", "kWp", 2, False),
-    ("PV yield", "kwh_per_kwp_allsky", "specific yield, all-sky", "kWh/kWp per year", 0, False),
-    ("PV yield", "kwh_per_kwp_clearsky", "specific yield, clear-sky", "kWh/kWp per year", 0, False),
+    ("PV yield", "kwh_per_kwp_allsky", "specific yield while driving, all-sky", "kWh/kWp per year", 0, False),
+    ("PV yield", "kwh_per_kwp_clearsky", "specific yield while driving, clear-sky", "kWh/kWp per year", 0, False),
+    ("PV yield", "kwh_per_kwp_in_service", "specific yield in service (driving + layovers), all-sky",
+     "kWh/kWp per year", 0, False),
+    ("PV yield", "kwh_per_kwp_whole_day", "specific yield over the whole day (+ parked), all-sky",
+     "kWh/kWp per year", 0, False),
+    ("PV yield", "pv_kwh_layover", "PV energy at terminals between trips", "kWh (simulated months)", 0, False),
+    ("PV yield", "pv_kwh_parked", "PV energy parked at the depot", "kWh (simulated months)", 0, False),
+    ("PV yield", "pv_kwh_curtailed", "PV energy the batteries could not take (curtailed)",
+     "kWh (simulated months)", 0, False),
     ("PV yield", "pv_kwh_allsky", "PV energy of the fleet, all-sky", "kWh (simulated months)", 0, False),
     ("PV yield", "pv_kwh_clearsky", "the same under a cloudless sky", "kWh (simulated months)", 0, False),
     ("PV yield", "pv_kwh_allsky_unshaded", "the same, all-sky, without buildings", "kWh (simulated months)", 0, False),
@@ -266,8 +274,13 @@ def _how_to_read(summary: dict) -> str:
         "3D city model's buildings casting shadows, hiding sky and reflecting light, and turns it "
         "into PV energy. <b>Specific yield</b> is the PV energy per installed kWp in a year: "
         f"{_fmt(s.get('kwh_per_kwp_allsky'), 0)} kWh/kWp here under the real (all-sky) weather, "
-        f"{_fmt(s.get('kwh_per_kwp_clearsky'), 0)} under a cloudless sky. A bus roof receives "
-        "light only while the bus is in service, and partly in the streets' shade, so it collects "
+        f"{_fmt(s.get('kwh_per_kwp_clearsky'), 0)} under a cloudless sky, counting the minutes "
+        "the buses drive their trips. The roof keeps harvesting while a bus stands at a terminal "
+        "between trips and while it is parked: "
+        f"{_fmt(s.get('kwh_per_kwp_in_service'), 0)} kWh/kWp in service (driving and layovers) and "
+        f"{_fmt(s.get('kwh_per_kwp_whole_day'), 0)} over the whole day (fleet.harvest: "
+        f"{html.escape(str(s.get('harvest', 'driving')))}); coverage, cycles and payback use what the "
+        "batteries can take. A bus roof is partly in the streets' shade, so it collects "
         "less than a fixed panel at the site would. The <b>shading loss</b> "
         f"({pct('shading_loss_allsky')} %) is the direct and sky light the buildings take away; the "
         f"light they reflect onto the roof is counted apart ({pct('reflection_gain_allsky')} %). "
