@@ -397,3 +397,23 @@ def test_demo_line_segments_and_trips_per_year(tmp_path):
                .groupby("direction_id").size())
     expected = demo_gtfs.trips_per_year("1", 2024)["per_direction"]
     assert {str(k): int(v) for k, v in per_dir.items()} == expected     # 20,570 each way
+
+
+def test_reingest_replaces_gtfs_folder_as_a_whole(tmp_path):
+    """A new ingest swaps a whole new gtfs/ in: nothing of the old folder stays beside the new
+    files, and the folder a killed ingest left (its process gone) is removed."""
+    import subprocess
+
+    ingest_gtfs(LUX, tmp_path, TrajectoryCfg(), crs="EPSG:2169")
+    (tmp_path / "gtfs" / "left-over.parquet").write_bytes(b"old")
+    proc = subprocess.Popen(["true"])          # a pid whose process has surely exited
+    proc.wait()
+    stale = tmp_path / f".gtfs-ingest-{proc.pid}"
+    stale.mkdir()
+    (stale / "segments.parquet").write_bytes(b"half")
+    before = json.loads((tmp_path / "gtfs" / "feed.json").read_text())["counts"]
+    ingest_gtfs(LUX, tmp_path, TrajectoryCfg(), crs="EPSG:2169")
+    assert not (tmp_path / "gtfs" / "left-over.parquet").exists()
+    assert not stale.exists()
+    assert json.loads((tmp_path / "gtfs" / "feed.json").read_text())["counts"] == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["gtfs"]

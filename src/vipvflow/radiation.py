@@ -36,6 +36,7 @@ import numpy as np
 import pandas as pd
 
 from .errors import InputError
+from .files import staging_dir, swap_dir
 
 log = logging.getLogger(__name__)
 
@@ -477,20 +478,17 @@ def ingest_cams(paths, data_dir, clear_sky_margin=CLEAR_SKY_MARGIN) -> dict:
                           "gaps": gap_runs(grid["t_utc"].to_numpy(), grid["flag"].to_numpy()),
                           "all_sky_from_clear_sky": bool((grid["flag"] & FLAG_NO_ALLSKY).any())})
     table = pd.concat(parts, ignore_index=True)
-    out_dir = Path(data_dir) / "radiation"
-    out_dir.mkdir(parents=True, exist_ok=True)
-    target = out_dir / "radiation.parquet"
-    tmp = out_dir / "radiation.parquet.tmp"
-    table.to_parquet(tmp, index=False)
-    tmp.replace(target)
+    # a new radiation/ folder, swapped in as a whole (table, report; the sun caches rebuild)
+    final = Path(data_dir) / "radiation"
+    out_dir = staging_dir(final)
+    table.to_parquet(out_dir / "radiation.parquet", index=False)
     report = {"files": files, "locations": locations, "grid_step_s": _GRID_S,
               "time_stamp": "centre of each minute (Unix s)", "units": "W/m2 mean over the minute",
               "flags": {"gap": FLAG_GAP, "negative": FLAG_NEGATIVE, "ghi_above_toa": FLAG_GHI_TOA,
                         "ghi_above_clear": FLAG_GHI_CLEAR, "dni_above_extra": FLAG_DNI_EXTRA,
                         "all_sky_from_clear_sky": FLAG_NO_ALLSKY}}
-    tmp = out_dir / "ingest_report.json.tmp"
-    tmp.write_text(json.dumps(report, indent=2))
-    tmp.replace(out_dir / "ingest_report.json")
+    (out_dir / "ingest_report.json").write_text(json.dumps(report, indent=2))
+    swap_dir(out_dir, final)
     return report
 
 

@@ -22,6 +22,7 @@ import numpy as np
 import pandas as pd
 
 from ..errors import InputError
+from ..files import staging_dir, swap_dir
 from .feed import read_feed
 from .schedule import pattern_segment_times, project_stops_monotone
 from .segments import build_segments, cumulative_distance, project_shapes
@@ -379,9 +380,11 @@ def ingest_gtfs(feed_path, data_dir, traj_cfg, crs=None, dist_units: str | None 
         "start_s": trips["start_s"],
     }).sort_values(["route_id", "start_s", "trip_id"], kind="stable", ignore_index=True)
 
-    # ---- write ----------------------------------------------------------------------------
+    # ---- write: into a new folder, swapped in for gtfs/ as a whole at the end -------------
     import geopandas as gpd
 
+    # (a folder a failed write leaves is removed by the next ingest, once its process is gone)
+    final, out = out, staging_dir(out)
     gseg = gpd.GeoDataFrame(segs, geometry=geom, crs=crs_obj)
     _atomic(out / "segments.parquet", lambda p: gseg.to_parquet(p, index=False))
     _atomic(out / "trips.parquet", lambda p: trips_out.to_parquet(p, index=False))
@@ -426,4 +429,5 @@ def ingest_gtfs(feed_path, data_dir, traj_cfg, crs=None, dist_units: str | None 
         "seconds": round(time.perf_counter() - t_start, 2),
     }
     _atomic(out / "feed.json", lambda p: p.write_text(json.dumps(report, indent=2)))
+    swap_dir(out, final)
     return report
