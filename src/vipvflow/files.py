@@ -23,7 +23,7 @@ def staging_dir(final: str | Path) -> Path:
     final.parent.mkdir(parents=True, exist_ok=True)
     for old in final.parent.glob(f".{final.name}-ingest-*"):
         pid = old.name.rsplit("-", 1)[-1]
-        if pid.isdigit() and not _alive(int(pid)):
+        if pid.isdigit() and not pid_alive(int(pid)):
             shutil.rmtree(old, ignore_errors=True)
     stage = final.with_name(f".{final.name}-ingest-{os.getpid()}")
     shutil.rmtree(stage, ignore_errors=True)
@@ -42,7 +42,8 @@ def swap_dir(new: Path, final: Path) -> None:
     shutil.rmtree(old, ignore_errors=True)
 
 
-def _alive(pid: int) -> bool:
+def pid_alive(pid: int) -> bool:
+    """Whether a process of this id runs (it may be another user's)."""
     try:
         os.kill(pid, 0)
     except ProcessLookupError:

@@ -39,6 +39,7 @@ import numpy as np
 
 from ..config import CityCfg
 from ..errors import InputError
+from ..files import pid_alive
 from ..mesh import SURFACE_CODE, SURFACE_TYPES, TileMesh
 from ..progress import Progress, citygml_bytes, file_position
 from ..tiles import tile_bounds, tile_index, tile_name
@@ -586,21 +587,9 @@ def _swap_in(new: Path, final: Path) -> None:
     shutil.rmtree(old, ignore_errors=True)
 
 
-def _pid_alive(pid: int) -> bool:
-    if pid == os.getpid():
-        return True
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except PermissionError:
-        return True
-    return True
-
-
 def _stale(path: Path, prefix: str) -> bool:
     tail = path.name[len(prefix):]
-    return tail.isdigit() and not _pid_alive(int(tail))
+    return tail.isdigit() and not pid_alive(int(tail))
 
 
 def remove_stale_ingests(data_dir: Path) -> list[Path]:
