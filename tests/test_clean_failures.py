@@ -122,7 +122,9 @@ def probe_ctrl_c(small_config, tmp_path, mounts):
         if not sent and any(parts.glob("*/2024/parts/segment_month/tile=*/month=*.parquet")):
             os.killpg(proc.pid, signal.SIGINT)
             sent["at"] = len(list(parts.glob("*/2024/parts/segment_month/tile=*/month=*.parquet")))
-    rc, _, err = _simulate(config, on_output=interrupt)
+    # as from a terminal: Ctrl-C handled by default (an ignored SIGINT would be inherited)
+    rc, _, err = _simulate(config, on_output=interrupt,
+                           preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     assert sent, err
     return rc, err, ["vipvflow: interrupted"]
 

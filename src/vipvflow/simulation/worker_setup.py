@@ -20,9 +20,14 @@ def _not_compute_failed(record: logging.LogRecord) -> bool:
 def dask_setup(worker) -> None:
     import dask
 
-    try:
-        signal.signal(signal.SIGINT, signal.SIG_IGN)
-    except ValueError:      # not the process's main thread: a worker not started by a nanny
-        pass
+    import multiprocessing
+
+    # only a worker process of its own (started by a nanny): a worker inside the command's or a
+    # test's process must leave that process's Ctrl-C alone (its children would inherit it)
+    if multiprocessing.parent_process() is not None:
+        try:
+            signal.signal(signal.SIGINT, signal.SIG_IGN)
+        except ValueError:      # not the process's main thread
+            pass
     if not dask.config.get("vipvflow.worker-failure-log", False):
         logging.getLogger("distributed.worker").addFilter(_not_compute_failed)
