@@ -35,8 +35,8 @@ _db_counter = itertools.count()
 # ---------------------------------------------------------------- fixtures
 
 @pytest.fixture(scope="session")
-def pg():
-    """A PostgreSQL + PostGIS cluster in a temporary folder on a free port, for the session.
+def postgis_bindir():
+    """The PostgreSQL server programs' folder, PostGIS installed for them.
 
     Skipped with what to install when the server programs or PostGIS are absent (a failure
     under ``VIPVFLOW_REQUIRE_SYSTEM_DEPS=1``, as in CI).
@@ -47,6 +47,12 @@ def pg():
                                "postgresql-15 postgresql-15-postgis-3")
     if not pgserver.postgis_available(bindir):
         missing_system_package(f"PostGIS not installed for {bindir}", "postgresql-15-postgis-3")
+    return bindir
+
+
+@pytest.fixture(scope="session")
+def pg(postgis_bindir):
+    """A PostgreSQL + PostGIS cluster in a temporary folder on a free port, for the session."""
     folder = tempfile.mkdtemp(prefix="vipvflow-pg-")  # under /tmp: reachable by 'postgres'
     srv = pgserver.start(folder, durable=False, say=lambda msg: None)
     try:
@@ -365,7 +371,7 @@ def test_server_socket_is_private_and_tcp_asks_for_the_password(pg):
         assert conn.execute("SELECT 1").fetchone()[0] == 1
 
 
-def test_db_start_prints_the_password_once():
+def test_db_start_prints_the_password_once(postgis_bindir):
     folder = tempfile.mkdtemp(prefix="vipvflow-pg-cli-")   # under /tmp: reachable by 'postgres'
     try:
         first = _cli("db", "start", "--dir", folder)
