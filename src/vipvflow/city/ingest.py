@@ -39,7 +39,7 @@ import numpy as np
 
 from ..config import CityCfg
 from ..errors import InputError
-from ..files import pid_alive
+from ..files import pid_alive, remove_stale, staging_dir, swap_dir
 from ..mesh import SURFACE_CODE, SURFACE_TYPES, TileMesh
 from ..progress import Progress, citygml_bytes, file_position
 from ..tiles import tile_bounds, tile_index, tile_name
@@ -365,10 +365,7 @@ def ingest_city(paths, data_dir, city_cfg: CityCfg | None = None, crs: str | Non
     data_dir.mkdir(parents=True, exist_ok=True)
     remove_stale_ingests(data_dir)
     final_dir = data_dir / "city"
-    city_dir = data_dir / f".city-ingest-{os.getpid()}"
-    if city_dir.exists():
-        shutil.rmtree(city_dir)
-    city_dir.mkdir()
+    city_dir = staging_dir(final_dir)           # data_dir/.city-ingest-<pid>, swapped in at the end
     albedo = cfg.albedo.model_dump()
     report = IngestReport(crs_source="--crs" if target else "")
     counts = _Counts()
@@ -433,7 +430,7 @@ def ingest_city(paths, data_dir, city_cfg: CityCfg | None = None, crs: str | Non
         report.elapsed_s = round(time.perf_counter() - t0, 3)
         report.report_path = str(final_dir / "ingest_report.json")
         _atomic_json(city_dir / "ingest_report.json", json.loads(report.to_json()))
-        _swap_in(city_dir, final_dir)
+        swap_dir(city_dir, final_dir)
     except BaseException:
         bar.close(failed=True)
         raise
@@ -575,45 +572,22 @@ def _check_not_empty(report: IngestReport, counts: _Counts, ignored: Counter,
                          f"(skipped: {why}); {kept}")
 
 
-def _swap_in(new: Path, final: Path) -> None:
-    """Replace directory *final* by *new* (two renames; :func:`remove_stale_ingests` repairs
-    a kill between them)."""
-    old = final.with_name(f".city-old-{os.getpid()}")
-    if final.exists():
-        if old.exists():
-            shutil.rmtree(old)
-        final.rename(old)
-    new.rename(final)
-    shutil.rmtree(old, ignore_errors=True)
-
-
-def _stale(path: Path, prefix: str) -> bool:
-    tail = path.name[len(prefix):]
-    return tail.isdigit() and not pid_alive(int(tail))
-
-
 def remove_stale_ingests(data_dir: Path) -> list[Path]:
     """Remove what killed city ingests left in *data_dir*; return the paths removed.
 
-    ``.city-ingest-<pid>`` (an unfinished new city) and ``city/.ingest-spool-<pid>`` (spools of
-    older versions) go when their process is gone; ``.city-old-<pid>`` (the previous city,
-    when the kill came between the two renames of the swap) is put back if ``city/`` is
-    missing, else removed.
+    ``.city-ingest-<pid>`` and ``.city-old-<pid>`` as :func:`vipvflow.files.remove_stale`
+    says (the previous city put back when a kill left none), and ``city/.ingest-spool-<pid>``
+    (spools of older versions) when their process is gone.
     """
     data_dir = Path(data_dir)
-    removed = []
     final = data_dir / "city"
-    for p in sorted(data_dir.glob(".city-old-*")):
-        if _stale(p, ".city-old-"):
-            if not final.exists():
-                p.rename(final)
-                log.warning("restored %s from an interrupted ingest", final)
-                continue
-            shutil.rmtree(p, ignore_errors=True)
-            removed.append(p)
-    for p in [*data_dir.glob(".city-ingest-*"), *final.glob(".ingest-spool-*")]:
-        prefix = ".city-ingest-" if p.name.startswith(".city-ingest-") else ".ingest-spool-"
-        if p.is_dir() and _stale(p, prefix):
+    had_city = final.exists()
+    removed = remove_stale(final)
+    if not had_city and final.exists():
+        log.warning("restored %s from an interrupted ingest", final)
+    for p in final.glob(".ingest-spool-*"):
+        pid = p.name.rsplit("-", 1)[-1]
+        if p.is_dir() and pid.isdigit() and not pid_alive(int(pid)):
             shutil.rmtree(p, ignore_errors=True)
             removed.append(p)
     for p in removed:
