@@ -1,6 +1,8 @@
 """Roof irradiance against pvlib, analytic shading edges and analytic view factors."""
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pandas as pd
 import pvlib
@@ -155,7 +157,8 @@ def test_reflection_from_large_wall_matches_view_factor():
     D, H, zr, rho, rho_g = 6.0, 25.0, 3.0, 0.4, 0.2
     scene = Scene(box_mesh([[D, -LONG, 0.0, D + 2, LONG, zr + H]], albedo_wall=rho))
     cfg = IrradianceCfg(svf_rays=64, reflection_rays=4096, ray_length_m=10_000.0, ray_offset_m=0.0,
-                        max_reflector_groups=3)
+                        max_reflector_groups=3, reflector_points=16,
+                        reflector_sky_rays=16)
     geometry = segment_geometry(scene, _segments([0.0], 0.0, zr), cfg)
     F = (1 - D / np.hypot(D, H)) / 2
     assert geometry["refl_vf"].iloc[0] == pytest.approx(rho * F, rel=0.03)
@@ -165,9 +168,21 @@ def test_reflection_from_large_wall_matches_view_factor():
     assert geometry["r0_sky"].iloc[0] == pytest.approx(0.5, abs=0.03)
     assert geometry["r0_open"].iloc[0] == pytest.approx(1 - geometry["r0_sky"].iloc[0], abs=1e-6)
     assert geometry["r0_gnd"].iloc[0] == 0
-    pz = geometry[[f"r0_p{k}_z" for k in range(cfg.reflector_points)]].to_numpy()
-    px = geometry[[f"r0_p{k}_x" for k in range(cfg.reflector_points)]].to_numpy()
-    assert (np.diff(pz) >= 0).all() and (pz > zr).all() and (pz < zr + H).all()
+    P = cfg.reflector_points
+    pz = geometry[[f"r0_p{k}_z" for k in range(P)]].to_numpy()
+    px = geometry[[f"r0_p{k}_x" for k in range(P)]].to_numpy()
+    py = geometry[[f"r0_p{k}_y" for k in range(P)]].to_numpy()
+    assert (pz > zr).all() and (pz < zr + H).all()
+    # stratified in 2D: the P points hold the P weight strata of height (the view factor of
+    # the wall up to height h above the roof is F(h), analytic) ...
+    quantile = (1 - D / np.hypot(D, np.sort(pz[0]) - zr)) / (1 - D / np.hypot(D, H))
+    np.testing.assert_array_less(np.abs(quantile * P - np.arange(P) - 0.5), 0.5)
+    # ... and in each of the sqrt(P) height bands, sqrt(P) strata along the wall, which the
+    # roof sees symmetrically about its own position (y = 0): half of each band either side
+    B = math.isqrt(P)
+    assert B * B == P
+    along = np.sort(py[0].reshape(B, B), axis=1)
+    assert (along[:, : B // 2] < 0).all() and (along[:, B // 2:] > 0).all()
     np.testing.assert_allclose(px, D - 0.02, atol=1e-5)      # on the face, lifted 2 cm
     # sun in the west at 30 deg elevation lights the wall face (normal -x) at cos = 0.866
     zen, az = np.array([60.0]), np.array([270.0])

@@ -115,9 +115,9 @@ class IrradianceCfg(_Model):
     ray_length_m: float = Field(300.0, gt=0, le=100_000)
     ray_offset_m: float = Field(0.05, ge=0)
     max_reflector_groups: int = Field(4, ge=0)
-    reflector_points: int = Field(16, ge=1)
+    reflector_points: int = Field(64, ge=1)
     reflector_sampling: Literal["rotate", "all"] = "rotate"
-    reflector_sky_rays: int = Field(16, ge=1)
+    reflector_sky_rays: int = Field(4, ge=1)
     seed: int = 7
 
 

@@ -42,6 +42,7 @@ canopy layer climate, Energy and Buildings 11, 103-113.  pvlib:
 """
 from __future__ import annotations
 
+import math
 import time
 
 import numpy as np
@@ -160,32 +161,69 @@ def _dominant_surface(gkey, surface, w, n_keys: int) -> np.ndarray:
 
 def _group_points(o, hs, gkey, w, hp, hn, w_g, n_g, P: int, lift: float):
     """P sample points per reflector group, each standing for an equal share of the group's
-    weight (albedo x view factor).
+    weight (albedo x view factor), stratified over the group's surface in two dimensions.
 
-    Hits are ordered within their group by height (walls: shadows of other buildings cover
-    a facade from the bottom up) or, for roof- and ground-like groups, by horizontal
-    distance from the roof point; point ``k`` is the hit holding the weight quantile
-    ``(k + 1/2) / P``.  Returns points (m, G, P, 3) lifted by *lift* along their own
-    surface normal, and those normals (m, G, P, 3); groups without hits keep the roof point.
+    The hits of a group are split into ``B = round(sqrt(P))`` bands of equal weight along a
+    first key and ordered within each band along a second key; point ``k`` is the hit
+    holding the weight quantile ``(k + 1/2) / P`` of that band-by-band order, so each band
+    gets ``P / B`` points spread along the second key.  Walls: height, then position along
+    the facade (shadows of other buildings cover a facade from the bottom up, and streets
+    across let the sun in at some stretches only); roof- and ground-like groups: horizontal
+    distance from the roof point, then azimuth about it.  Returns points (m, G, P, 3) lifted
+    by *lift* along their own surface normal, and those normals (m, G, P, 3); groups without
+    hits keep the roof point.
     """
     m, G = w_g.shape
-    vertical = np.abs(n_g[..., 2]).reshape(-1) < 0.7
-    key = np.where(vertical[gkey], hp[:, 2],
-                   np.hypot(hp[:, 0] - o[hs, 0], hp[:, 1] - o[hs, 1]))
-    srt = np.lexsort((key, gkey))
-    gs = gkey[srt]
-    cw = np.cumsum(w[srt])
+    n_flat = n_g.reshape(-1, 3)
+    vertical = np.abs(n_flat[:, 2]) < 0.7
+    rel = hp - o[hs]
+    along = rel[:, 0] * -n_flat[gkey, 1] + rel[:, 1] * n_flat[gkey, 0]     # along the facade
+    v = vertical[gkey]
+    key1 = np.where(v, hp[:, 2], np.hypot(rel[:, 0], rel[:, 1]))
+    key2 = np.where(v, along, np.arctan2(rel[:, 0], rel[:, 1]))
     wflat = w_g.reshape(-1)
     before = np.cumsum(wflat) - wflat                           # weight of earlier groups
-    target = before[:, None] + (np.arange(P) + 0.5) / P * wflat[:, None]     # (m G, P)
-    lo = np.searchsorted(gs, np.arange(m * G), side="left")
-    hi = np.searchsorted(gs, np.arange(m * G), side="right") - 1
-    idx = np.clip(np.searchsorted(cw, target, side="left"), lo[:, None], np.maximum(hi, lo)[:, None])
+    # band of each hit: the weight quantile of its mid-weight along key1 within its group
+    srt = np.lexsort((key1, gkey))
+    mid = np.empty(len(w))
+    mid[srt] = np.cumsum(w[srt]) - 0.5 * w[srt] - before[gkey[srt]]
+    B = math.isqrt(P)
+    B = B if B * B == P else P           # P not a square: P bands along key1, as in 1D
+    band = np.minimum((B * mid / np.maximum(wflat[gkey], 1e-300)).astype(np.int64), B - 1)
+    # cell within the band: the weight quantile of the hit's mid-weight along key2
+    bkey = gkey * B + band
+    w_band = np.bincount(bkey, w, m * G * B)
+    srt = np.lexsort((key2, bkey))
+    mid[srt] = np.cumsum(w[srt]) - 0.5 * w[srt] - (np.cumsum(w_band) - w_band)[bkey[srt]]
+    per = P // B                                                # cells per band
+    cell = np.minimum((per * mid / np.maximum(w_band[bkey], 1e-300)).astype(np.int64), per - 1)
+    ckey = bkey * per + cell
+    # point k = (band b, cell c) takes, within its cell ordered by key1, the weight quantile
+    # (s + 1/2) / per with s = (c + b) mod per: the P points hold P distinct key1 levels
+    # (a Latin square of bands and cells) and B x per strata of key2 within the bands
+    srt = np.lexsort((key1, ckey))
+    cs = ckey[srt]
+    cw = np.cumsum(w[srt])
+    n_cell = m * G * B * per
+    w_cell = np.bincount(ckey, w, n_cell).reshape(m * G, B, per)
+    start = (np.cumsum(w_cell) - w_cell.reshape(-1)).reshape(m * G, B, per)
+    bb, cc = np.divmod(np.arange(B * per), per)
+    sub = ((cc + bb) % per + 0.5) / per
+    target = (start + sub.reshape(B, per) * w_cell).reshape(m * G, B * per)[:, :P]
+    cells = np.arange(n_cell).reshape(m * G, B * per)[:, :P]
+    lo = np.searchsorted(cs, cells, side="left")
+    hi = np.searchsorted(cs, cells, side="right") - 1
+    # an empty cell (few hits) takes the group's nearest hit in the order
+    glo = np.searchsorted(gkey[srt], np.arange(m * G), side="left")[:, None]
+    ghi = np.searchsorted(gkey[srt], np.arange(m * G), side="right")[:, None] - 1
+    empty = hi < lo
+    lo, hi = np.where(empty, glo, lo), np.where(empty, np.maximum(ghi, glo), hi)
+    idx = np.clip(np.searchsorted(cw, target, side="left"), lo, hi)
     idx = srt[np.minimum(idx, len(srt) - 1)]
     used = (wflat > 0)[:, None]
     pts = np.where(used[..., None], hp[idx] + lift * hn[idx],
                    np.repeat(o, G, axis=0)[:, None, :])
-    nrm = np.where(used[..., None], hn[idx], n_g.reshape(-1, 1, 3))
+    nrm = np.where(used[..., None], hn[idx], n_flat[:, None, :])
     return pts.reshape(m, G, P, 3), nrm.reshape(m, G, P, 3)
 
 
