@@ -50,17 +50,37 @@ def _months(values) -> pd.DatetimeIndex:
 
 
 def fig_monthly(monthly: pd.DataFrame, summary: dict):
-    fig, ax = plt.subplots(figsize=(8, 4))
+    """Monthly all-sky yield of the fleet (kWh/kWp), stacked: driving, at terminals between
+    trips, parked outside the blocks; driving + terminals is the in-service yield, the top
+    of each bar the whole day.  Black marks: driving without buildings (the gap to the
+    driving bar is the shading loss on the road).  Runs without the split (driving only)
+    show the driving bar alone."""
+    fig, ax = plt.subplots(figsize=(9.5, 4))
     x = np.arange(len(monthly))
     kwp = summary["kwp_per_bus"] * summary["buses"]
-    ax.bar(x - 0.2, monthly["pv_kwh_clear"] / kwp, 0.4, label="clear-sky", color="#f4b400")
-    ax.bar(x + 0.2, monthly["pv_kwh"] / kwp, 0.4, label="all-sky", color="#4285f4")
-    ax.plot(x - 0.2, monthly["pv_kwh_clear_unshaded"] / kwp, "k_", ms=14, label="without buildings")
-    ax.plot(x + 0.2, monthly["pv_kwh_unshaded"] / kwp, "k_", ms=14)
+    split = {"pv_kwh_driving", "pv_kwh_layover", "pv_kwh_parked"} <= set(monthly.columns)
+    driving = (monthly["pv_kwh_driving"] if split else monthly["pv_kwh"]).to_numpy(float) / kwp
+    ax.bar(x, driving, 0.6, label="driving", color="#4285f4")
+    if split:
+        layover = monthly["pv_kwh_layover"].to_numpy(float) / kwp
+        parked = monthly["pv_kwh_parked"].to_numpy(float) / kwp
+        ax.bar(x, layover, 0.6, bottom=driving, color="#9fc5f8",
+               label="+ at terminals between trips (top: in service)")
+        ax.bar(x, parked, 0.6, bottom=driving + layover, color="#c8c8c8",
+               label="+ parked outside service (top: whole day)")
+    ax.plot(x, monthly["pv_kwh_unshaded"].to_numpy(float) / kwp, "k_", ms=18,
+            label="driving, without buildings")
     ax.set_xticks(x, _months(monthly["month"]).strftime("%b"))
-    ax.set_ylabel("PV energy (kWh per installed kWp)")
-    ax.set_title("Monthly PV yield of the fleet; the gap to the black marks is the shading loss")
-    ax.legend(loc="upper left", fontsize=8)
+    ax.set_xlabel("month")
+    ax.set_ylabel("all-sky PV energy (kWh per installed kWp)")
+    title = "Monthly PV yield of the fleet"
+    keys = ("kwh_per_kwp_driving", "kwh_per_kwp_in_service", "kwh_per_kwp_whole_day")
+    if split and all(summary.get(k) is not None for k in keys):
+        title += ("\nthe year: driving {:.0f}, in service {:.0f}, whole day {:.0f} kWh/kWp"
+                  .format(*(summary[k] for k in keys)))
+    ax.set_title(title, fontsize=10)
+    handles, labels = ax.get_legend_handles_labels()
+    ax.legend(handles[::-1], labels[::-1], loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
     return fig
 
 
@@ -338,7 +358,8 @@ def write_report(run_dir: Path, summary: dict, monthly, smg, hp, rm, cfg=None, s
         footprints = building_footprints(cfg.data_dir, tiles=tiles,
                                          bounds=(xmin - 200, ymin - 200, xmax + 200, ymax + 200))
     figs = [
-        ("monthly_yield", "Monthly yield, clear-sky vs all-sky, with shading losses", fig_monthly(monthly, summary)),
+        ("monthly_yield", "Monthly yield: driving, in service and whole day (all-sky), with the "
+         "shading loss on the road", fig_monthly(monthly, summary)),
         ("map_yield", "Yield per segment",
          fig_map(segments, "kwh_per_kwp_year", "specific yield (kWh/kWp per year)", "viridis",
                  "PV yield of a bus in each segment's light, all-sky (kWh/kWp per year)", footprints, crs)),
