@@ -152,6 +152,30 @@ def test_report_reads(small_run):
         assert (small_run / "figures" / f"{name}.png").stat().st_size > 10_000, name
 
 
+def test_monthly_chart_stacks_driving_in_service_and_whole_day(small_run):
+    """The monthly chart's bars: driving, then terminals on top (in service), then parked
+    time (whole day), each month's stack summing to the monthly table's whole-day yield, in
+    the proportions of the summary's three yields (kWh/kWp)."""
+    from vipvflow.simulation.report import fig_monthly
+
+    monthly = pd.read_parquet(small_run / "monthly.parquet")
+    s = json.loads((small_run / "summary.json").read_text())
+    kwp = s["kwp_per_bus"] * s["buses"]
+    ax = fig_monthly(monthly, s).axes[0]
+    heights = np.array([p.get_height() for p in ax.patches]).reshape(3, len(monthly))
+    np.testing.assert_allclose(heights.sum(0), monthly["pv_kwh_whole_day"] / kwp, rtol=1e-9)
+    np.testing.assert_allclose(heights[0], monthly["pv_kwh_driving"] / kwp, rtol=1e-9)
+    # the summary's yields are per year (scaled from the months simulated): same proportions
+    year = heights.sum(1)
+    np.testing.assert_allclose(np.array([year[0], year[:2].sum(), year.sum()]) / year.sum(),
+                               np.array([s["kwh_per_kwp_driving"], s["kwh_per_kwp_in_service"],
+                                         s["kwh_per_kwp_whole_day"]]) / s["kwh_per_kwp_whole_day"],
+                               rtol=1e-6)
+    labels = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert any("in service" in t for t in labels) and any("whole day" in t for t in labels)
+    assert "kWh per installed kWp" in ax.get_ylabel()
+
+
 def test_close_up_is_on_the_canyons(small_run):
     """The map's close-up window holds the segment whose roof sees the least sky."""
     from vipvflow.simulation.report import CLOSE_UP_M, close_up_window
