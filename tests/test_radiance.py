@@ -172,7 +172,7 @@ def _engine(name: str, cfg: IrradianceCfg):
                          "z": np.full(k, ROOF_Z), "heading_deg": np.zeros(k),
                          "gradient": np.zeros(k)})
     geo = segment_geometry(scene, segs, cfg)
-    sun, el, dni, dhi, ghi = _sky()
+    sun, _, dni, dhi, ghi = _sky()
     f = np.float32
     rows = np.tile(np.arange(k), len(INSTANTS))
     rep = lambda v: np.repeat(np.asarray(v, f), k)             # noqa: E731
@@ -190,7 +190,7 @@ def _run(name: str, work: Path) -> pd.DataFrame:
     spec = SCENES[name]
     k = len(spec["points"])
     n = len(INSTANTS)
-    sun, el, dni, dhi, ghi = _sky()
+    sun, el, dni, dhi, _ = _sky()
     geo, svf, paper = _engine(name, CFG_SVF)
     origin = geo[["px", "py", "pz"]].to_numpy(float)
     recs = []

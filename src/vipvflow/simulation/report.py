@@ -358,8 +358,8 @@ def write_report(run_dir: Path, summary: dict, monthly, smg, hp, rm, cfg=None, s
         footprints = building_footprints(cfg.data_dir, tiles=tiles,
                                          bounds=(xmin - 200, ymin - 200, xmax + 200, ymax + 200))
     figs = [
-        ("monthly_yield", "Monthly yield: driving, in service and whole day (all-sky), with the "
-         "shading loss on the road", fig_monthly(monthly, summary)),
+        ("monthly_yield", ("Monthly yield: driving, in service and whole day (all-sky), with the "
+                           "shading loss on the road"), fig_monthly(monthly, summary)),
         ("map_yield", "Yield per segment",
          fig_map(segments, "kwh_per_kwp_year", "specific yield (kWh/kWp per year)", "viridis",
                  "PV yield of a bus in each segment's light, all-sky (kWh/kWp per year)", footprints, crs)),
