@@ -273,11 +273,11 @@ def _group_points(o, hs, gkey, w, hp, hn, w_g, n_g, P: int, lift: float):
     start = (np.cumsum(w_cell) - w_cell.reshape(-1)).reshape(m * G, B, per)
     bb, cc = np.divmod(np.arange(B * per), per)
     sub = ((cc + bb) % per + 0.5) / per
-    target = (start + sub.reshape(B, per) * w_cell).reshape(m * G, B * per)[:, :P]
-    cells = np.arange(n_cell).reshape(m * G, B * per)[:, :P]
+    target = (start + sub.reshape(B, per) * w_cell).reshape(m * G, P)
+    cells = np.arange(n_cell).reshape(m * G, P)
     lo = np.searchsorted(cs, cells, side="left")
     hi = np.searchsorted(cs, cells, side="right") - 1
-    # an empty cell (few hits) takes the group's nearest hit in the order
+    # an empty cell (a group of few hits) takes the hit at its target in the group's order
     glo = np.searchsorted(gkey[srt], np.arange(m * G), side="left")[:, None]
     ghi = np.searchsorted(gkey[srt], np.arange(m * G), side="right")[:, None] - 1
     empty = hi < lo
@@ -428,8 +428,9 @@ def segment_geometry(scene, segments: pd.DataFrame, cfg: IrradianceCfg | None = 
     T. R. Oke (1988), Street design and urban canopy layer climate, Energy and Buildings 11,
     103-113 (sky view factor).  Cosine-weighted hemisphere sampling by Malley's method
     (concentric disk projected to the hemisphere): M. Pharr, W. Jakob, G. Humphreys,
-    Physically Based Rendering, 3rd ed., section 13.6.3.  Roof model and its view-factor
-    reflection: the paper of this project (docs/physics.md, sections 3.2.1 to 3.2.3).
+    Physically Based Rendering, 3rd ed., section 13.6.3.  The roof model and its
+    view-factor reflection: Pera et al., Dynamic 3D Solar Irradiation Modelling for
+    Vehicle-Integrated Photovoltaics (CITATION.cff), sections 3.2.1 to 3.2.3.
     """
     cfg = cfg or IrradianceCfg()
     n_seg = len(segments)
