@@ -31,6 +31,7 @@ import numpy as np
 import pandas as pd
 
 from .errors import InputError
+from .store import write_bytes
 
 VDRI_NAMES = {"s": "s_m", "v": "v_kmh", "grad": "grad_pct", "stop": "stop_s"}
 VDRI_HEADER = {v: f"<{k}>" for k, v in VDRI_NAMES.items()}
@@ -135,12 +136,7 @@ def write_vdri(vdri: pd.DataFrame, path: str | Path) -> Path:
     header = ",".join(VDRI_HEADER.get(c, f"<{c}>") for c in cols)
     columns = [_fmt(vdri[c].to_numpy()) for c in cols]
     lines = [header] + [",".join(row) for row in zip(*columns)]
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_bytes(("\r\n".join(lines) + "\r\n").encode("utf-8"))
-    tmp.replace(path)
-    return path
+    return write_bytes(("\r\n".join(lines) + "\r\n").encode("utf-8"), path)
 
 
 def _stationary_runs(moving: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

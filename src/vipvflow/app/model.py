@@ -44,6 +44,7 @@ import pandas as pd
 
 from ..config import Config, PVSystem
 from ..irradiance import shading_loss
+from ..store import DataDir, RunDir
 
 #: PV technologies offered: PVWatts temperature coefficient of power (1/K, typical datasheet
 #: values), module efficiency at STC (for sizing by area) and the pvlib SAPM mounting of the
@@ -173,7 +174,7 @@ class TripModel:
         self.manifest = manifest
         self.year = int(manifest["year"])
         self.cfg = Config.model_validate(manifest["config"])
-        gdir = self.data_dir / "gtfs"
+        gdir = DataDir(self.data_dir).gtfs.root
         self.timezone = json.loads((gdir / "feed.json").read_text())["timezone"]
         self.vehicle = self.cfg.vehicle_params()
         self.run_pv = self.cfg.pv_system()
@@ -186,7 +187,7 @@ class TripModel:
 
         # segments with geometry factors and horizons, one row per segment id
         geo = pd.concat([pd.read_parquet(f) for f in
-                         sorted((self.run_dir / "parts" / "geometry").glob("tile=*.parquet"))],
+                         RunDir(self.run_dir).part_files("geometry")],
                         ignore_index=True)
         hor = load_horizons(self.run_dir)
         if len(hor) == 0:

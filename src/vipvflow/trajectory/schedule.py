@@ -36,6 +36,8 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+
+from ..store import DataDir
 import pyarrow.parquet as pq
 
 WEEKDAYS = ["monday", "tuesday", "wednesday", "thursday", "friday", "saturday", "sunday"]
@@ -153,7 +155,7 @@ def pattern_segment_times(stop_d, arr, dep, seg_start, seg_len):
 # service dates
 
 def _read(data_dir, name: str, **kw) -> pd.DataFrame:
-    path = Path(data_dir) / "gtfs" / name
+    path = DataDir(data_dir).gtfs.root / name
     return pq.read_table(path, **kw).to_pandas()
 
 
@@ -222,7 +224,7 @@ def service_dates(data_dir, year: int) -> pd.DataFrame:
     -------
     DataFrame[service_id (str), date (datetime64[ns], midnight)]
     """
-    gdir = (Path(data_dir) / "gtfs").resolve()
+    gdir = DataDir(data_dir).gtfs.root.resolve()
     stamp = _stamp(gdir, ("calendar.parquet", "calendar_dates.parquet"))
     return _service_dates_cached(str(gdir), int(year), stamp).copy()
 
@@ -247,7 +249,7 @@ def service_day_origin_utc(dates, timezone: str) -> np.ndarray:
 # passes
 
 def _feed_info(data_dir) -> dict:
-    return json.loads((Path(data_dir) / "gtfs" / "feed.json").read_text())
+    return json.loads(DataDir(data_dir).gtfs.feed_json.read_text())
 
 
 def _parse_month(month, year):
@@ -331,7 +333,7 @@ def iter_passes(data_dir, tile: str, month, year: int | None = None,
         date (see module doc). Only this month and this tile are ever held in memory.
     """
     period = _parse_month(month, year)
-    gdir = (Path(data_dir) / "gtfs").resolve()
+    gdir = DataDir(data_dir).gtfs.root.resolve()
     stamp = _stamp(gdir, _GTFS_TABLES)
     pat = _tile_patterns(str(gdir), tile, stamp)
     if pat.empty:
