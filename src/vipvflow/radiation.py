@@ -527,7 +527,7 @@ def _cached_sun(path: Path, grid, lat, lon, alt) -> np.ndarray:
     st = path.stat()
     key = json.dumps([st.st_size, st.st_mtime_ns, float(grid[0]), float(grid[-1]), len(grid),
                       np.round(lat, 8).tolist(), np.round(lon, 8).tolist(), np.round(alt, 3).tolist()])
-    cache = path.with_name(f"sun_{int(grid[0])}_{len(grid)}.npz")
+    cache = RadiationDir(path.parent).sun_cache(int(grid[0]), len(grid))
     try:
         with np.load(cache) as z:
             if str(z["key"]) == key:

@@ -81,6 +81,10 @@ class CityDir:
         return self.surfaces / f"tile={tile}" / "part-0.parquet"
 
 
+#: the tables of ``gtfs/``, each ``<name>.parquet``
+GTFS_TABLES = ("segments", "trips", "patterns", "pattern_stops", "calendar", "calendar_dates")
+
+
 @dataclass(frozen=True)
 class GtfsDir:
     """``gtfs/``: the timetable cut into segments, by the GTFS ingest."""
@@ -108,7 +112,9 @@ class GtfsDir:
         return self.root / "patterns.parquet"
 
     def table(self, name: str) -> Path:
-        """``<name>.parquet`` (``calendar``, ``calendar_dates``, ``pattern_stops``, ...)."""
+        """``<name>.parquet``, one of :data:`GTFS_TABLES`."""
+        if name not in GTFS_TABLES:
+            raise ValueError(f"no GTFS table {name!r} in the store")
         return self.root / f"{name}.parquet"
 
 
@@ -128,6 +134,11 @@ class RadiationDir:
     @property
     def stamp(self) -> Path:
         return self.root / ".inputs.json"
+
+    def sun_cache(self, first_s: int, n: int) -> Path:
+        """Sun vectors of the table's grid from *first_s* (Unix s), *n* steps, kept for the
+        workers of a run (:func:`vipvflow.radiation._cached_sun`)."""
+        return self.root / f"sun_{first_s}_{n}.npz"
 
 
 @dataclass(frozen=True)
@@ -200,6 +211,8 @@ PARTS = {
     "timeline": PartKind("run", "the fleet's day: block_days, intervals, trip_runs, points", {}),
 }
 PARTITION_KINDS = ("hourly", "trip", "segment_month")
+#: the tables of ``parts/timeline/``, each ``<name>.parquet``
+TIMELINE_TABLES = ("block_days", "intervals", "trip_runs", "points")
 #: the ``month`` of a standing partition: one per tile holds all the run's months (a tile
 #: has only a few standing points; per month, loading the tile's scene cost more than them)
 ALL_MONTHS = "all"
@@ -247,6 +260,12 @@ class RunDir:
         if PARTS[kind].per != "tile":
             raise ValueError(f"parts/{kind} is not stored per tile")
         return self.part_dir(kind) / f"tile={tile}.parquet"
+
+    def timeline_table(self, name: str) -> Path:
+        """``parts/timeline/<name>.parquet``, one of :data:`TIMELINE_TABLES`."""
+        if name not in TIMELINE_TABLES:
+            raise ValueError(f"no timeline table {name!r} in the store")
+        return self.timeline / f"{name}.parquet"
 
     def part_files(self, kind: str, pattern: str | None = None) -> list[Path]:
         """Every file of *kind* (matching *pattern* under ``parts/<kind>/``), in path order."""
@@ -296,10 +315,11 @@ def atomic_path(path: str | Path, suffix: str = "") -> Iterator[Path]:
         raise
 
 
-def write_parquet(df, path: str | Path) -> Path:
+def write_parquet(df, path: str | Path, pandas_dtypes: bool = False) -> Path:
     """Write *df* (DataFrame or GeoDataFrame) to *path* atomically.
 
-    Plain tables (numbers, bools, dates, strings) go straight to pyarrow: pandas' own
+    With *pandas_dtypes* pandas writes it, with its metadata: nullable integers and pandas'
+    string flavours read back as they were (the GTFS tables). Otherwise plain tables (numbers, bools, dates, strings) go straight to pyarrow: pandas' own
     conversion costs more than the write for the run's wide, small tables.  A file named as
     one of the run's outputs (``trip_energy.parquet``, ... :data:`dictionary.OUTPUTS`) is
     written as the data dictionary describes it: ``month`` as a date, every documented
@@ -311,8 +331,8 @@ def write_parquet(df, path: str | Path) -> Path:
     path = Path(path)
     output = path.stem if path.suffix == ".parquet" and path.stem in OUTPUTS else None
     with atomic_path(path) as tmp:
-        table = _plain_table(df)
-        if table is None and output is not None:
+        table = None if pandas_dtypes else _plain_table(df)
+        if table is None and output is not None and not pandas_dtypes:
             table = _arrow_table(df)
         if table is None:
             df.to_parquet(tmp, index=False)

@@ -175,9 +175,9 @@ def block_day_table(cfg: Config, run_dir: Path, trip: pd.DataFrame, vehicle):
     from ..trajectory.schedule import IDLE_BLOCK
     from ..vehicle import block_day_balance
 
-    tdir = RunDir(run_dir).timeline
-    tl = pd.read_parquet(tdir / "block_days.parquet")
-    runs = pd.read_parquet(tdir / "trip_runs.parquet")
+    run = RunDir(run_dir)
+    tl = pd.read_parquet(run.timeline_table("block_days"))
+    runs = pd.read_parquet(run.timeline_table("trip_runs"))
     key = ["block_id", "service_date"]
     merged = trip.drop(columns=["block_id"]).merge(runs, on=["trip_id", "service_date"], how="left",
                                                    validate="one_to_one")

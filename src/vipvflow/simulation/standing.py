@@ -130,10 +130,10 @@ def run_standing(ctx, tile: str) -> dict:
 
     tune_malloc()
     t_start = time.perf_counter()
-    tdir = timeline_dir(ctx.run_dir)
-    points = pd.read_parquet(tdir / "points.parquet")
+    run = RunDir(ctx.run_dir)
+    points = pd.read_parquet(run.timeline_table("points"))
     points = points[points["tile"] == tile]
-    iv = pd.read_parquet(tdir / "intervals.parquet")
+    iv = pd.read_parquet(run.timeline_table("intervals"))
     iv = iv[iv["point_id"].isin(points["point_id"])].reset_index(drop=True)
     cfg = IrradianceCfg(**ctx.irradiance)
     dark = tile == "covered" or not len(iv)
@@ -215,8 +215,8 @@ def write_timeline(cfg, year: int, run_dir, routes=None) -> list[tuple[str, str]
     run and return the tiles that have standing intervals (one ``standing`` task each)."""
     from ..trajectory.schedule import block_timeline
 
-    tdir = timeline_dir(run_dir)
-    if not (tdir / "points.parquet").exists():
+    run = RunDir(run_dir)
+    if not run.timeline_table("points").exists():
         tl = block_timeline(cfg.data_dir, year, months=cfg.run.months, routes=routes,
                             depot=depot_point(cfg, cfg.data_dir), depot_shading=cfg.fleet.depot_shading)
         iv = tl["intervals"]
@@ -224,13 +224,13 @@ def write_timeline(cfg, year: int, run_dir, routes=None) -> list[tuple[str, str]
             iv = iv[iv["kind"] == "layover"]
         elif cfg.fleet.harvest == "driving":
             iv = iv.iloc[:0]
-        write_parquet(tl["block_days"].reset_index(drop=True), tdir / "block_days.parquet")
-        write_parquet(iv.astype({"kind": str}).reset_index(drop=True), tdir / "intervals.parquet")
-        write_parquet(tl["trip_runs"], tdir / "trip_runs.parquet")
+        write_parquet(tl["block_days"].reset_index(drop=True), run.timeline_table("block_days"))
+        write_parquet(iv.astype({"kind": str}).reset_index(drop=True), run.timeline_table("intervals"))
+        write_parquet(tl["trip_runs"], run.timeline_table("trip_runs"))
         write_parquet(tl["points"].astype({"stop_id": str, "tile": str, "shading": str}),
-                      tdir / "points.parquet")
-    iv = pd.read_parquet(tdir / "intervals.parquet", columns=["point_id"])
-    tiles = pd.read_parquet(tdir / "points.parquet").set_index("point_id")["tile"]
+                      run.timeline_table("points"))
+    iv = pd.read_parquet(run.timeline_table("intervals"), columns=["point_id"])
+    tiles = pd.read_parquet(run.timeline_table("points")).set_index("point_id")["tile"]
     return sorted(set(tiles.reindex(iv["point_id"].unique()).astype(str)))
 
 

@@ -378,10 +378,10 @@ def ingest_gtfs(feed_path, data_dir, traj_cfg, crs=None, dist_units: str | None 
     # (a folder a failed write leaves is removed by the next ingest, once its process is gone)
     final, out = out, GtfsDir(staging_dir(out))
     gseg = gpd.GeoDataFrame(segs, geometry=geom, crs=crs_obj)
-    write_parquet(gseg, out.table("segments"))
-    write_parquet(trips_out, out.table("trips"))
-    write_parquet(patterns, out.table("patterns"))
-    write_parquet(pstops, out.table("pattern_stops"))
+    write_parquet(gseg, out.table("segments"), pandas_dtypes=True)
+    write_parquet(trips_out, out.table("trips"), pandas_dtypes=True)
+    write_parquet(patterns, out.table("patterns"), pandas_dtypes=True)
+    write_parquet(pstops, out.table("pattern_stops"), pandas_dtypes=True)
     cal_cols = ["service_id", "monday", "tuesday", "wednesday", "thursday", "friday",
                 "saturday", "sunday", "start_date", "end_date"]
     cal = (feed.calendar[cal_cols] if feed.calendar is not None
@@ -390,8 +390,8 @@ def ingest_gtfs(feed_path, data_dir, traj_cfg, crs=None, dist_units: str | None 
     cd_cols = ["service_id", "date", "exception_type"]
     cd = (feed.calendar_dates[cd_cols] if feed.calendar_dates is not None
           else pd.DataFrame(columns=cd_cols)).astype({"service_id": str, "date": str})
-    write_parquet(cal, out.table("calendar"))
-    write_parquet(cd, out.table("calendar_dates"))
+    write_parquet(cal, out.table("calendar"), pandas_dtypes=True)
+    write_parquet(cd, out.table("calendar_dates"), pandas_dtypes=True)
 
     report = {
         "feed": str(Path(feed_path)),
