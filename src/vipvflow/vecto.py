@@ -31,7 +31,7 @@ import numpy as np
 import pandas as pd
 
 from .errors import InputError
-from .store import write_bytes
+from .store import write_bytes, write_text
 
 VDRI_NAMES = {"s": "s_m", "v": "v_kmh", "grad": "grad_pct", "stop": "stop_s"}
 VDRI_HEADER = {v: f"<{k}>" for k, v in VDRI_NAMES.items()}
@@ -430,14 +430,12 @@ def _header() -> dict:
 def _write_json(path: Path, body: dict, file_version: int) -> Path:
     header = _header()
     header["FileVersion"] = file_version
-    path.write_text(json.dumps({"Header": header, "Body": body}, indent=2) + "\n", encoding="utf-8")
-    return path
+    return write_text(json.dumps({"Header": header, "Body": body}, indent=2) + "\n", path)
 
 
 def _write_csv(path: Path, header: str, rows: np.ndarray) -> Path:
     lines = [header] + [",".join(_fmt(r)) for r in rows]
-    path.write_bytes(("\r\n".join(lines) + "\r\n").encode("utf-8"))
-    return path
+    return write_bytes(("\r\n".join(lines) + "\r\n").encode("utf-8"), path)
 
 
 def write_vecto_job(out_dir: str | Path, params, cycles: list[str | Path] = (),

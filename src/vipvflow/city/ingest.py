@@ -151,9 +151,7 @@ class _Chunk:
         return _Chunk(V=V, vsz=vsz, T=T, tsz=tsz, R=R, rsz=rsz, **out)
 
     def save(self, path: Path, own: np.ndarray) -> None:
-        tmp = path.with_name(path.name + ".tmp.npz")
-        np.savez(tmp, own=own, **{k: getattr(self, k) for k in self.FIELDS})
-        tmp.replace(path)
+        write_npz(path, own=own, **{k: getattr(self, k) for k in self.FIELDS})
 
     @classmethod
     def load_many(cls, paths) -> tuple["_Chunk", np.ndarray]:

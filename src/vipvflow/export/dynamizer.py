@@ -36,7 +36,7 @@ import pyarrow.parquet as pq
 from lxml import etree
 
 from ..errors import InputError
-from ..store import DataDir, RunDir
+from ..store import DataDir, RunDir, atomic_path
 from .citygml3 import (CORE, DYN, NSMAP, SCHEMA_LOCATIONS, XSI, first_srs_name, q, schema_location,
                        srs_name, vertical_epsg)
 
@@ -887,7 +887,6 @@ def write_dynamizers(run_dir: str | Path, out: str | Path, encoding: str = "inli
     out.parent.mkdir(parents=True, exist_ok=True)
     counts = {"segments": 0, "route_directions": 0, "surfaces": 0, "network": 0, "dynamizers": 0}
     table = _Tabulated(out.with_suffix(".csv")) if encoding == "tabulated" else None
-    tmp = out.with_name(out.name + ".tmp")
 
     def members() -> Iterator[MemberWriter]:
         if aggregate == "segment":
@@ -902,17 +901,15 @@ def write_dynamizers(run_dir: str | Path, out: str | Path, encoding: str = "inli
 
     ok = False
     try:
-        if embed is None:
-            _write_standalone(tmp, run, sel, members())
-        else:
-            _write_embedded(tmp, Path(embed), members())
+        with atomic_path(out) as tmp:
+            if embed is None:
+                _write_standalone(tmp, run, sel, members())
+            else:
+                _write_embedded(tmp, Path(embed), members())
         ok = True
     finally:
         if table is not None:
             table.close(keep=ok)
-        if not ok:
-            tmp.unlink(missing_ok=True)
-    tmp.replace(out)
     files = [out] + ([table.path] if table is not None else [])
     return {"files": files, "aggregate": aggregate, **counts}
 
