@@ -15,7 +15,7 @@ import pytest
 import shapely
 
 from vipvflow.simulation.dictionary import OUTPUTS, describe, render_markdown
-from vipvflow.simulation.storage import write_parquet
+from vipvflow.store import write_parquet
 
 ROOT = Path(__file__).resolve().parents[1]
 

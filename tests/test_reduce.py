@@ -7,7 +7,7 @@ import pytest
 
 from vipvflow.errors import InputError
 from vipvflow.simulation.reduce import _read_parts, _trip_totals
-from vipvflow.simulation.storage import partition_path, write_parquet
+from vipvflow.store import RunDir, write_parquet
 
 PV = ["pv_kwh", "pv_kwh_clear", "pv_kwh_direct"]
 
@@ -28,10 +28,10 @@ def test_trips_are_summed_over_tiles_and_sorted(tmp_path):
         for month, dates in [("2024-01", ["2024-01-02", "2024-01-01"]), ("2024-02", ["2024-02-05"])]:
             df = _trip_part(rng, trips, dates)
             df["tile"] = tile
-            write_parquet(df, partition_path(tmp_path, "trip", tile, month))
+            write_parquet(df, RunDir(tmp_path).part("trip", tile, month))
             parts.append(df)
     # a partition without passes
-    write_parquet(parts[0].iloc[:0], partition_path(tmp_path, "trip", "d", "2024-01"))
+    write_parquet(parts[0].iloc[:0], RunDir(tmp_path).part("trip", "d", "2024-01"))
     got = _trip_totals(tmp_path)
     want = (pd.concat(parts).groupby(["trip_id", "service_date"], sort=True)[PV + ["seconds"]]
             .sum().reset_index())
@@ -45,8 +45,8 @@ def test_trips_are_summed_over_tiles_and_sorted(tmp_path):
 def test_files_with_different_schemas_are_promoted(tmp_path):
     a = pd.DataFrame({"segment_id": np.array([1, 2], np.int64), "h_total": [1.0, 2.0]})
     b = pd.DataFrame({"segment_id": np.array([3], np.int32), "h_total": np.array([3.0], np.float32)})
-    write_parquet(a, partition_path(tmp_path, "segment_month", "a", "2024-01"))
-    write_parquet(b, partition_path(tmp_path, "segment_month", "b", "2024-01"))
+    write_parquet(a, RunDir(tmp_path).part("segment_month", "a", "2024-01"))
+    write_parquet(b, RunDir(tmp_path).part("segment_month", "b", "2024-01"))
     got = _read_parts(tmp_path, "segment_month")
     assert got["segment_id"].tolist() == [1, 2, 3]
     assert got["h_total"].tolist() == [1.0, 2.0, 3.0]
@@ -54,7 +54,7 @@ def test_files_with_different_schemas_are_promoted(tmp_path):
 
 def test_a_run_without_any_pass_is_named(tmp_path):
     empty = _trip_part(np.random.default_rng(0), ["t1"], ["2024-01-01"]).iloc[:0]
-    write_parquet(empty, partition_path(tmp_path, "trip", "a", "2024-01"))
+    write_parquet(empty, RunDir(tmp_path).part("trip", "a", "2024-01"))
     with pytest.raises(InputError, match="no trip partitions with passes"):
         _trip_totals(tmp_path)
     with pytest.raises(InputError, match="parts/trip"):

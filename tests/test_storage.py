@@ -5,7 +5,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from vipvflow.simulation.storage import _plain_table, write_parquet
+from vipvflow.store import _plain_table, write_parquet
 
 
 @pytest.mark.parametrize("frame, fast", [

@@ -22,6 +22,7 @@ from pydantic import (BaseModel, ConfigDict, Field, ValidationError, field_valid
                       model_validator)
 
 from .errors import ConfigError
+from .store import TILE_SIZE_M
 
 CONF_DIR = Path(os.environ.get("VIPVFLOW_CONF_DIR") or str(resources.files("vipvflow") / "conf"))
 _NOT_SCENARIOS = {"default", "vehicles", "pv_systems"}
@@ -82,7 +83,7 @@ class Albedo(_Model):
 
 class CityCfg(_Model):
     # bounds keep a run's tile and mesh count sane (a 1 mm tile would ask for GiBs of index)
-    tile_size_m: float = Field(500.0, ge=50, le=100_000)
+    tile_size_m: float = Field(TILE_SIZE_M, ge=50, le=100_000)
     buffer_m: float = Field(300.0, ge=0, le=5_000)
     albedo: Albedo = Field(default_factory=Albedo)
     planarity_tolerance_m: float = Field(0.10, gt=0)

@@ -19,10 +19,11 @@ The same description of terrain shading is used by GRASS GIS ``r.horizon`` / ``r
 """
 from __future__ import annotations
 
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
+
+from .store import RunDir
 
 #: azimuth bins of a stored profile (degrees from north, clockwise)
 N_AZIMUTH = 72
@@ -87,14 +88,9 @@ def horizon_frame(segment_ids, profile: np.ndarray) -> pd.DataFrame:
     return pd.DataFrame(out)
 
 
-def horizon_path(run_dir, tile: str) -> Path:
-    """``parts/horizon/tile=<TILE>.parquet`` of a run directory."""
-    return Path(run_dir) / "parts" / "horizon" / f"tile={tile}.parquet"
-
-
 def load_horizons(run_dir) -> pd.DataFrame:
     """All tiles' horizon tables of a run, concatenated (empty frame when none)."""
-    files = sorted((Path(run_dir) / "parts" / "horizon").glob("tile=*.parquet"))
+    files = RunDir(run_dir).part_files("horizon")
     if not files:
         return pd.DataFrame({"segment_id": np.zeros(0, np.int64)})
     return pd.concat([pd.read_parquet(f) for f in files], ignore_index=True)

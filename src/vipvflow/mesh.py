@@ -10,6 +10,8 @@ from pathlib import Path
 
 import numpy as np
 
+from .store import write_npz
+
 #: surface type codes used in ``TileMesh.surface_type``
 SURFACE_TYPES = ("roof", "wall", "ground", "closure", "terrain", "vegetation", "other")
 SURFACE_CODE = {name: i for i, name in enumerate(SURFACE_TYPES)}
@@ -49,10 +51,7 @@ class TileMesh:
 
     def save(self, path: str | Path) -> None:
         """Write atomically as ``.npz`` (temporary name, then rename)."""
-        path = Path(path)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        tmp = path.with_name(path.name + ".tmp.npz")
-        np.savez(tmp, vertices=self.vertices.astype(np.float64),
+        write_npz(path, vertices=self.vertices.astype(np.float64),
                  triangles=self.triangles.astype(np.int32),
                  surface_index=self.surface_index.astype(np.int32),
                  surface_ids=np.asarray(self.surface_ids, dtype=str),
@@ -60,7 +59,6 @@ class TileMesh:
                  surface_type=self.surface_type.astype(np.int8),
                  bounds=np.asarray(self.bounds, dtype=np.float64),
                  buffer_m=np.float64(self.buffer_m), name=np.str_(self.name))
-        tmp.replace(path)
 
     @classmethod
     def load(cls, path: str | Path) -> "TileMesh":

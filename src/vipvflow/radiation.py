@@ -36,7 +36,7 @@ import numpy as np
 import pandas as pd
 
 from .errors import InputError
-from .files import staging_dir, swap_dir
+from .store import DataDir, RadiationDir, staging_dir, swap_dir, write_json, write_npz
 
 log = logging.getLogger(__name__)
 
@@ -479,16 +479,16 @@ def ingest_cams(paths, data_dir, clear_sky_margin=CLEAR_SKY_MARGIN) -> dict:
                           "all_sky_from_clear_sky": bool((grid["flag"] & FLAG_NO_ALLSKY).any())})
     table = pd.concat(parts, ignore_index=True)
     # a new radiation/ folder, swapped in as a whole (table, report; the sun caches rebuild)
-    final = Path(data_dir) / "radiation"
-    out_dir = staging_dir(final)
-    table.to_parquet(out_dir / "radiation.parquet", index=False)
+    final = DataDir(data_dir).radiation.root
+    out_dir = RadiationDir(staging_dir(final))
+    table.to_parquet(out_dir.table, index=False)
     report = {"files": files, "locations": locations, "grid_step_s": _GRID_S,
               "time_stamp": "centre of each minute (Unix s)", "units": "W/m2 mean over the minute",
               "flags": {"gap": FLAG_GAP, "negative": FLAG_NEGATIVE, "ghi_above_toa": FLAG_GHI_TOA,
                         "ghi_above_clear": FLAG_GHI_CLEAR, "dni_above_extra": FLAG_DNI_EXTRA,
                         "all_sky_from_clear_sky": FLAG_NO_ALLSKY}}
-    (out_dir / "ingest_report.json").write_text(json.dumps(report, indent=2))
-    swap_dir(out_dir, final)
+    write_json(report, out_dir.report)
+    swap_dir(out_dir.root, final)
     return report
 
 
@@ -527,7 +527,7 @@ def _cached_sun(path: Path, grid, lat, lon, alt) -> np.ndarray:
     st = path.stat()
     key = json.dumps([st.st_size, st.st_mtime_ns, float(grid[0]), float(grid[-1]), len(grid),
                       np.round(lat, 8).tolist(), np.round(lon, 8).tolist(), np.round(alt, 3).tolist()])
-    cache = path.with_name(f"sun_{int(grid[0])}_{len(grid)}.npz")
+    cache = RadiationDir(path.parent).sun_cache(int(grid[0]), len(grid))
     try:
         with np.load(cache) as z:
             if str(z["key"]) == key:
@@ -535,10 +535,8 @@ def _cached_sun(path: Path, grid, lat, lon, alt) -> np.ndarray:
     except (OSError, KeyError, ValueError):
         pass
     sun = sun_vectors(grid, lat, lon, alt)
-    tmp = cache.with_name(f".{cache.name}.{os.getpid()}.tmp.npz")
     try:
-        np.savez(tmp, sun=sun, key=np.array(key))
-        os.replace(tmp, cache)
+        write_npz(cache, sun=sun, key=np.array(key))
     except OSError:
         pass
     return sun
@@ -661,7 +659,7 @@ class RadiationTable:
         InputError
             When the file is missing or does not cover any of the year.
         """
-        path = Path(data_dir) / "radiation" / "radiation.parquet"
+        path = DataDir(data_dir).radiation.table
         if not path.is_file():
             raise InputError(f"{path}: not found; run 'vipvflow ingest cams' first")
         lo = pd.Timestamp(f"{year}-01-01", tz="UTC").timestamp() - pad_days * 86400
@@ -696,7 +694,7 @@ class RadiationTable:
 
         with tempfile.TemporaryDirectory() as tmp:
             ingest_cams(paths, tmp)
-            table = pd.read_parquet(Path(tmp) / "radiation" / "radiation.parquet")
+            table = pd.read_parquet(DataDir(tmp).radiation.table)
         locs = table[["lat", "lon", "altitude"]].drop_duplicates().to_numpy()
         grid = np.arange(table["t_utc"].min(), table["t_utc"].max() + 1, _GRID_S, dtype=np.float64)
         values = {c: np.full((len(locs), len(grid)), np.nan, np.float32) for c in COLUMNS}

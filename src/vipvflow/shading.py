@@ -21,6 +21,7 @@ from embreex import rtcore_scene
 from embreex.mesh_construction import TriangleMesh
 
 from .mesh import SURFACE_CODE, TileMesh
+from .store import DataDir
 
 #: number of BVH builds by :func:`get_scene`, per (data_dir, tile)
 BVH_BUILDS: collections.Counter = collections.Counter()
@@ -202,7 +203,7 @@ def get_scene(data_dir, tile: str, cache_size: int = 8, n_threads: int | None = 
         if scene is not None:
             _cache.move_to_end(key)
             return scene
-    scene = Scene(TileMesh.load(Path(data_dir) / "city" / "meshes" / f"{tile}.npz"), n_threads=n_threads)
+    scene = Scene(TileMesh.load(DataDir(data_dir).city.mesh(tile)), n_threads=n_threads)
     with _cache_lock:
         BVH_BUILDS[key] += 1
         _cache[key] = scene

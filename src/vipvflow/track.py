@@ -17,6 +17,7 @@ import pandas as pd
 
 from .config import IrradianceCfg
 from .errors import InputError
+from .store import DataDir
 from .irradiance import evaluate_passes, segment_geometry
 from .shading import get_scene
 from .tiles import tile_names
@@ -99,7 +100,7 @@ def model_track(track: pd.DataFrame, data_dir, radiation_table, cfg: IrradianceC
     """Irradiance components (W/m2) at every point of a track read by :func:`read_track`."""
     cfg = cfg or IrradianceCfg()
     data_dir = Path(data_dir)
-    tiles_json = data_dir / "city" / "tiles.json"
+    tiles_json = DataDir(data_dir).city.tiles_json
     meta = json.loads(tiles_json.read_text())
     tr = track.sort_values("t_utc", kind="stable").reset_index(drop=True)
     x, y = tr["x"].to_numpy(), tr["y"].to_numpy()

@@ -31,6 +31,7 @@ import numpy as np
 import pandas as pd
 
 from .errors import InputError
+from .store import write_bytes, write_text
 
 VDRI_NAMES = {"s": "s_m", "v": "v_kmh", "grad": "grad_pct", "stop": "stop_s"}
 VDRI_HEADER = {v: f"<{k}>" for k, v in VDRI_NAMES.items()}
@@ -135,12 +136,7 @@ def write_vdri(vdri: pd.DataFrame, path: str | Path) -> Path:
     header = ",".join(VDRI_HEADER.get(c, f"<{c}>") for c in cols)
     columns = [_fmt(vdri[c].to_numpy()) for c in cols]
     lines = [header] + [",".join(row) for row in zip(*columns)]
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_bytes(("\r\n".join(lines) + "\r\n").encode("utf-8"))
-    tmp.replace(path)
-    return path
+    return write_bytes(("\r\n".join(lines) + "\r\n").encode("utf-8"), path)
 
 
 def _stationary_runs(moving: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -434,14 +430,12 @@ def _header() -> dict:
 def _write_json(path: Path, body: dict, file_version: int) -> Path:
     header = _header()
     header["FileVersion"] = file_version
-    path.write_text(json.dumps({"Header": header, "Body": body}, indent=2) + "\n", encoding="utf-8")
-    return path
+    return write_text(json.dumps({"Header": header, "Body": body}, indent=2) + "\n", path)
 
 
 def _write_csv(path: Path, header: str, rows: np.ndarray) -> Path:
     lines = [header] + [",".join(_fmt(r)) for r in rows]
-    path.write_bytes(("\r\n".join(lines) + "\r\n").encode("utf-8"))
-    return path
+    return write_bytes(("\r\n".join(lines) + "\r\n").encode("utf-8"), path)
 
 
 def write_vecto_job(out_dir: str | Path, params, cycles: list[str | Path] = (),

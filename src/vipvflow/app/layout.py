@@ -21,6 +21,7 @@ from bokeh.palettes import Category10_5, Viridis256
 from bokeh.plotting import figure
 from bokeh.transform import dodge
 
+from ..store import DataDir
 from .model import TECHNOLOGIES, PVChoice, TripModel
 
 log = logging.getLogger(__name__)
@@ -87,7 +88,7 @@ def _crs_name(model: TripModel) -> str:
     import json
 
     try:
-        return str(json.loads((model.data_dir / "city" / "tiles.json").read_text())["crs"])
+        return str(json.loads(DataDir(model.data_dir).city.tiles_json.read_text())["crs"])
     except (OSError, KeyError, ValueError):
         return "projected"
 

@@ -44,6 +44,7 @@ import pandas as pd
 
 from ..config import Config, PVSystem
 from ..irradiance import shading_loss
+from ..store import DataDir, RunDir
 
 #: PV technologies offered: PVWatts temperature coefficient of power (1/K, typical datasheet
 #: values), module efficiency at STC (for sizing by area) and the pvlib SAPM mounting of the
@@ -173,8 +174,8 @@ class TripModel:
         self.manifest = manifest
         self.year = int(manifest["year"])
         self.cfg = Config.model_validate(manifest["config"])
-        gdir = self.data_dir / "gtfs"
-        self.timezone = json.loads((gdir / "feed.json").read_text())["timezone"]
+        gdir = DataDir(self.data_dir).gtfs
+        self.timezone = json.loads(gdir.feed_json.read_text())["timezone"]
         self.vehicle = self.cfg.vehicle_params()
         self.run_pv = self.cfg.pv_system()
         self.run_pv_choice = PVChoice(
@@ -186,13 +187,13 @@ class TripModel:
 
         # segments with geometry factors and horizons, one row per segment id
         geo = pd.concat([pd.read_parquet(f) for f in
-                         sorted((self.run_dir / "parts" / "geometry").glob("tile=*.parquet"))],
+                         RunDir(self.run_dir).part_files("geometry")],
                         ignore_index=True)
         hor = load_horizons(self.run_dir)
         if len(hor) == 0:
             raise FileNotFoundError(f"{self.run_dir / 'parts' / 'horizon'}: no horizon profiles; "
                                     "re-run the simulation with this version of vipvflow")
-        seg = pd.read_parquet(gdir / "segments.parquet",
+        seg = pd.read_parquet(gdir.segments,
                               columns=["segment_id", "shape_id", "x", "y", "x_end", "y_end",
                                        "length_m", "tile"])
         geo = geo.merge(hor, on="segment_id", how="inner", validate="one_to_one")
@@ -210,11 +211,11 @@ class TripModel:
         self.radiation = RadiationTable.load(self.data_dir, self.year)
 
         # timetable
-        self.trips = pd.read_parquet(gdir / "trips.parquet")
+        self.trips = pd.read_parquet(gdir.trips)
         self.trips["route_id"] = self.trips["route_id"].astype(str)
         self.trips["service_id"] = self.trips["service_id"].astype(str)
         self.trips["direction_id"] = self.trips["direction_id"].fillna(0).astype(int)
-        pat = pd.read_parquet(gdir / "patterns.parquet")
+        pat = pd.read_parquet(gdir.patterns)
         pat = pat.sort_values(["pattern_id", "t_offset_s"], kind="stable")
         self._patterns = {int(k): g for k, g in pat.groupby("pattern_id", sort=True)}
         self.service_dates = service_dates(self.data_dir, self.year)

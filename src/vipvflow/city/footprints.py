@@ -7,9 +7,10 @@ seen from above. Everything is read from the data directory: no map service, no 
 """
 from __future__ import annotations
 
-from pathlib import Path
 
 import numpy as np
+
+from ..store import DataDir
 
 
 def building_footprints(data_dir, tiles=None, bounds=None) -> list[np.ndarray]:
@@ -28,7 +29,7 @@ def building_footprints(data_dir, tiles=None, bounds=None) -> list[np.ndarray]:
     import pyarrow.dataset as ds
     import shapely
 
-    root = Path(data_dir) / "city" / "surfaces"
+    root = DataDir(data_dir).city.surfaces
     files = sorted(root.glob("tile=*/*.parquet"))
     if tiles is not None:
         wanted = {f"tile={t}" for t in tiles}

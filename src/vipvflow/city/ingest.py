@@ -39,7 +39,8 @@ import numpy as np
 
 from ..config import CityCfg
 from ..errors import InputError
-from ..files import pid_alive, remove_stale, staging_dir, swap_dir
+from ..store import (CityDir, DataDir, atomic_path, pid_alive, remove_stale, staging_dir, swap_dir,
+                     write_json, write_npz)
 from ..mesh import SURFACE_CODE, SURFACE_TYPES, TileMesh
 from ..progress import Progress, citygml_bytes, file_position
 from ..tiles import tile_bounds, tile_index, tile_name
@@ -150,9 +151,7 @@ class _Chunk:
         return _Chunk(V=V, vsz=vsz, T=T, tsz=tsz, R=R, rsz=rsz, **out)
 
     def save(self, path: Path, own: np.ndarray) -> None:
-        tmp = path.with_name(path.name + ".tmp.npz")
-        np.savez(tmp, own=own, **{k: getattr(self, k) for k in self.FIELDS})
-        tmp.replace(path)
+        write_npz(path, own=own, **{k: getattr(self, k) for k in self.FIELDS})
 
     @classmethod
     def load_many(cls, paths) -> tuple["_Chunk", np.ndarray]:
@@ -293,11 +292,8 @@ def _write_tile(name: str, spool: Path, city_dir: Path, cfg: CityCfg, crs: str) 
         "area_m2": own_part.area, "nx": own_part.normal[:, 0], "ny": own_part.normal[:, 1],
         "nz": own_part.normal[:, 2], "albedo": own_part.albedo.astype(np.float64),
         "tile": np.full(n_own, name, dtype=object)}, geometry=polys, crs=crs)
-    out = city_dir / "surfaces" / f"tile={name}" / "part-0.parquet"
-    out.parent.mkdir(parents=True, exist_ok=True)
-    tmp = out.with_name(out.name + ".tmp")
-    gdf.to_parquet(tmp, index=False)
-    tmp.replace(out)
+    with atomic_path(CityDir(city_dir).surface_part(name)) as tmp:
+        gdf.to_parquet(tmp, index=False)
     del gdf, polys, rings
     # -- mesh (own + buffer)
     vo = _offsets(chunk.vsz)
@@ -309,7 +305,7 @@ def _write_tile(name: str, spool: Path, city_dir: Path, cfg: CityCfg, crs: str) 
                     normals=chunk.normal[tri_owner].astype(np.float32),
                     surface_type=chunk.code[tri_owner], bounds=bounds,
                     buffer_m=float(cfg.buffer_m), name=name)
-    mesh.save(city_dir / "meshes" / f"{name}.npz")
+    mesh.save(CityDir(city_dir).mesh(name))
     return {"bounds": bounds.tolist(), "n_surfaces": n_own,
             "n_buffer_surfaces": int(chunk.n - n_own), "n_triangles": int(len(triangles))}
 
@@ -364,7 +360,7 @@ def ingest_city(paths, data_dir, city_cfg: CityCfg | None = None, crs: str | Non
     data_dir = Path(data_dir)
     data_dir.mkdir(parents=True, exist_ok=True)
     remove_stale_ingests(data_dir)
-    final_dir = data_dir / "city"
+    final_dir = DataDir(data_dir).city.root
     city_dir = staging_dir(final_dir)           # data_dir/.city-ingest-<pid>, swapped in at the end
     albedo = cfg.albedo.model_dump()
     report = IngestReport(crs_source="--crs" if target else "")
@@ -413,9 +409,9 @@ def ingest_city(paths, data_dir, city_cfg: CityCfg | None = None, crs: str | Non
             tiles[name] = _write_tile(name, spool, city_dir, cfg, target)
         terrain_tris = _write_terrain(city_dir, acc, target)
         shutil.rmtree(spool)
-        _atomic_json(city_dir / "tiles.json", {
+        write_json({
             "crs": target, "tile_size_m": cfg.tile_size_m, "buffer_m": cfg.buffer_m,
-            "tiles": tiles})
+            "tiles": tiles}, CityDir(city_dir).tiles_json, sort_keys=True)
         report.surfaces = dict(counts.written)
         report.thematic_surfaces = dict(counts.thematic)
         report.area_m2 = {k: round(v, 3) for k, v in counts.area.items()}
@@ -428,8 +424,8 @@ def ingest_city(paths, data_dir, city_cfg: CityCfg | None = None, crs: str | Non
         report.triangles = int(sum(t["n_triangles"] for t in tiles.values()))
         report.terrain_triangles = terrain_tris
         report.elapsed_s = round(time.perf_counter() - t0, 3)
-        report.report_path = str(final_dir / "ingest_report.json")
-        _atomic_json(city_dir / "ingest_report.json", json.loads(report.to_json()))
+        report.report_path = str(CityDir(final_dir).report)
+        write_json(json.loads(report.to_json()), CityDir(city_dir).report, sort_keys=True)
         swap_dir(city_dir, final_dir)
     except BaseException:
         bar.close(failed=True)
@@ -575,12 +571,12 @@ def _check_not_empty(report: IngestReport, counts: _Counts, ignored: Counter,
 def remove_stale_ingests(data_dir: Path) -> list[Path]:
     """Remove what killed city ingests left in *data_dir*; return the paths removed.
 
-    ``.city-ingest-<pid>`` and ``.city-old-<pid>`` as :func:`vipvflow.files.remove_stale`
+    ``.city-ingest-<pid>`` and ``.city-old-<pid>`` as :func:`vipvflow.store.remove_stale`
     says (the previous city put back when a kill left none), and ``city/.ingest-spool-<pid>``
     (spools of older versions) when their process is gone.
     """
     data_dir = Path(data_dir)
-    final = data_dir / "city"
+    final = DataDir(data_dir).city.root
     had_city = final.exists()
     removed = remove_stale(final)
     if not had_city and final.exists():
@@ -605,23 +601,14 @@ def _write_terrain(city_dir: Path, acc: _Accumulator, crs: str | None) -> int:
     vertices = np.concatenate(V) if V else np.zeros((0, 3))
     triangles = np.concatenate(T).astype(np.int32) if T else np.zeros((0, 3), np.int32)
     ground = np.concatenate(acc.ground_points) if acc.ground_points else np.zeros((0, 3))
-    out = city_dir / "terrain.npz"
-    tmp = out.with_name(out.name + ".tmp.npz")
-    np.savez(tmp, tin_vertices=vertices, tin_triangles=triangles, ground_points=ground,
-             crs=np.str_(crs or ""))
-    tmp.replace(out)
+    write_npz(CityDir(city_dir).terrain, tin_vertices=vertices, tin_triangles=triangles,
+              ground_points=ground, crs=np.str_(crs or ""))
     return int(len(triangles))
-
-
-def _atomic_json(path: Path, data) -> None:
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(json.dumps(data, indent=2, sort_keys=True, default=str))
-    tmp.replace(path)
 
 
 def load_tile_mesh(data_dir, tile: str) -> TileMesh:
     """The mesh of *tile* (own + buffer surfaces) written by :func:`ingest_city`."""
-    path = Path(data_dir) / "city" / "meshes" / f"{tile}.npz"
+    path = DataDir(data_dir).city.mesh(tile)
     if not path.exists():
         raise InputError(f"{path}: no mesh for tile {tile} (run `vipvflow ingest city` first)")
     return TileMesh.load(path)

@@ -15,11 +15,11 @@ where there is nothing.
 """
 from __future__ import annotations
 
-from pathlib import Path
 
 import numpy as np
 
 from ..errors import InputError
+from ..store import DataDir
 
 
 class TerrainModel:
@@ -38,7 +38,7 @@ class TerrainModel:
     @classmethod
     def load(cls, data_dir, max_distance_m: float = 100.0) -> "TerrainModel":
         """Read ``<data_dir>/city/terrain.npz``."""
-        path = Path(data_dir) / "city" / "terrain.npz"
+        path = DataDir(data_dir).city.terrain
         if not path.exists():
             raise InputError(f"{path}: no terrain model (run `vipvflow ingest city` first)")
         with np.load(path, allow_pickle=False) as z:

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 from ..errors import InputError
+from ..store import RunDir
 
 
 def register(sub):
@@ -24,8 +25,9 @@ def run(args):
     from ..simulation.rundir import open_run
 
     run = open_run(args.run_dir, APP_NEEDS)       # from any working directory
-    if not (run.path / "parts" / "horizon").is_dir():
-        raise InputError(f"{run.path / 'parts' / 'horizon'}: no horizon profiles; the run predates "
+    horizons = RunDir(run.path).part_dir("horizon")
+    if not horizons.is_dir():
+        raise InputError(f"{horizons}: no horizon profiles; the run predates "
                          "them: delete the run's parts/ and simulate again")
     serve(run.path, port=args.port, host=args.host, show=args.show)
     return 0

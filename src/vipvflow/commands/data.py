@@ -11,7 +11,7 @@ from pathlib import Path
 import yaml
 
 from ..errors import InputError
-from ..files import sha256
+from ..store import sha256
 
 #: the CAMS radiation service (SoDa WPS); ``$VIPVFLOW_CAMS_URL`` replaces it (a mirror, tests)
 CAMS_SERVICE = "https://api.soda-solar.com/service/wps"

@@ -6,6 +6,7 @@ from pathlib import Path
 
 from ..config import load_config
 from ..errors import InputError
+from ..store import DataDir
 
 
 def register(sub):
@@ -32,7 +33,7 @@ def run(args):
         from ..simulation.rundir import open_run
 
         args.city = open_run(args.city, needs=("city/tiles.json",)).data_dir
-    tiles_json = args.city / "city" / "tiles.json"
+    tiles_json = DataDir(args.city).city.tiles_json
     if not tiles_json.is_file():
         raise InputError(f"{tiles_json}: not found; run 'vipvflow ingest city' first")
     city_crs = json.loads(tiles_json.read_text())["crs"]

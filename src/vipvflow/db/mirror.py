@@ -23,7 +23,7 @@ import pyarrow.csv as pacsv
 import pyarrow.parquet as pq
 
 from ..errors import InputError, VipvError
-from ..files import sha256
+from ..store import sha256
 from ..simulation.rundir import mask_text, masked_config
 from . import schema as S
 

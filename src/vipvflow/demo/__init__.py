@@ -20,7 +20,6 @@ size give byte-identical files.
 from __future__ import annotations
 
 import json
-import os
 import re
 import time
 from pathlib import Path
@@ -30,6 +29,7 @@ import shapely
 from pyproj import Transformer
 
 from ..progress import Progress
+from ..store import atomic_path, write_text
 from .cams import write_cams_csv
 from .city import SRS_NAME, Terrain, place_buildings, write_citygml
 from .gtfs import AVERAGE_SPEED_KMH, AGENCY_TZ, stop_positions, stop_offsets, trips_per_year, write_gtfs
@@ -45,14 +45,6 @@ TERRAIN_NEAR_M = 500.0     # terrain tiles written within this distance of a lin
 
 # a JSON list of numbers only, spread over lines by indent: printed on one line instead
 _NUMBER_LIST = re.compile(r"\[\s*((?:-?[\d.e+-]+,\s*)*-?[\d.e+-]+)\s*\]")
-
-
-def _tmp(path: Path) -> Path:
-    return path.with_name(f".{path.name}.tmp")
-
-
-def _commit(path: Path) -> None:
-    os.replace(_tmp(path), path)
 
 
 def _rounded(xy, nd: int = 2) -> list:
@@ -153,31 +145,29 @@ def _generate(paths: dict, seconds: dict, year: int, seed: int, size: str, bar) 
     buildings = place_buildings(layout, terrain, seed)
     near = shapely.union_all([shapely.buffer(shapely.linestrings(line.xy), TERRAIN_NEAR_M)
                               for line in layout.lines])
-    city = write_citygml(_tmp(paths["citygml"]), buildings, terrain, near)
-    _commit(paths["citygml"])
+    with atomic_path(paths["citygml"]) as tmp:
+        city = write_citygml(tmp, buildings, terrain, near)
     seconds["citygml"] = time.perf_counter() - t
     bar.update(1, "GTFS")
 
     t = time.perf_counter()
-    gtfs = write_gtfs(_tmp(paths["gtfs"]), layout, year)
-    _commit(paths["gtfs"])
+    with atomic_path(paths["gtfs"]) as tmp:
+        gtfs = write_gtfs(tmp, layout, year)
     seconds["gtfs"] = time.perf_counter() - t
     bar.update(1, "layout")
 
     t = time.perf_counter()
     doc = layout_document(layout, year, buildings, terrain)
-    with open(_tmp(paths["layout"]), "w", encoding="utf-8", newline="\n") as fh:
-        fh.write(_NUMBER_LIST.sub(lambda m: "[" + " ".join(m.group(1).split()) + "]",
-                                  json.dumps(doc, indent=1)) + "\n")
-    _commit(paths["layout"])
+    write_text(_NUMBER_LIST.sub(lambda m: "[" + " ".join(m.group(1).split()) + "]",
+                                json.dumps(doc, indent=1)) + "\n", paths["layout"])
     seconds["layout"] = time.perf_counter() - t
     bar.update(1, "CAMS radiation year")
 
     t = time.perf_counter()
     alt = round(float(terrain.z(*CENTRE_XY)), 2)
-    cams = write_cams_csv(_tmp(paths["cams"]), year, round(doc["centre"]["lat"], 4),
-                          round(doc["centre"]["lon"], 4), alt, seed)
-    _commit(paths["cams"])
+    with atomic_path(paths["cams"]) as tmp:
+        cams = write_cams_csv(tmp, year, round(doc["centre"]["lat"], 4),
+                              round(doc["centre"]["lon"], 4), alt, seed)
     seconds["cams"] = time.perf_counter() - t
     bar.update(1, "done")
 

@@ -36,6 +36,7 @@ import pyarrow.parquet as pq
 from lxml import etree
 
 from ..errors import InputError
+from ..store import DataDir, RunDir, atomic_path
 from .citygml3 import (CORE, DYN, NSMAP, SCHEMA_LOCATIONS, XSI, first_srs_name, q, schema_location,
                        srs_name, vertical_epsg)
 
@@ -185,7 +186,7 @@ def load_run(run_dir: str | Path) -> RunData:
     run = open_run(run_dir)          # the data dir found from anywhere (run folders travel)
     manifest, data_dir = run.manifest, run.data_dir
     tz = "UTC"
-    feed = data_dir / "gtfs" / "feed.json"
+    feed = DataDir(data_dir).gtfs.feed_json
     if feed.exists():
         tz = json.loads(feed.read_text()).get("timezone", "UTC")
     else:
@@ -741,11 +742,11 @@ def reflector_contributions(run: RunData, sel: Selection | None = None) -> pd.Da
 
     cols = ["surface_id", "building_id", "surface_type", "month", "pv_kwh_reflected", "segments"]
     months = sel.months if sel is not None else run.months
-    files = sorted((run.run_dir / "parts" / "geometry").glob("tile=*.parquet"))
+    files = RunDir(run.run_dir).part_files("geometry")
     pieces = []
     for f in files:
         tile = f.stem.split("=", 1)[1]
-        mesh_path = run.data_dir / "city" / "meshes" / f"{tile}.npz"
+        mesh_path = DataDir(run.data_dir).city.mesh(tile)
         if not mesh_path.exists():
             log.warning("no city mesh for tile %s (%s): its reflectors are not attributed", tile, mesh_path)
             continue
@@ -798,7 +799,7 @@ def _tile_reflected(run: RunData, tile: str, months: list[str]) -> pd.DataFrame:
     """``segment_id, month, pv_kwh_reflected`` of one tile (its run partitions)."""
     frames = []
     for m in months:
-        f = run.run_dir / "parts" / "segment_month" / f"tile={tile}" / f"month={m}.parquet"
+        f = RunDir(run.run_dir).part("segment_month", tile, m)
         if f.exists():
             d = pq.read_table(f, columns=["segment_id", "pv_kwh_reflected"])
             frames.append(pd.DataFrame({"segment_id": d.column(0).to_numpy(), "month": m,
@@ -815,7 +816,7 @@ def _building_ids(data_dir: Path, wanted: set) -> dict:
 
     value_set = pa.array(sorted(map(str, wanted)), pa.string())
     out = {}
-    for f in sorted((data_dir / "city" / "surfaces").glob("tile=*/*.parquet")):
+    for f in sorted(DataDir(data_dir).city.surfaces.glob("tile=*/*.parquet")):
         t = pq.read_table(f, columns=["surface_id", "building_id"])
         t = t.filter(pc.is_in(pc.cast(t.column("surface_id"), pa.string()), value_set=value_set))
         out.update(zip(t.column("surface_id").to_pylist(), t.column("building_id").to_pylist()))
@@ -886,7 +887,6 @@ def write_dynamizers(run_dir: str | Path, out: str | Path, encoding: str = "inli
     out.parent.mkdir(parents=True, exist_ok=True)
     counts = {"segments": 0, "route_directions": 0, "surfaces": 0, "network": 0, "dynamizers": 0}
     table = _Tabulated(out.with_suffix(".csv")) if encoding == "tabulated" else None
-    tmp = out.with_name(out.name + ".tmp")
 
     def members() -> Iterator[MemberWriter]:
         if aggregate == "segment":
@@ -901,17 +901,15 @@ def write_dynamizers(run_dir: str | Path, out: str | Path, encoding: str = "inli
 
     ok = False
     try:
-        if embed is None:
-            _write_standalone(tmp, run, sel, members())
-        else:
-            _write_embedded(tmp, Path(embed), members())
+        with atomic_path(out) as tmp:
+            if embed is None:
+                _write_standalone(tmp, run, sel, members())
+            else:
+                _write_embedded(tmp, Path(embed), members())
         ok = True
     finally:
         if table is not None:
             table.close(keep=ok)
-        if not ok:
-            tmp.unlink(missing_ok=True)
-    tmp.replace(out)
     files = [out] + ([table.path] if table is not None else [])
     return {"files": files, "aggregate": aggregate, **counts}
 

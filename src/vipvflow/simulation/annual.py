@@ -18,6 +18,7 @@ import numpy as np
 import pandas as pd
 
 from ..irradiance import shading_loss
+from ..store import DataDir
 
 #: geometry factors of ``parts/geometry`` that a map reader needs (the rest is the irradiance
 #: model's internal reflector geometry and stays in parts/)
@@ -79,7 +80,7 @@ def site_ghi_kwh_m2(data_dir: Path, year: int, min_coverage: float = 0.99) -> fl
     60 s; the few missing minutes of a covered year are filled with the year's mean."""
     import pyarrow.parquet as pq
 
-    path = Path(data_dir) / "radiation" / "radiation.parquet"
+    path = DataDir(data_dir).radiation.table
     if not path.is_file():
         return None
     lo = int(pd.Timestamp(f"{year}-01-01", tz="UTC").timestamp())

@@ -1,7 +1,7 @@
 """The data dictionary of a run's outputs: every column of every output file, its unit and meaning.
 
 The same entries go three ways: into each output Parquet file as field metadata (``unit``,
-``description``; :func:`annotate`, applied by :func:`vipvflow.simulation.storage.write_parquet`
+``description``; :func:`annotate`, applied by :func:`vipvflow.store.write_parquet`
 to files named as an output), into ``docs/outputs.md`` (:func:`render_markdown`, kept in sync
 by a test) and into the report.
 

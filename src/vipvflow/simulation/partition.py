@@ -16,7 +16,7 @@ import numpy as np
 import pandas as pd
 
 from ..config import IrradianceCfg, PVSystem
-from .storage import geometry_path, partition_path, write_parquet
+from ..store import PARTITION_KINDS, DataDir, RunDir, write_parquet
 
 #: per-pass energy columns (kWh) and irradiation columns (Wh/m2) summed in a partition
 PV_COMPONENTS = ("direct", "diffuse", "reflected")
@@ -54,7 +54,7 @@ class RunContext:
 def _segments(data_dir: str) -> pd.DataFrame:
     cols = ["segment_id", "shape_id", "x", "y", "z", "x_end", "y_end", "z_end", "heading_deg",
             "gradient", "length_m", "tile"]
-    seg = pd.read_parquet(Path(data_dir) / "gtfs" / "segments.parquet", columns=cols)
+    seg = pd.read_parquet(DataDir(data_dir).gtfs.segments, columns=cols)
     return seg.set_index("segment_id", drop=False).sort_index()
 
 
@@ -122,10 +122,10 @@ def tile_geometry(ctx: RunContext, tile: str) -> pd.DataFrame:
     once per run and stored in ``parts/geometry/tile=<TILE>.parquet``, and the segments'
     horizon profiles (:func:`vipvflow.horizon.horizon_profile` from the roof ray origins)
     in ``parts/horizon/tile=<TILE>.parquet``, so a trip can be recomputed without rays."""
-    from ..horizon import horizon_frame, horizon_path, horizon_profile
+    from ..horizon import horizon_frame, horizon_profile
     from ..irradiance import segment_geometry
 
-    path = geometry_path(Path(ctx.run_dir), tile)
+    path = RunDir(ctx.run_dir).tile_part("geometry", tile)
     if path.exists():
         geom = pd.read_parquet(path)
     else:
@@ -135,7 +135,7 @@ def tile_geometry(ctx: RunContext, tile: str) -> pd.DataFrame:
             seg = seg[seg["shape_id"].isin(ctx.shapes)]
         geom = segment_geometry(_scene(ctx, tile), seg, IrradianceCfg(**ctx.irradiance))
         write_parquet(geom, path)
-    hpath = horizon_path(ctx.run_dir, tile)
+    hpath = RunDir(ctx.run_dir).tile_part("horizon", tile)
     if not hpath.exists():
         origins = geom[["px", "py", "pz"]].to_numpy(np.float64)
         profile = horizon_profile(_scene(ctx, tile), origins,
@@ -307,7 +307,7 @@ def run_partition(ctx: RunContext, tile: str, month: str, geometry: pd.DataFrame
 
     tune_malloc()
     t0 = time.perf_counter()
-    run_dir = Path(ctx.run_dir)
+    run = RunDir(ctx.run_dir)
     if geometry is None:
         geometry = tile_geometry(ctx, tile)
     passes = iter_passes(ctx.data_dir, tile, month, ctx.year, routes=ctx.routes)
@@ -336,10 +336,10 @@ def run_partition(ctx: RunContext, tile: str, month: str, geometry: pd.DataFrame
     timings["reduce_s"] = time.perf_counter() - t2
 
     t3 = time.perf_counter()
-    write_parquet(hourly, partition_path(run_dir, "hourly", tile, month))
-    write_parquet(trip, partition_path(run_dir, "trip", tile, month))
+    write_parquet(hourly, run.part("hourly", tile, month))
+    write_parquet(trip, run.part("trip", tile, month))
     # segment_month last: its presence marks the partition complete
-    write_parquet(segm, partition_path(run_dir, "segment_month", tile, month))
+    write_parquet(segm, run.part("segment_month", tile, month))
     timings["write_s"] = time.perf_counter() - t3
 
     by_route: dict[str, float] = {}
@@ -353,8 +353,7 @@ def run_partition(ctx: RunContext, tile: str, month: str, geometry: pd.DataFrame
 
 
 def partition_done(run_dir: Path, tile: str, month: str) -> bool:
-    return all(partition_path(run_dir, kind, tile, month).exists()
-               for kind in ("hourly", "trip", "segment_month"))
+    return all(RunDir(run_dir).part(kind, tile, month).exists() for kind in PARTITION_KINDS)
 
 
 def worker_bvh_builds() -> dict:

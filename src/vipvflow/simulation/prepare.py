@@ -7,7 +7,7 @@ from pathlib import Path
 
 from ..config import Config
 from ..errors import InputError
-from ..files import sha256
+from ..store import DataDir, sha256, write_text
 
 log = logging.getLogger(__name__)
 
@@ -41,8 +41,7 @@ def _read_marker(path: Path) -> dict | None:
 
 
 def _stamp(stamp: Path, fp: dict) -> None:
-    stamp.parent.mkdir(parents=True, exist_ok=True)
-    stamp.write_text(json.dumps(fp, indent=1))
+    write_text(json.dumps(fp, indent=1), stamp)
 
 
 def ensure_demo(cfg: Config, year: int, say=print) -> None:
@@ -94,7 +93,8 @@ def ensure_ingested(cfg: Config, say=print) -> dict:
 
     city_fp = _fingerprint(city_files, {"city": cfg.city.model_dump(mode="json"),
                                         "crs": cfg.inputs.citygml_crs})
-    stamp = data_dir / "city" / ".inputs.json"
+    data = DataDir(data_dir)
+    stamp = data.city.stamp
     if city_files and not _cached(stamp, city_fp):
         say(f"ingesting {len(city_files)} CityGML file(s)")
         report = ingest_city(city_files, data_dir, cfg.city, crs=cfg.inputs.citygml_crs)
@@ -103,7 +103,7 @@ def ensure_ingested(cfg: Config, say=print) -> dict:
     gtfs_fp = _fingerprint([gtfs], {"trajectory": cfg.trajectory.model_dump(mode="json"), "city": city_fp,
                                     "timezone": cfg.inputs.gtfs_timezone,
                                     "route_types": cfg.run.route_types})
-    stamp = data_dir / "gtfs" / ".inputs.json"
+    stamp = data.gtfs.stamp
     if not _cached(stamp, gtfs_fp):
         from ..commands.ingest_gtfs import findings
 
@@ -118,10 +118,10 @@ def ensure_ingested(cfg: Config, say=print) -> dict:
             say("  " + line)
         _stamp(stamp, gtfs_fp)
     else:
-        _earlier(data_dir / "gtfs" / "feed.json", "problems", say)
+        _earlier(data.gtfs.feed_json, "problems", say)
     # the checks' version: data ingested before gaps were listed is read again
     cams_fp = _fingerprint(cams_files, {"checks": 2})
-    stamp = data_dir / "radiation" / ".inputs.json"
+    stamp = data.radiation.stamp
     if not _cached(stamp, cams_fp):
         say(f"ingesting {len(cams_files)} CAMS file(s)")
         from ..commands.ingest_cams import findings
@@ -131,7 +131,7 @@ def ensure_ingested(cfg: Config, say=print) -> dict:
             say("  " + line)
         _stamp(stamp, cams_fp)
     else:
-        _earlier(data_dir / "radiation" / "ingest_report.json", "gaps", say)
+        _earlier(data.radiation.report, "gaps", say)
     return {str(p): sha256(p) for p in [*city_files, gtfs, *cams_files]}
 
 
@@ -200,9 +200,10 @@ def preflight(cfg: Config, year: int, say=print) -> dict:
 
     check_year(year)
     data_dir = Path(cfg.data_dir)
-    gdir = data_dir / "gtfs"
-    feed = json.loads((gdir / "feed.json").read_text())
-    trips = pd.read_parquet(gdir / "trips.parquet",
+    data = DataDir(data_dir)
+    gdir = data.gtfs.root
+    feed = json.loads(data.gtfs.feed_json.read_text())
+    trips = pd.read_parquet(data.gtfs.trips,
                             columns=["trip_id", "route_id", "shape_id", "service_id", "pattern_id",
                                      "start_s"])
     routes = cfg.run.routes
@@ -226,10 +227,10 @@ def preflight(cfg: Config, year: int, say=print) -> dict:
                          f"{year}{which}; it runs from {lo} to {hi}")
 
     # --- city
-    tiles_json = data_dir / "city" / "tiles.json"
+    tiles_json = data.city.tiles_json
     if tiles_json.exists():
         city = json.loads(tiles_json.read_text())
-        seg = pd.read_parquet(gdir / "segments.parquet", columns=["tile", "shape_id"])
+        seg = pd.read_parquet(data.gtfs.segments, columns=["tile", "shape_id"])
         seg = seg[seg["shape_id"].isin(set(trips["shape_id"]))]
         inside = seg["tile"].isin(set(city.get("tiles", {})))
         if len(seg) and not inside.any():
@@ -242,14 +243,14 @@ def preflight(cfg: Config, year: int, say=print) -> dict:
                 "model's tiles (nothing shades them there)")
 
     # --- radiation over every service day's hours on the road
-    pat = pd.read_parquet(gdir / "patterns.parquet", columns=["pattern_id", "t_offset_s", "dt_s"])
+    pat = pd.read_parquet(data.gtfs.patterns, columns=["pattern_id", "t_offset_s", "dt_s"])
     dur = (pat["t_offset_s"] + pat["dt_s"]).groupby(pat["pattern_id"]).max()
     tr = trips.assign(end_s=trips["start_s"] + trips["pattern_id"].map(dur).fillna(0.0))
     span = tr.groupby("service_id").agg(lo=("start_s", "min"), hi=("end_s", "max"))
     days = sd.join(span, on="service_id").groupby("date").agg(lo=("lo", "min"), hi=("hi", "max"))
     origin = service_day_origin_utc(days.index.to_numpy(), feed["timezone"])
     lo, hi = origin + days["lo"].to_numpy(), origin + days["hi"].to_numpy()
-    report_path = data_dir / "radiation" / "ingest_report.json"
+    report_path = data.radiation.report
     try:
         rad = json.loads(report_path.read_text())
     except (OSError, ValueError):

@@ -21,7 +21,7 @@ import pyarrow.parquet as pq
 from ..config import Config
 from ..errors import InputError
 from ..irradiance import shading_loss
-from .storage import write_json, write_parquet
+from ..store import DataDir, RunDir, write_json, write_parquet
 
 log = logging.getLogger(__name__)
 
@@ -34,7 +34,7 @@ def _part_table(run_dir: Path, kind: str, pattern: str = "tile=*/month=*.parquet
     thousands of small files: one pandas read each cost most of the reduce); files whose
     schemas differ (an empty partition's columns, say) are read one by one and their
     schemas promoted instead."""
-    files = sorted((run_dir / "parts" / kind).glob(pattern))
+    files = RunDir(run_dir).part_files(kind, pattern)
     if not files:
         return None
     try:
@@ -121,7 +121,7 @@ def _radiation_gaps(data_dir: Path, year: int, months) -> dict:
     import json
 
     try:
-        rad = json.loads((data_dir / "radiation" / "ingest_report.json").read_text())
+        rad = json.loads(DataDir(data_dir).radiation.report.read_text())
     except (OSError, ValueError):
         return {}
     spans = [(pd.Timestamp(year, m, 1, tz="UTC").timestamp(),
@@ -175,9 +175,9 @@ def block_day_table(cfg: Config, run_dir: Path, trip: pd.DataFrame, vehicle):
     from ..trajectory.schedule import IDLE_BLOCK
     from ..vehicle import block_day_balance
 
-    tdir = run_dir / "parts" / "timeline"
-    tl = pd.read_parquet(tdir / "block_days.parquet")
-    runs = pd.read_parquet(tdir / "trip_runs.parquet")
+    run = RunDir(run_dir)
+    tl = pd.read_parquet(run.timeline_table("block_days"))
+    runs = pd.read_parquet(run.timeline_table("trip_runs"))
     key = ["block_id", "service_date"]
     merged = trip.drop(columns=["block_id"]).merge(runs, on=["trip_id", "service_date"], how="left",
                                                    validate="one_to_one")
@@ -263,7 +263,7 @@ def reduce_run(cfg: Config, year: int, run_dir: Path, say=print) -> dict:
     from .report import write_report
 
     data_dir = Path(cfg.data_dir)
-    trips_meta = pd.read_parquet(data_dir / "gtfs" / "trips.parquet")
+    trips_meta = pd.read_parquet(DataDir(data_dir).gtfs.trips)
 
     # --- per trip and service date
     trip = _trip_totals(run_dir)
@@ -273,7 +273,7 @@ def reduce_run(cfg: Config, year: int, run_dir: Path, say=print) -> dict:
                       on="trip_id", how="left", validate="many_to_one")
     trip["month"] = pd.to_datetime(trip["service_date"]).dt.strftime("%Y-%m")
     cons = trip_consumption(cfg, data_dir, year, trip["pattern_id"].unique(),
-                            vecto_dir=run_dir / "vecto", say=say)
+                            vecto_dir=RunDir(run_dir).vecto, say=say)
     trip = trip.merge(cons, on=["pattern_id", "month"], how="left", validate="many_to_one")
     trip["coverage"] = trip["pv_kwh"] / trip["consumption_kwh"]
     # vehicle block per day: driving, layovers, parked; the battery's share (sets the
@@ -283,7 +283,7 @@ def reduce_run(cfg: Config, year: int, run_dir: Path, say=print) -> dict:
     write_parquet(trip, run_dir / "trip_energy.parquet")
 
     # --- segments (their geometry factors and year: after the segment-months)
-    segments = gpd.read_parquet(data_dir / "gtfs" / "segments.parquet")
+    segments = gpd.read_parquet(DataDir(data_dir).gtfs.segments)
     segments = segments[segments["shape_id"].isin(trip["shape_id"].unique())]
     geo = _part_table(run_dir, "geometry", "tile=*.parquet")
     geo = geo.to_pandas() if geo is not None else None

@@ -22,6 +22,7 @@ from matplotlib.collections import LineCollection, PolyCollection  # noqa: E402
 from matplotlib.patches import Rectangle  # noqa: E402
 
 from ..irradiance import shading_loss  # noqa: E402
+from ..store import RunDir, write_bytes, write_text  # noqa: E402
 from .dictionary import SUMMARY  # noqa: E402
 
 #: colour limits of the maps: these percentiles of the segments' values (a few segments with
@@ -34,13 +35,11 @@ CLOSE_UP_M = 1200.0
 
 
 def _save(fig, run_dir: Path, name: str) -> str:
-    out = run_dir / "figures"
-    out.mkdir(parents=True, exist_ok=True)
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=110, bbox_inches="tight")
     plt.close(fig)
     data = buf.getvalue()
-    (out / f"{name}.png").write_bytes(data)
+    write_bytes(data, RunDir(run_dir).figures / f"{name}.png")
     return base64.b64encode(data).decode()
 
 
@@ -387,9 +386,7 @@ p{{line-height:1.45;max-width:900px}}</style></head><body>
 <h2>Summary</h2>{summary_table(summary)}
 <h2>Inputs</h2>{_inputs_table(cfg, crs, len(tiles) if tiles else None)}
 {''.join(parts)}</body></html>"""
-    path = run_dir / "report.html"
-    path.write_text(doc, encoding="utf-8")
-    return path
+    return write_text(doc, RunDir(run_dir).report)
 
 
 def _model_note(summary: dict) -> str:

@@ -21,7 +21,7 @@ from ..progress import FolderProgress, MapProgress
 from .partition import RunContext, partition_done, run_partition, tile_geometry, worker_bvh_builds
 from .standing import run_standing, standing_done, write_timeline
 from .rundir import data_dir_record, masked_config
-from .storage import write_json
+from ..store import DataDir, RunDir, aside_folders, set_aside, write_json, write_text
 
 log = logging.getLogger(__name__)
 
@@ -34,16 +34,13 @@ def _months(cfg: Config, year: int) -> list[str]:
     return [f"{year}-{m:02d}" for m in cfg.run.months]
 
 
-CONFIG_STAMP = ("parts", "config_digest.txt")
-
-
 def _digest_in(run_dir: Path) -> str | None:
     """The configuration digest of the run (finished or partial) in *run_dir*, if any."""
-    stamp = run_dir.joinpath(*CONFIG_STAMP)
-    if stamp.is_file():
-        return stamp.read_text().strip()
+    run = RunDir(run_dir)
+    if run.config_stamp.is_file():
+        return run.config_stamp.read_text().strip()
     try:
-        return json.loads((run_dir / "manifest.json").read_text()).get("config_digest")
+        return json.loads(run.manifest.read_text()).get("config_digest")
     except (OSError, ValueError, AttributeError):
         return None
 
@@ -56,7 +53,7 @@ def claim_run_dir(run_dir: Path, digest: str, force: bool = False, say=print) ->
     then deleted, so that an interruption leaves either the old run or the new one, never
     parts of both. Folders left aside by an interrupted replacement are removed.
     """
-    for stale in run_dir.parent.glob(f".{run_dir.name}.replaced-*"):
+    for stale in aside_folders(run_dir):
         shutil.rmtree(stale, ignore_errors=True)
     other = _digest_in(run_dir)
     if other is not None and other != digest:
@@ -65,14 +62,12 @@ def claim_run_dir(run_dir: Path, digest: str, force: bool = False, say=print) ->
                 f"{run_dir}: holds a run of another configuration (digest {other}; this "
                 f"configuration's digest is {digest}): pass --force to replace it, or set "
                 "another scenario or out_dir")
-        aside = run_dir.parent / f".{run_dir.name}.replaced-{other}-{os.getpid()}"
-        os.replace(run_dir, aside)
+        aside = set_aside(run_dir, other)
         say(f"replacing the run of configuration {other} in {run_dir}")
         shutil.rmtree(aside, ignore_errors=True)
-    stamp = run_dir.joinpath(*CONFIG_STAMP)
-    stamp.parent.mkdir(parents=True, exist_ok=True)
+    stamp = RunDir(run_dir).config_stamp
     if not stamp.is_file():
-        stamp.write_text(digest)
+        write_text(digest, stamp)
 
 
 #: Dask settings of a LocalCluster started by a run, whose processes share the machine's
@@ -133,8 +128,8 @@ def dashboard_address(port: int | None) -> str:
 def selected_network(cfg: Config) -> tuple[pd.DataFrame, tuple | None, list[str]]:
     """The trips (``trip_id, route_id, shape_id``), shapes (``None``: all) and tiles that
     the run covers, after ``run.routes``; needs the ingested GTFS in ``cfg.data_dir``."""
-    data_dir = Path(cfg.data_dir)
-    trips = pd.read_parquet(data_dir / "gtfs" / "trips.parquet", columns=["trip_id", "route_id", "shape_id"])
+    gtfs = DataDir(cfg.data_dir).gtfs
+    trips = pd.read_parquet(gtfs.trips, columns=["trip_id", "route_id", "shape_id"])
     routes = cfg.run.routes
     shapes = None
     if routes is not None:
@@ -143,7 +138,7 @@ def selected_network(cfg: Config) -> tuple[pd.DataFrame, tuple | None, list[str]
             raise InputError(f"{cfg._source}: run.routes: route_id(s) not in the feed: {', '.join(unknown)}")
         trips = trips[trips["route_id"].astype(str).isin(routes)]
         shapes = tuple(sorted(trips["shape_id"].unique()))
-    seg = pd.read_parquet(data_dir / "gtfs" / "segments.parquet", columns=["tile", "shape_id"])
+    seg = pd.read_parquet(gtfs.segments, columns=["tile", "shape_id"])
     if shapes is not None:
         seg = seg[seg["shape_id"].isin(shapes)]
     return trips, shapes, sorted(seg["tile"].unique())
@@ -184,7 +179,7 @@ def run_simulation(cfg: Config, year: int, scheduler: str | None = None,
     timings["prepare_s"] = time.perf_counter() - t_start
 
     data_dir = Path(cfg.data_dir)
-    feed = json.loads((data_dir / "gtfs" / "feed.json").read_text())
+    feed = json.loads(DataDir(data_dir).gtfs.feed_json.read_text())
     trips, shapes, tiles = selected_network(cfg)
     routes = cfg.run.routes
     ctx = RunContext(
@@ -333,7 +328,7 @@ def _write_manifest(cfg, year, run_dir, checksums, timings, results, builds) -> 
         "bvh_builds_per_worker": builds,
         "created_utc": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
     }
-    write_json(manifest, run_dir / "manifest.json")
+    write_json(manifest, RunDir(run_dir).manifest)
 
 
 def _summary_line(s: dict) -> str:

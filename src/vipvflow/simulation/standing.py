@@ -23,7 +23,7 @@ import numpy as np
 import pandas as pd
 
 from ..config import IrradianceCfg
-from .storage import partition_path, write_parquet
+from ..store import ALL_MONTHS, DataDir, RunDir, write_parquet
 
 #: energy (kWh) columns of an interval and the irradiance component each integrates
 PV_SOURCE = {"pv_kwh": "total", "pv_kwh_clear": "total_clear", "pv_kwh_unshaded": "total_unshaded",
@@ -36,7 +36,7 @@ _MINUTE = 60.0
 
 
 def timeline_dir(run_dir) -> Path:
-    return Path(run_dir) / "parts" / "timeline"
+    return RunDir(run_dir).timeline
 
 
 def open_scene():
@@ -120,10 +120,6 @@ def interval_integrals(intervals: pd.DataFrame, geometry: pd.DataFrame, radiatio
     return pd.DataFrame(out, index=intervals.index)
 
 
-#: the ``month`` of a standing partition: one per tile holds all the run's months (a tile
-#: has only a few standing points; per month, loading the tile's scene cost more than them)
-ALL_MONTHS = "all"
-
 
 def run_standing(ctx, tile: str) -> dict:
     """Evaluate the layover and parked intervals at the points of *tile* (``open`` and
@@ -134,10 +130,10 @@ def run_standing(ctx, tile: str) -> dict:
 
     tune_malloc()
     t_start = time.perf_counter()
-    tdir = timeline_dir(ctx.run_dir)
-    points = pd.read_parquet(tdir / "points.parquet")
+    run = RunDir(ctx.run_dir)
+    points = pd.read_parquet(run.timeline_table("points"))
     points = points[points["tile"] == tile]
-    iv = pd.read_parquet(tdir / "intervals.parquet")
+    iv = pd.read_parquet(run.timeline_table("intervals"))
     iv = iv[iv["point_id"].isin(points["point_id"])].reset_index(drop=True)
     cfg = IrradianceCfg(**ctx.irradiance)
     dark = tile == "covered" or not len(iv)
@@ -171,7 +167,7 @@ def run_standing(ctx, tile: str) -> dict:
     table = pd.concat([iv[["block_id", "service_date", "kind", "after_trip", "point_id", "t0_utc",
                            "t1_utc", "buses"]].astype({"block_id": str, "kind": str}), res], axis=1)
     table["tile"] = tile
-    write_parquet(table, partition_path(Path(ctx.run_dir), "standing", tile, ALL_MONTHS))
+    write_parquet(table, RunDir(ctx.run_dir).part("standing", tile, ALL_MONTHS))
     elapsed = time.perf_counter() - t_start
     # standing_s in all; its parts: reading the timeline, the tile's scene and radiation table
     # (cached per worker), the points' geometry factors, the minutes through the kernel
@@ -199,12 +195,13 @@ def depot_point(cfg, data_dir) -> tuple | None:
     depot = cfg.fleet.depot
     if depot is None:
         return None
-    feed = json.loads((Path(data_dir) / "gtfs" / "feed.json").read_text())
+    data = DataDir(data_dir)
+    feed = json.loads(data.gtfs.feed_json.read_text())
     x, y = Transformer.from_crs("EPSG:4326", feed["crs"], always_xy=True).transform(depot.lon, depot.lat)
-    seg = pd.read_parquet(Path(data_dir) / "gtfs" / "segments.parquet", columns=["x", "y", "z"])
+    seg = pd.read_parquet(data.gtfs.segments, columns=["x", "y", "z"])
     near = int(np.argmin(np.hypot(seg["x"].to_numpy() - x, seg["y"].to_numpy() - y)))
-    tile = str(tile_names([x], [y], float(feed.get("tile_size_m", 500.0)))[0])
-    mesh = Path(data_dir) / "city" / "meshes" / f"{tile}.npz"
+    tile = str(tile_names([x], [y], data.tile_size_m())[0])
+    mesh = data.city.mesh(tile)
     if cfg.fleet.depot_shading == "city" and not mesh.exists():
         raise InputError(f"{cfg._source}: fleet.depot ({depot.lat}, {depot.lon}) lies outside the city "
                          f"model (no mesh for tile {tile}); set fleet.depot_shading to open or covered")
@@ -218,8 +215,8 @@ def write_timeline(cfg, year: int, run_dir, routes=None) -> list[tuple[str, str]
     run and return the tiles that have standing intervals (one ``standing`` task each)."""
     from ..trajectory.schedule import block_timeline
 
-    tdir = timeline_dir(run_dir)
-    if not (tdir / "points.parquet").exists():
+    run = RunDir(run_dir)
+    if not run.timeline_table("points").exists():
         tl = block_timeline(cfg.data_dir, year, months=cfg.run.months, routes=routes,
                             depot=depot_point(cfg, cfg.data_dir), depot_shading=cfg.fleet.depot_shading)
         iv = tl["intervals"]
@@ -227,15 +224,15 @@ def write_timeline(cfg, year: int, run_dir, routes=None) -> list[tuple[str, str]
             iv = iv[iv["kind"] == "layover"]
         elif cfg.fleet.harvest == "driving":
             iv = iv.iloc[:0]
-        write_parquet(tl["block_days"].reset_index(drop=True), tdir / "block_days.parquet")
-        write_parquet(iv.astype({"kind": str}).reset_index(drop=True), tdir / "intervals.parquet")
-        write_parquet(tl["trip_runs"], tdir / "trip_runs.parquet")
+        write_parquet(tl["block_days"].reset_index(drop=True), run.timeline_table("block_days"))
+        write_parquet(iv.astype({"kind": str}).reset_index(drop=True), run.timeline_table("intervals"))
+        write_parquet(tl["trip_runs"], run.timeline_table("trip_runs"))
         write_parquet(tl["points"].astype({"stop_id": str, "tile": str, "shading": str}),
-                      tdir / "points.parquet")
-    iv = pd.read_parquet(tdir / "intervals.parquet", columns=["point_id"])
-    tiles = pd.read_parquet(tdir / "points.parquet").set_index("point_id")["tile"]
+                      run.timeline_table("points"))
+    iv = pd.read_parquet(run.timeline_table("intervals"), columns=["point_id"])
+    tiles = pd.read_parquet(run.timeline_table("points")).set_index("point_id")["tile"]
     return sorted(set(tiles.reindex(iv["point_id"].unique()).astype(str)))
 
 
 def standing_done(run_dir, tile: str) -> bool:
-    return partition_path(Path(run_dir), "standing", tile, ALL_MONTHS).exists()
+    return RunDir(run_dir).part("standing", tile, ALL_MONTHS).exists()

@@ -17,10 +17,11 @@ at most ``dwell_s``, so layovers absorb delays. The profile is analytic; it is s
 """
 from __future__ import annotations
 
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
+
+from ..store import DataDir
 
 
 def _limits(cfg):
@@ -214,15 +215,15 @@ def pattern_cycle(data_dir, pattern_id: int, cfg=None) -> pd.DataFrame:
     """The driving cycle of one stored pattern (``gtfs/pattern_stops.parquet``)."""
     import pyarrow.parquet as pq
 
-    gdir = Path(data_dir) / "gtfs"
-    ps = pq.read_table(gdir / "pattern_stops.parquet",
+    gdir = DataDir(data_dir).gtfs
+    ps = pq.read_table(gdir.table("pattern_stops"),
                        filters=[("pattern_id", "==", int(pattern_id))]).to_pandas()
     if ps.empty:
-        raise KeyError(f"pattern {pattern_id} not in {gdir / 'pattern_stops.parquet'}")
+        raise KeyError(f"pattern {pattern_id} not in {gdir.table('pattern_stops')}")
     ps = ps.sort_values("stop_index")
-    trips = pq.read_table(gdir / "trips.parquet", columns=["pattern_id", "shape_id"],
+    trips = pq.read_table(gdir.trips, columns=["pattern_id", "shape_id"],
                           filters=[("pattern_id", "==", int(pattern_id))]).to_pandas()
-    segs = pq.read_table(gdir / "segments.parquet", columns=["shape_id", "cum_dist_m", "gradient"],
+    segs = pq.read_table(gdir.segments, columns=["shape_id", "cum_dist_m", "gradient"],
                          filters=[("shape_id", "==", str(trips["shape_id"].iloc[0]))]).to_pandas()
     return driving_cycle(ps["dist_m"].to_numpy(), ps["arr_s"].to_numpy(), ps["dep_s"].to_numpy(),
                          cfg, segs)

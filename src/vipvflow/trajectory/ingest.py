@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import json
 import logging
-import os
 import time
 from pathlib import Path
 
@@ -22,7 +21,7 @@ import numpy as np
 import pandas as pd
 
 from ..errors import InputError
-from ..files import staging_dir, swap_dir
+from ..store import TILE_SIZE_M, DataDir, GtfsDir, staging_dir, swap_dir, write_parquet, write_text
 from .feed import read_feed
 from .schedule import pattern_segment_times, project_stops_monotone
 from .segments import build_segments, cumulative_distance, project_shapes
@@ -32,16 +31,9 @@ log = logging.getLogger(__name__)
 _UNIT_M = {"m": 1.0, "km": 1000.0, "mi": 1609.344, "ft": 0.3048}
 
 
-def _atomic(path: Path, write) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    write(tmp)
-    os.replace(tmp, path)
-
-
 def _city_grid(data_dir: Path):
     """(crs, tile_size_m) from ``city/tiles.json`` or (None, None)."""
-    path = data_dir / "city" / "tiles.json"
+    path = DataDir(data_dir).city.tiles_json
     if not path.exists():
         return None, None
     try:
@@ -53,7 +45,7 @@ def _city_grid(data_dir: Path):
 
 def _terrain(data_dir: Path, problems: list[str]):
     """The city's terrain model, or None (module not available or no terrain.npz)."""
-    if not (data_dir / "city" / "terrain.npz").exists():
+    if not DataDir(data_dir).city.terrain.exists():
         return None
     try:
         from ..city import TerrainModel
@@ -206,13 +198,13 @@ def ingest_gtfs(feed_path, data_dir, traj_cfg, crs=None, dist_units: str | None 
 
     t_start = time.perf_counter()
     data_dir = Path(data_dir)
-    out = data_dir / "gtfs"
+    out = DataDir(data_dir).gtfs.root
     feed = read_feed(feed_path, dist_units=dist_units, timezone=timezone, route_types=route_types)
     problems = list(feed.problems)
     crs_obj, tile_size, crs_source = _choose_crs(feed, data_dir, crs)
     if not crs_obj.is_projected:
         raise InputError(f"{crs_obj.to_string()}: the trajectory CRS must be projected (metres)")
-    tile_size = float(tile_size or 500.0)
+    tile_size = float(tile_size or TILE_SIZE_M)
     to_xy = Transformer.from_crs("EPSG:4326", crs_obj, always_xy=True)
 
     trips = feed.trips.copy()
@@ -384,12 +376,12 @@ def ingest_gtfs(feed_path, data_dir, traj_cfg, crs=None, dist_units: str | None 
     import geopandas as gpd
 
     # (a folder a failed write leaves is removed by the next ingest, once its process is gone)
-    final, out = out, staging_dir(out)
+    final, out = out, GtfsDir(staging_dir(out))
     gseg = gpd.GeoDataFrame(segs, geometry=geom, crs=crs_obj)
-    _atomic(out / "segments.parquet", lambda p: gseg.to_parquet(p, index=False))
-    _atomic(out / "trips.parquet", lambda p: trips_out.to_parquet(p, index=False))
-    _atomic(out / "patterns.parquet", lambda p: patterns.to_parquet(p, index=False))
-    _atomic(out / "pattern_stops.parquet", lambda p: pstops.to_parquet(p, index=False))
+    write_parquet(gseg, out.table("segments"), pandas_dtypes=True)
+    write_parquet(trips_out, out.table("trips"), pandas_dtypes=True)
+    write_parquet(patterns, out.table("patterns"), pandas_dtypes=True)
+    write_parquet(pstops, out.table("pattern_stops"), pandas_dtypes=True)
     cal_cols = ["service_id", "monday", "tuesday", "wednesday", "thursday", "friday",
                 "saturday", "sunday", "start_date", "end_date"]
     cal = (feed.calendar[cal_cols] if feed.calendar is not None
@@ -398,8 +390,8 @@ def ingest_gtfs(feed_path, data_dir, traj_cfg, crs=None, dist_units: str | None 
     cd_cols = ["service_id", "date", "exception_type"]
     cd = (feed.calendar_dates[cd_cols] if feed.calendar_dates is not None
           else pd.DataFrame(columns=cd_cols)).astype({"service_id": str, "date": str})
-    _atomic(out / "calendar.parquet", lambda p: cal.to_parquet(p, index=False))
-    _atomic(out / "calendar_dates.parquet", lambda p: cd.to_parquet(p, index=False))
+    write_parquet(cal, out.table("calendar"), pandas_dtypes=True)
+    write_parquet(cd, out.table("calendar_dates"), pandas_dtypes=True)
 
     report = {
         "feed": str(Path(feed_path)),
@@ -428,6 +420,6 @@ def ingest_gtfs(feed_path, data_dir, traj_cfg, crs=None, dist_units: str | None 
         "problems": problems,
         "seconds": round(time.perf_counter() - t_start, 2),
     }
-    _atomic(out / "feed.json", lambda p: p.write_text(json.dumps(report, indent=2)))
-    swap_dir(out, final)
+    write_text(json.dumps(report, indent=2), out.feed_json)
+    swap_dir(out.root, final)
     return report

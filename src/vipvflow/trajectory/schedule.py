@@ -36,6 +36,8 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+
+from ..store import DataDir, GtfsDir
 import pyarrow.parquet as pq
 
 WEEKDAYS = ["monday", "tuesday", "wednesday", "thursday", "friday", "saturday", "sunday"]
@@ -153,7 +155,8 @@ def pattern_segment_times(stop_d, arr, dep, seg_start, seg_len):
 # service dates
 
 def _read(data_dir, name: str, **kw) -> pd.DataFrame:
-    path = Path(data_dir) / "gtfs" / name
+    """The GTFS table *name* (``trips``, ``patterns``, ...) of *data_dir*."""
+    path = DataDir(data_dir).gtfs.table(name)
     return pq.read_table(path, **kw).to_pandas()
 
 
@@ -196,11 +199,10 @@ def service_dates_from_tables(calendar: pd.DataFrame | None, calendar_dates: pd.
 
 @functools.lru_cache(maxsize=16)
 def _service_dates_cached(gdir: str, year: int, stamp: tuple) -> pd.DataFrame:
-    gdir = Path(gdir)
-    cal = (pq.read_table(gdir / "calendar.parquet").to_pandas()
-           if (gdir / "calendar.parquet").exists() else None)
-    cd = (pq.read_table(gdir / "calendar_dates.parquet").to_pandas()
-          if (gdir / "calendar_dates.parquet").exists() else None)
+    gtfs = GtfsDir(Path(gdir))
+    cal_path, cd_path = gtfs.table("calendar"), gtfs.table("calendar_dates")
+    cal = pq.read_table(cal_path).to_pandas() if cal_path.exists() else None
+    cd = pq.read_table(cd_path).to_pandas() if cd_path.exists() else None
     return service_dates_from_tables(cal, cd, year)
 
 
@@ -222,7 +224,7 @@ def service_dates(data_dir, year: int) -> pd.DataFrame:
     -------
     DataFrame[service_id (str), date (datetime64[ns], midnight)]
     """
-    gdir = (Path(data_dir) / "gtfs").resolve()
+    gdir = DataDir(data_dir).gtfs.root.resolve()
     stamp = _stamp(gdir, ("calendar.parquet", "calendar_dates.parquet"))
     return _service_dates_cached(str(gdir), int(year), stamp).copy()
 
@@ -247,7 +249,7 @@ def service_day_origin_utc(dates, timezone: str) -> np.ndarray:
 # passes
 
 def _feed_info(data_dir) -> dict:
-    return json.loads((Path(data_dir) / "gtfs" / "feed.json").read_text())
+    return json.loads(DataDir(data_dir).gtfs.feed_json.read_text())
 
 
 def _parse_month(month, year):
@@ -331,7 +333,7 @@ def iter_passes(data_dir, tile: str, month, year: int | None = None,
         date (see module doc). Only this month and this tile are ever held in memory.
     """
     period = _parse_month(month, year)
-    gdir = (Path(data_dir) / "gtfs").resolve()
+    gdir = DataDir(data_dir).gtfs.root.resolve()
     stamp = _stamp(gdir, _GTFS_TABLES)
     pat = _tile_patterns(str(gdir), tile, stamp)
     if pat.empty:
@@ -353,11 +355,11 @@ def _tile_patterns(gdir: str, tile: str, stamp: tuple) -> pd.DataFrame:
     """The pattern rows of the segments of *tile*, sorted by pattern and time (cached per
     process: a worker evaluates a tile for every month)."""
     data_dir = Path(gdir).parent
-    segs = _read(data_dir, "segments.parquet", columns=["segment_id", "tile"],
+    segs = _read(data_dir, "segments", columns=["segment_id", "tile"],
                  filters=[("tile", "==", tile)])
     if segs.empty:
         return pd.DataFrame()
-    pat = _read(data_dir, "patterns.parquet",
+    pat = _read(data_dir, "patterns",
                 filters=[("segment_id", "in", segs["segment_id"].to_numpy().tolist())])
     if pat.empty:
         return pd.DataFrame()
@@ -373,7 +375,7 @@ def _month_runs(gdir: str, month: str, routes: tuple | None, stamp: tuple) -> pd
     service date and trip; ``trip_id`` categorical over all the feed's trips (cached per
     process: the tiles of a worker share a month's runs)."""
     period = pd.Period(month, freq="M")
-    trips = _read(Path(gdir).parent, "trips.parquet",
+    trips = _read(Path(gdir).parent, "trips",
                   columns=["trip_id", "route_id", "service_id", "pattern_id", "start_s"])
     names = np.unique(trips["trip_id"].astype(str).to_numpy())
     if routes is not None:
@@ -419,13 +421,13 @@ def passes_for_trip(data_dir, trip_id: str, service_date) -> pd.DataFrame:
     The date need not be a day the trip's service runs (the app may ask "what if"); the
     timing is the trip's pattern placed on that date.
     """
-    trips = _read(data_dir, "trips.parquet", columns=["trip_id", "service_id", "pattern_id",
+    trips = _read(data_dir, "trips", columns=["trip_id", "service_id", "pattern_id",
                                                       "start_s"])
     trips = trips[trips["trip_id"] == str(trip_id)]
     if trips.empty:
         raise KeyError(f"trip {trip_id!r} not in {Path(data_dir) / 'gtfs' / 'trips.parquet'}")
     pid = int(trips["pattern_id"].iloc[0])
-    pat = _read(data_dir, "patterns.parquet", filters=[("pattern_id", "==", pid)])
+    pat = _read(data_dir, "patterns", filters=[("pattern_id", "==", pid)])
     date = pd.Timestamp(service_date).normalize()
     sd = pd.DataFrame({"service_id": trips["service_id"].astype(str).to_numpy(),
                        "date": pd.DatetimeIndex([date]).astype("datetime64[ns]")})
@@ -460,7 +462,7 @@ def stop_positions(data_dir, shape_dist: pd.DataFrame) -> pd.DataFrame:
     DataFrame indexed like *shape_dist*: ``x, y, z`` (the roof point on the road, as the
     segments' points: the road's height plus the roof height) and ``tile`` (the segment's).
     """
-    seg = _read(data_dir, "segments.parquet", columns=["shape_id", "cum_dist_m", "length_m", "x", "y",
+    seg = _read(data_dir, "segments", columns=["shape_id", "cum_dist_m", "length_m", "x", "y",
                                                        "z", "x_end", "y_end", "z_end", "tile"])
     seg = seg.sort_values(["shape_id", "cum_dist_m"], kind="stable").reset_index(drop=True)
     out = pd.DataFrame(index=shape_dist.index, columns=["x", "y", "z"], dtype=float)
@@ -524,11 +526,11 @@ def block_timeline(data_dir, year: int, months=None, routes=None, depot=None,
     """
     from ..vehicle import infer_blocks
 
-    trips = _read(data_dir, "trips.parquet", columns=["trip_id", "route_id", "service_id", "block_id",
+    trips = _read(data_dir, "trips", columns=["trip_id", "route_id", "service_id", "block_id",
                                                       "shape_id", "pattern_id", "start_s"])
     if routes is not None:
         trips = trips[trips["route_id"].astype(str).isin([str(r) for r in routes])]
-    ps = _read(data_dir, "pattern_stops.parquet").sort_values(["pattern_id", "stop_index"], kind="stable")
+    ps = _read(data_dir, "pattern_stops").sort_values(["pattern_id", "stop_index"], kind="stable")
     ends = ps.groupby("pattern_id", sort=True).agg(
         first_stop_id=("stop_id", "first"), last_stop_id=("stop_id", "last"),
         first_dist_m=("dist_m", "first"), last_dist_m=("dist_m", "last"), duration_s=("arr_s", "last"))

@@ -1,0 +1,499 @@
+"""Where every stage's files live, what a run's partitions hold, and how files are written.
+
+Two folders hold everything the pipeline writes (docs/store.md draws them):
+
+- the **data dir** (``data_dir`` of the scenario): the ingested inputs, one folder per source,
+  each written whole by its ingest (:func:`staging_dir`, then :func:`swap_dir`):
+  ``city/`` (:class:`CityDir`), ``gtfs/`` (:class:`GtfsDir`), ``radiation/``
+  (:class:`RadiationDir`); :class:`DataDir` names them;
+- the **run dir** (``out/<scenario>/<year>/``, :class:`RunDir`): the partitions the workers
+  write under ``parts/`` (kinds in :data:`PARTS`), then the outputs the reduce writes beside
+  them and the run's ``manifest.json``.
+
+Stages ask these classes for paths instead of spelling folder names, and write through one
+family of atomic writers (:func:`atomic_path`, :func:`write_parquet`, :func:`write_json`,
+:func:`write_text`, :func:`write_bytes`, :func:`write_npz`): each writes a temporary name
+beside the file and renames it, so a reader sees the old file or the new one, never half of
+one.
+
+The columns of the run's *output* files, with units, are in
+:mod:`vipvflow.simulation.dictionary`; :data:`PARTS` says what one row of each partition kind
+is and which columns identify it.
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import shutil
+from contextlib import contextmanager
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Iterator
+
+from .errors import InputError
+
+#: tile edge (m) of a data dir without a city: the GTFS ingest's grid when no
+#: ``city/tiles.json`` gives one; the default of the configuration's ``city.tile_size_m``
+TILE_SIZE_M = 500.0
+
+
+# --------------------------------------------------------------------------- data dir
+@dataclass(frozen=True)
+class CityDir:
+    """``city/``: tiled surfaces, tile meshes and terrain of the CityGML ingest.
+
+    *root* is the folder itself (``<data_dir>/city`` or the ingest's staging folder)."""
+    root: Path
+
+    @property
+    def tiles_json(self) -> Path:
+        """CRS, tile size, buffer and the tiles with their extents."""
+        return self.root / "tiles.json"
+
+    @property
+    def report(self) -> Path:
+        return self.root / "ingest_report.json"
+
+    @property
+    def stamp(self) -> Path:
+        """Digest of the inputs this folder was ingested from (``prepare``)."""
+        return self.root / ".inputs.json"
+
+    @property
+    def terrain(self) -> Path:
+        return self.root / "terrain.npz"
+
+    @property
+    def meshes(self) -> Path:
+        return self.root / "meshes"
+
+    @property
+    def surfaces(self) -> Path:
+        """GeoParquet of every tile's own surfaces: ``surfaces/tile=<T>/part-0.parquet``."""
+        return self.root / "surfaces"
+
+    def mesh(self, tile: str) -> Path:
+        """Triangle mesh of *tile*, its own surfaces and the buffer around it."""
+        return self.meshes / f"{tile}.npz"
+
+    def surface_part(self, tile: str) -> Path:
+        return self.surfaces / f"tile={tile}" / "part-0.parquet"
+
+
+#: the tables of ``gtfs/``, each ``<name>.parquet``
+GTFS_TABLES = ("segments", "trips", "patterns", "pattern_stops", "calendar", "calendar_dates")
+
+
+@dataclass(frozen=True)
+class GtfsDir:
+    """``gtfs/``: the timetable cut into segments, by the GTFS ingest."""
+    root: Path
+
+    @property
+    def feed_json(self) -> Path:
+        """Time zone, CRS, tile size, counts and problems of the ingested feed."""
+        return self.root / "feed.json"
+
+    @property
+    def stamp(self) -> Path:
+        return self.root / ".inputs.json"
+
+    @property
+    def segments(self) -> Path:
+        return self.root / "segments.parquet"
+
+    @property
+    def trips(self) -> Path:
+        return self.root / "trips.parquet"
+
+    @property
+    def patterns(self) -> Path:
+        return self.root / "patterns.parquet"
+
+    def table(self, name: str) -> Path:
+        """``<name>.parquet``, one of :data:`GTFS_TABLES`."""
+        if name not in GTFS_TABLES:
+            raise ValueError(f"no GTFS table {name!r} in the store")
+        return self.root / f"{name}.parquet"
+
+
+@dataclass(frozen=True)
+class RadiationDir:
+    """``radiation/``: the CAMS series of the CAMS ingest (and its sun-position caches)."""
+    root: Path
+
+    @property
+    def table(self) -> Path:
+        return self.root / "radiation.parquet"
+
+    @property
+    def report(self) -> Path:
+        return self.root / "ingest_report.json"
+
+    @property
+    def stamp(self) -> Path:
+        return self.root / ".inputs.json"
+
+    def sun_cache(self, first_s: int, n: int) -> Path:
+        """Sun vectors of the table's grid from *first_s* (Unix s), *n* steps, kept for the
+        workers of a run (:func:`vipvflow.radiation._cached_sun`)."""
+        return self.root / f"sun_{first_s}_{n}.npz"
+
+
+@dataclass(frozen=True)
+class DataDir:
+    """The ingested inputs of a scenario: ``city/``, ``gtfs/``, ``radiation/``."""
+    root: Path
+
+    def __post_init__(self):
+        object.__setattr__(self, "root", Path(self.root))
+
+    @property
+    def city(self) -> CityDir:
+        return CityDir(self.root / "city")
+
+    @property
+    def gtfs(self) -> GtfsDir:
+        return GtfsDir(self.root / "gtfs")
+
+    @property
+    def radiation(self) -> RadiationDir:
+        return RadiationDir(self.root / "radiation")
+
+    def tile_size_m(self) -> float:
+        """The tile edge (m) of this data dir's grid: ``tile_size_m`` of ``gtfs/feed.json``
+        (the grid the segments were cut on), else of ``city/tiles.json``.
+
+        Raises :class:`InputError` naming the file when neither exists or neither says."""
+        for path in (self.gtfs.feed_json, self.city.tiles_json):
+            if path.is_file():
+                try:
+                    size = json.loads(path.read_text()).get("tile_size_m")
+                except (ValueError, AttributeError) as exc:
+                    raise InputError(f"{path}: not a JSON object: {exc}") from None
+                if size is not None:
+                    return float(size)
+        raise InputError(f"{self.gtfs.feed_json}: not found, and no tile_size_m in "
+                         f"{self.city.tiles_json}; run 'vipvflow ingest gtfs' first")
+
+
+# --------------------------------------------------------------------------- run dir
+@dataclass(frozen=True)
+class PartKind:
+    """A kind of file the workers write under ``parts/``."""
+    per: str
+    """``"tile/month"`` (one file per tile and month), ``"tile"`` or ``"run"`` (named files)"""
+    rows: str
+    """what one row holds"""
+    key: dict
+    """columns that identify a row, with their Arrow types (the other columns: the
+    measures of :mod:`vipvflow.simulation.partition`, named as in the data dictionary)"""
+
+
+#: every kind of file under a run's ``parts/``; a partition (tile, month) is complete when its
+#: :data:`PARTITION_KINDS` files exist (``segment_month`` is written last)
+PARTS = {
+    "hourly": PartKind("tile/month", "one local hour of the day: irradiation sums and pass time",
+                       {"hour": "int8", "tile": "string", "month": "string"}),
+    "trip": PartKind("tile/month", "one trip on one service date: PV kWh by sky and component",
+                     {"trip_id": "string", "service_date": "timestamp[ns]", "tile": "string"}),
+    "segment_month": PartKind("tile/month", "one segment: passes, irradiation sums, kWh",
+                              {"segment_id": "int64", "tile": "string", "month": "string"}),
+    "standing": PartKind("tile/month", "one layover or parked interval of a block at a stop "
+                         "(month=all: the whole year)",
+                         {"block_id": "string", "service_date": "timestamp[ns]",
+                          "kind": "string", "after_trip": "int64"}),
+    "geometry": PartKind("tile", "one segment: its roof's view of the sky and the reflectors",
+                         {"segment_id": "int64"}),
+    "horizon": PartKind("tile", "one segment: the horizon profile the web app reads",
+                        {"segment_id": "int64"}),
+    "timeline": PartKind("run", "the fleet's day: block_days, intervals, trip_runs, points", {}),
+}
+PARTITION_KINDS = ("hourly", "trip", "segment_month")
+#: the tables of ``parts/timeline/``, each ``<name>.parquet``
+TIMELINE_TABLES = ("block_days", "intervals", "trip_runs", "points")
+#: the ``month`` of a standing partition: one per tile holds all the run's months (a tile
+#: has only a few standing points; per month, loading the tile's scene cost more than them)
+ALL_MONTHS = "all"
+
+
+@dataclass(frozen=True)
+class RunDir:
+    """A run's folder ``out/<scenario>/<year>/``."""
+    root: Path
+
+    def __post_init__(self):
+        object.__setattr__(self, "root", Path(self.root))
+
+    @property
+    def parts(self) -> Path:
+        return self.root / "parts"
+
+    @property
+    def manifest(self) -> Path:
+        return self.root / "manifest.json"
+
+    @property
+    def config_stamp(self) -> Path:
+        """Digest of the configuration the partitions under ``parts/`` were computed with."""
+        return self.parts / "config_digest.txt"
+
+    @property
+    def timeline(self) -> Path:
+        return self.part_dir("timeline")
+
+    def part_dir(self, kind: str) -> Path:
+        """``parts/<kind>/``."""
+        if kind not in PARTS:
+            raise ValueError(f"no partition kind {kind!r}")
+        return self.parts / kind
+
+    def part(self, kind: str, tile: str, month: str) -> Path:
+        """``parts/<kind>/tile=<TILE>/month=<YYYY-MM>.parquet``: findable with ls."""
+        if PARTS[kind].per != "tile/month":
+            raise ValueError(f"parts/{kind} is not stored per tile and month")
+        return self.part_dir(kind) / f"tile={tile}" / f"month={month}.parquet"
+
+    def tile_part(self, kind: str, tile: str) -> Path:
+        """``parts/<kind>/tile=<TILE>.parquet`` (``geometry``, ``horizon``)."""
+        if PARTS[kind].per != "tile":
+            raise ValueError(f"parts/{kind} is not stored per tile")
+        return self.part_dir(kind) / f"tile={tile}.parquet"
+
+    def timeline_table(self, name: str) -> Path:
+        """``parts/timeline/<name>.parquet``, one of :data:`TIMELINE_TABLES`."""
+        if name not in TIMELINE_TABLES:
+            raise ValueError(f"no timeline table {name!r} in the store")
+        return self.timeline / f"{name}.parquet"
+
+    def part_files(self, kind: str, pattern: str | None = None) -> list[Path]:
+        """Every file of *kind* (matching *pattern* under ``parts/<kind>/``), in path order."""
+        if pattern is None:
+            pattern = {"tile/month": "tile=*/month=*.parquet", "tile": "tile=*.parquet",
+                       "run": "*.parquet"}[PARTS[kind].per]
+        return sorted(self.part_dir(kind).glob(pattern))
+
+    @property
+    def figures(self) -> Path:
+        """The report's PNG figures."""
+        return self.root / "figures"
+
+    @property
+    def vecto(self) -> Path:
+        """VECTO driving cycles and job files of the run's patterns."""
+        return self.root / "vecto"
+
+    @property
+    def report(self) -> Path:
+        return self.root / "report.html"
+
+    def output(self, name: str) -> Path:
+        """An output of the reduce beside ``parts/``: ``summary.json``, ``trip_energy.parquet``..."""
+        return self.root / name
+
+
+# --------------------------------------------------------------------------- atomic writes
+@contextmanager
+def atomic_path(path: str | Path, suffix: str = "") -> Iterator[Path]:
+    """The temporary name to write *path* under, renamed to *path* when the block ends.
+
+    The temporary file ``.<name>.<pid>.tmp<suffix>`` sits beside *path* (same file system,
+    hidden from ``ls`` and from the progress view); *suffix* is for writers that insist on an
+    extension (``np.savez`` adds ``.npz``). On failure it is removed and an OSError names
+    *path* (a full disk's ``ENOSPC`` from a write names no file)."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp{suffix}")
+    try:
+        yield tmp
+        os.replace(tmp, path)
+    except BaseException as exc:
+        tmp.unlink(missing_ok=True)
+        if isinstance(exc, OSError) and exc.errno and not exc.filename:
+            raise OSError(exc.errno, os.strerror(exc.errno), str(path)) from exc
+        raise
+
+
+def write_parquet(df, path: str | Path, pandas_dtypes: bool = False) -> Path:
+    """Write *df* (DataFrame or GeoDataFrame) to *path* atomically.
+
+    With *pandas_dtypes* pandas writes it, with its metadata: nullable integers and pandas'
+    string flavours read back as they were (the GTFS tables). Otherwise plain tables (numbers, bools, dates, strings) go straight to pyarrow: pandas' own
+    conversion costs more than the write for the run's wide, small tables.  A file named as
+    one of the run's outputs (``trip_energy.parquet``, ... :data:`dictionary.OUTPUTS`) is
+    written as the data dictionary describes it: ``month`` as a date, every documented
+    column with its unit and meaning in the field metadata."""
+    import pyarrow.parquet as pq
+
+    from .simulation.dictionary import OUTPUTS, annotate
+
+    path = Path(path)
+    output = path.stem if path.suffix == ".parquet" and path.stem in OUTPUTS else None
+    with atomic_path(path) as tmp:
+        table = None if pandas_dtypes else _plain_table(df)
+        if table is None and output is not None and not pandas_dtypes:
+            table = _arrow_table(df)
+        if table is None:
+            df.to_parquet(tmp, index=False)
+        else:
+            pq.write_table(annotate(table, output) if output else table, tmp)
+    return path
+
+
+def write_json(obj, path: str | Path, sort_keys: bool = False) -> Path:
+    """Write *obj* as indented JSON (values JSON does not know as ``str``)."""
+    return write_text(json.dumps(obj, indent=2, sort_keys=sort_keys, default=str), path)
+
+
+def write_text(text: str, path: str | Path) -> Path:
+    path = Path(path)
+    with atomic_path(path) as tmp:
+        tmp.write_text(text, encoding="utf-8")
+    return path
+
+
+def write_bytes(data: bytes, path: str | Path) -> Path:
+    path = Path(path)
+    with atomic_path(path) as tmp:
+        tmp.write_bytes(data)
+    return path
+
+
+def write_npz(path: str | Path, **arrays) -> Path:
+    """``np.savez`` of *arrays* to *path* atomically."""
+    import numpy as np
+
+    path = Path(path)
+    with atomic_path(path, suffix=".npz") as tmp:
+        np.savez(tmp, **arrays)
+    return path
+
+
+def _plain_table(df):
+    """*df* as a pyarrow Table built column by column from numpy, when every column is a
+    number, bool, datetime64 or string (the partition and geometry tables); ``None``
+    otherwise (GeoDataFrames, categoricals, ...), for pandas to convert."""
+    import pandas as pd
+    import pyarrow as pa
+
+    if hasattr(df, "geometry") or not df.columns.is_unique:
+        return None
+    arrays = []
+    for name in df.columns:
+        col = df[name]
+        kind = col.dtype.kind
+        if kind in "biuf" or (kind == "M" and getattr(col.dtype, "tz", None) is None):
+            arrays.append(pa.array(col.to_numpy()))
+        elif pd.api.types.is_string_dtype(col.dtype) and not isinstance(col.dtype, pd.CategoricalDtype):
+            try:        # object columns may hold anything: only real strings take this path
+                arr = pa.array(col.to_numpy(dtype=object), from_pandas=True)
+            except (pa.ArrowInvalid, pa.ArrowTypeError):
+                return None
+            if not (pa.types.is_string(arr.type) or pa.types.is_large_string(arr.type)
+                    or (pa.types.is_null(arr.type) and col.dtype != object)):
+                return None
+            arrays.append(arr.cast(pa.string()))
+        else:
+            return None
+    return pa.Table.from_arrays(arrays, names=[str(c) for c in df.columns])
+
+
+def _arrow_table(df):
+    """*df* as pyarrow converts it for ``to_parquet`` (GeoDataFrames with their GeoParquet
+    metadata)."""
+    import pyarrow as pa
+
+    if hasattr(df, "geometry"):
+        # geopandas' own conversion of to_parquet (WKB geometry, "geo" schema metadata)
+        from geopandas.io.arrow import _geopandas_to_arrow
+
+        return _geopandas_to_arrow(df, index=False)
+    return pa.Table.from_pandas(df, preserve_index=False)
+
+
+# --------------------------------------------------------------------------- whole folders
+def staging_dir(final: str | Path) -> Path:
+    """An empty folder beside *final* (``.<name>-ingest-<pid>``) to write a new version of
+    *final* into before :func:`swap_dir`; what killed ingests left there is cleaned up first
+    (:func:`remove_stale`)."""
+    final = Path(final)
+    final.parent.mkdir(parents=True, exist_ok=True)
+    remove_stale(final)
+    stage = final.with_name(f".{final.name}-ingest-{os.getpid()}")
+    shutil.rmtree(stage, ignore_errors=True)
+    stage.mkdir()
+    return stage
+
+
+def swap_dir(new: Path, final: Path) -> None:
+    """Replace folder *final* by *new* as a whole (two renames; a reader sees the old or the
+    new version, never a mix of files; :func:`remove_stale` repairs a kill between them)."""
+    old = final.with_name(f".{final.name}-old-{os.getpid()}")
+    shutil.rmtree(old, ignore_errors=True)
+    if final.exists():
+        final.rename(old)
+    new.rename(final)
+    shutil.rmtree(old, ignore_errors=True)
+
+
+def set_aside(folder: Path, tag: str) -> Path:
+    """Rename *folder* to ``.<name>.replaced-<tag>-<pid>`` beside it in one step (for the
+    caller to delete); the aside folders of earlier, interrupted calls are :func:`aside_folders`."""
+    aside = folder.parent / f".{folder.name}.replaced-{tag}-{os.getpid()}"
+    os.replace(folder, aside)
+    return aside
+
+
+def aside_folders(folder: Path) -> list[Path]:
+    """The folders :func:`set_aside` left beside *folder*."""
+    return sorted(folder.parent.glob(f".{folder.name}.replaced-*"))
+
+
+def remove_stale(final: str | Path) -> list[Path]:
+    """Clean up beside folder *final* after killed ingests; return the paths removed.
+
+    ``.<name>-ingest-<pid>`` (an unfinished new version) goes when its process is gone;
+    ``.<name>-old-<pid>`` (the previous version, when the kill came between the two renames of
+    :func:`swap_dir`) is put back if *final* is missing, else removed.
+    """
+    final = Path(final)
+    removed = []
+    for p in sorted(final.parent.glob(f".{final.name}-old-*")):
+        if _stale(p):
+            if not final.exists():
+                p.rename(final)
+                continue
+            shutil.rmtree(p, ignore_errors=True)
+            removed.append(p)
+    for p in sorted(final.parent.glob(f".{final.name}-ingest-*")):
+        if p.is_dir() and _stale(p):
+            shutil.rmtree(p, ignore_errors=True)
+            removed.append(p)
+    return removed
+
+
+def _stale(path: Path) -> bool:
+    """A ``...-<pid>`` folder whose process is gone."""
+    pid = path.name.rsplit("-", 1)[-1]
+    return pid.isdigit() and not pid_alive(int(pid))
+
+
+def pid_alive(pid: int) -> bool:
+    """Whether a process of this id runs (it may be another user's)."""
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True
+
+
+def sha256(path: str | Path) -> str:
+    """SHA-256 hex digest of a file, read in 1 MiB blocks."""
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for block in iter(lambda: fh.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()

@@ -1,0 +1,131 @@
+"""The store names every file the pipeline writes, its partitions hold the key columns it
+declares, and its writers leave the old file or the new one, never a part."""
+from __future__ import annotations
+
+import json
+import os
+
+import pandas as pd
+import pyarrow.parquet as pq
+import pytest
+
+from vipvflow.errors import InputError
+from vipvflow.simulation.dictionary import OUTPUTS
+from vipvflow.simulation.rundir import open_run
+from vipvflow.store import (ALL_MONTHS, GTFS_TABLES, PARTS, TIMELINE_TABLES, DataDir, RunDir,
+                            atomic_path, remove_stale, staging_dir, swap_dir, write_json)
+
+
+def _named_by_store(data_dir, run_dir) -> set:
+    """Every file the store names for this data dir and run (the run's tiles and months)."""
+    data, run = DataDir(data_dir), RunDir(run_dir)
+    manifest = json.loads(run.manifest.read_text())
+    year, months = manifest["year"], manifest["config"]["run"]["months"]
+    tiles = set(json.loads(data.city.tiles_json.read_text())["tiles"])
+    tiles |= set(pd.read_parquet(data.gtfs.segments, columns=["tile"])["tile"].astype(str))
+    city, gtfs, rad = data.city, data.gtfs, data.radiation
+    names = {city.tiles_json, city.report, city.stamp, city.terrain, gtfs.feed_json, gtfs.stamp,
+             rad.table, rad.report, rad.stamp, run.manifest, run.config_stamp, run.report,
+             run.output("summary.json")}
+    names |= {city.mesh(t) for t in tiles} | {city.surface_part(t) for t in tiles}
+    names |= {gtfs.table(n) for n in GTFS_TABLES}
+    names |= {run.output(f"{name}.parquet") for name in OUTPUTS}
+    names |= {run.timeline_table(n) for n in TIMELINE_TABLES}
+    for kind, spec in PARTS.items():
+        if spec.per == "tile/month":
+            names |= {run.part(kind, t, m) for t in tiles
+                      for m in [f"{year}-{m:02d}" for m in months] + [ALL_MONTHS]}
+        elif spec.per == "tile":
+            names |= {run.tile_part(kind, t) for t in tiles}
+    return names
+
+
+def test_every_file_of_a_run_is_one_the_store_names(small_run):
+    run = RunDir(small_run)
+    data = DataDir(open_run(run.root).data_dir)
+    named = _named_by_store(data.root, run.root)
+    written = {p for root in (data.root, run.root) for p in root.rglob("*") if p.is_file()}
+    # figures, VECTO files and the sun caches are named by the modules that draw or compute them,
+    # in the folders the store gives them
+    free = [p for p in written
+            if run.figures in p.parents or run.vecto in p.parents
+            or (p.parent == data.radiation.root and p.name.startswith("sun_"))]
+    assert all(p.suffix == ".png" for p in free if run.figures in p.parents)
+    unnamed = sorted(str(p) for p in written - named - set(free))
+    assert unnamed == [], "files the store does not name (or temporaries left):\n" + "\n".join(unnamed)
+    # and the run wrote what the store promises: every partition of every tile it computed
+    computed = {p.parent.name[5:] for p in run.part_files("segment_month")}
+    assert computed, "no partitions"
+    for tile in computed:
+        assert run.tile_part("geometry", tile).is_file() and run.tile_part("horizon", tile).is_file()
+
+
+def test_partitions_hold_the_key_columns_the_store_declares(small_run):
+    run = RunDir(small_run)
+    seen = set()
+    for kind, spec in PARTS.items():
+        for path in run.part_files(kind):
+            schema = pq.read_schema(path)
+            for column, arrow_type in spec.key.items():
+                assert str(schema.field(column).type) == arrow_type, (path, column)
+            seen.add(kind)
+    assert {"hourly", "trip", "segment_month", "geometry", "horizon", "timeline"} <= seen
+
+
+def test_paths_of_a_kind_stored_otherwise_are_refused(tmp_path):
+    run = RunDir(tmp_path)
+    assert run.part("trip", "E1N2", "2024-06") == tmp_path / "parts/trip/tile=E1N2/month=2024-06.parquet"
+    assert run.tile_part("geometry", "E1N2") == tmp_path / "parts/geometry/tile=E1N2.parquet"
+    with pytest.raises(ValueError):
+        run.part("geometry", "E1N2", "2024-06")
+    with pytest.raises(ValueError):
+        run.tile_part("trip", "E1N2")
+    with pytest.raises(ValueError):
+        DataDir(tmp_path).gtfs.table("stop_times")
+
+
+def test_tile_size_from_the_feed_then_the_city_else_one_line(tmp_path):
+    data = DataDir(tmp_path)
+    with pytest.raises(InputError, match=r"gtfs/feed.json: not found.*ingest gtfs"):
+        data.tile_size_m()
+    write_json({"crs": "EPSG:2169", "tile_size_m": 250, "tiles": {}}, data.city.tiles_json)
+    assert data.tile_size_m() == 250.0
+    write_json({"tile_size_m": 1000}, data.gtfs.feed_json)
+    assert data.tile_size_m() == 1000.0
+    data.gtfs.feed_json.write_text("[1, 2]")
+    with pytest.raises(InputError, match="feed.json: not a JSON object"):
+        data.tile_size_m()
+
+
+def test_a_failed_write_keeps_the_old_file_and_leaves_no_temporary(tmp_path):
+    path = write_json({"v": 1}, tmp_path / "a.json")
+    with pytest.raises(RuntimeError):
+        with atomic_path(path) as tmp:
+            tmp.write_text('{"v": 2')          # half written, then the writer fails
+            raise RuntimeError("killed")
+    assert json.loads(path.read_text()) == {"v": 1}
+    assert [p.name for p in tmp_path.iterdir()] == ["a.json"]
+
+
+def test_a_folder_swapped_whole_and_a_killed_swap_repaired(tmp_path):
+    final = tmp_path / "gtfs"
+    final.mkdir()
+    (final / "old.txt").write_text("old")
+    stage = staging_dir(final)
+    (stage / "new.txt").write_text("new")
+    swap_dir(stage, final)
+    assert [p.name for p in final.iterdir()] == ["new.txt"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["gtfs"]
+    # a kill between the two renames of a swap: the previous version lies aside, none in place
+    dead = 2 ** 22 + 1
+    while True:
+        try:
+            os.kill(dead, 0)
+            dead += 1
+        except ProcessLookupError:
+            break
+        except PermissionError:
+            dead += 1
+    final.rename(tmp_path / f".gtfs-old-{dead}")
+    remove_stale(final)
+    assert (final / "new.txt").read_text() == "new"
