@@ -6,6 +6,7 @@ from pathlib import Path
 
 from ..config import load_config
 from ..errors import InputError
+from . import add_config
 
 
 def register(sub):
@@ -19,7 +20,7 @@ def register(sub):
     p.add_argument("--cams", type=Path, nargs="+", required=True, help="CAMS CSV file(s) covering the track")
     p.add_argument("--crs", default=None, help="CRS of x/y columns (default: the city's)")
     p.add_argument("--out", type=Path, required=True, help="output CSV")
-    p.add_argument("--config", "-c", default=None, help="scenario YAML (irradiance settings)")
+    add_config(p)
     p.set_defaults(func=run)
 
 
