@@ -16,7 +16,8 @@ def register(sub):
                     "track CSV (time, lat/lon or x/y, optional z, heading_deg, measured_wm2) "
                     "in an ingested city; with measured_wm2, print RMSE, MBE and R2.")
     p.add_argument("track", type=Path, help="track CSV")
-    p.add_argument("--city", type=Path, required=True, help="data dir holding city/ (tiles, meshes), or a run folder (its data dir)")
+    p.add_argument("--city", type=Path, required=True,
+                   help="data dir holding city/ (tiles, meshes), or a run folder (its data dir)")
     p.add_argument("--cams", type=Path, nargs="+", required=True, help="CAMS CSV file(s) covering the track")
     p.add_argument("--crs", default=None, help="CRS of x/y columns (default: the city's)")
     p.add_argument("--out", type=Path, required=True, help="output CSV")
