@@ -9,12 +9,12 @@ from __future__ import annotations
 
 import argparse
 import errno
-import importlib
 import logging
 import os
 import sys
 
 from . import __version__
+from .commands import register_all
 from .errors import VipvError
 
 # subcommand modules in the order --help lists them
@@ -43,12 +43,6 @@ typical use:
   vipvflow simulate --config demo --year 2024 [--out DIR]
   vipvflow simulate --config my_city.yaml --year 2024 --scheduler tcp://host:8786
 """
-
-
-def register_all(subparsers, modules: list[str]) -> None:
-    """Let each module of :mod:`vipvflow.commands` named in *modules* add its subcommand."""
-    for name in modules:
-        importlib.import_module(f"vipvflow.commands.{name}").register(subparsers)
 
 
 def build_parser() -> argparse.ArgumentParser:

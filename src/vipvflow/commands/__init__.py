@@ -1,1 +1,30 @@
-"""Subcommands of the ``vipvflow`` CLI, one module each (see :mod:`vipvflow.cli`)."""
+"""The subcommands of ``vipvflow``: one module each, defining ``register(subparsers)``.
+
+This package holds what the subcommands share: :func:`register_all` (used by :mod:`vipvflow.cli`
+and by ``ingest`` for its own subcommands, so no command module imports the CLI) and
+:func:`add_config`, the one ``--config`` option of every subcommand that reads a scenario.
+"""
+from __future__ import annotations
+
+import importlib
+
+#: the help of ``--config`` (every subcommand that reads a scenario)
+CONFIG_HELP = ("scenario: a YAML file, or the name of a shipped scenario ({names}); "
+               "default: {default}")
+
+
+def register_all(subparsers, modules: list[str]) -> None:
+    """Let each module of :mod:`vipvflow.commands` named in *modules* add its subcommand."""
+    for name in modules:
+        importlib.import_module(f"{__name__}.{name}").register(subparsers)
+
+
+def add_config(parser, default: str | None = None) -> None:
+    """Add ``--config/-c`` to *parser*: a scenario YAML or a shipped scenario's name, read by
+    :func:`vipvflow.config.load_config` (names resolved by :func:`vipvflow.config.scenario_path`).
+    *default* ``None`` means the shipped defaults alone."""
+    from ..config import shipped_scenarios
+
+    parser.add_argument("--config", "-c", default=default, metavar="SCENARIO",
+                        help=CONFIG_HELP.format(names=", ".join(shipped_scenarios()),
+                                                default=default or "the shipped defaults alone"))

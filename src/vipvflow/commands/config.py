@@ -4,12 +4,12 @@ from __future__ import annotations
 import yaml
 
 from ..config import load_config
+from . import add_config
 
 
 def register(sub):
     p = sub.add_parser("config", help="validate a scenario YAML and print the merged configuration")
-    p.add_argument("--config", "-c", default=None, help="scenario YAML or a shipped scenario's name "
-                   "(demo, luxembourg, paper); default: the defaults alone")
+    add_config(p)
     p.set_defaults(func=run)
 
 

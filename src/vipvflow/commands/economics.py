@@ -17,12 +17,13 @@ import pandas as pd
 from .. import economics
 from ..config import load_config
 from ..errors import InputError
+from . import add_config
 
 
 def register(sub):
     p = sub.add_parser("economics", help="PV coverage, avoided charging cycles and payback",
                        description=__doc__.split("\n\n")[0])
-    p.add_argument("--config", "-c", default=None, help="scenario YAML for the defaults")
+    add_config(p)
     p.add_argument("--yield-kwh-per-kwp", type=float, help="annual PV yield (kWh/kWp/yr)")
     p.add_argument("--performance-ratio", type=float, default=None,
                    help="multiply the yield by this PR (when the yield is given before losses)")

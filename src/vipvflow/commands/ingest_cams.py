@@ -5,6 +5,7 @@ from pathlib import Path
 
 from ..config import load_config
 from ..errors import InputError
+from . import add_config
 
 
 def register(sub):
@@ -17,7 +18,7 @@ def register(sub):
     p.add_argument("files", nargs="*", type=Path, help="CAMS CSV files (default: inputs.cams)")
     p.add_argument("--data-dir", type=Path, default=None,
                    help="scenario data dir (default: data_dir of the config)")
-    p.add_argument("--config", "-c", default=None, help="scenario YAML")
+    add_config(p)
     p.set_defaults(func=run)
 
 

@@ -6,6 +6,7 @@ from pathlib import Path
 from ..config import load_config
 from ..errors import InputError
 from ..progress import set_quiet
+from . import add_config
 
 
 def register(sub):
@@ -26,7 +27,7 @@ def register(sub):
                         "geographic CRSs; for projected ones the order that fits the CRS's area "
                         "of use, easting first when both do), epsg (always the EPSG order), "
                         "xy (always easting/longitude first)")
-    p.add_argument("--config", "-c", default=None, help="scenario YAML (tile size, buffer, albedo)")
+    add_config(p)
     p.add_argument("--quiet", "-q", action="store_true",
                    help="no progress bars or progress lines")
     p.set_defaults(func=run)

@@ -3,6 +3,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from . import add_config
+
 
 def register(sub):
     p = sub.add_parser("gtfs", help="GTFS feed -> gtfs/segments.parquet, trips, patterns",
@@ -14,7 +16,7 @@ def register(sub):
     p.add_argument("--crs", default=None,
                    help="projected CRS when the city is not ingested, e.g. EPSG:2169 "
                         "(default: city/tiles.json, else the local UTM zone)")
-    p.add_argument("--config", default=None, help="scenario YAML (trajectory settings)")
+    add_config(p)
     p.add_argument("--dist-units", default=None, choices=["m", "km", "mi", "ft"],
                    help="units of shape_dist_traveled (default: inferred and checked)")
     p.add_argument("--timezone", default=None,

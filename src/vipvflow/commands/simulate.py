@@ -5,6 +5,7 @@ from pathlib import Path
 
 from ..config import load_config
 from ..progress import set_quiet
+from . import add_config
 
 
 def register(sub):
@@ -12,8 +13,7 @@ def register(sub):
                        description="Prepare inputs (demo generation, ingest), evaluate every pass of "
                        "every trip of the year per (tile, month) partition, reduce and write "
                        "out/<scenario>/<year>/. Re-running resumes an interrupted run.")
-    p.add_argument("--config", "-c", default="demo",
-                   help="scenario YAML, or a shipped scenario's name: demo (default), luxembourg, paper")
+    add_config(p, default="demo")
     p.add_argument("--year", type=int, required=True)
     p.add_argument("--out", type=Path, default=None,
                    help="folder for the scenario's relative data_dir and out_dir (and the demo's "

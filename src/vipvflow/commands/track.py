@@ -7,6 +7,7 @@ from pathlib import Path
 from ..config import load_config
 from ..errors import InputError
 from ..store import DataDir
+from . import add_config
 
 
 def register(sub):
@@ -16,11 +17,12 @@ def register(sub):
                     "track CSV (time, lat/lon or x/y, optional z, heading_deg, measured_wm2) "
                     "in an ingested city; with measured_wm2, print RMSE, MBE and R2.")
     p.add_argument("track", type=Path, help="track CSV")
-    p.add_argument("--city", type=Path, required=True, help="data dir holding city/ (tiles, meshes), or a run folder (its data dir)")
+    p.add_argument("--city", type=Path, required=True,
+                   help="data dir holding city/ (tiles, meshes), or a run folder (its data dir)")
     p.add_argument("--cams", type=Path, nargs="+", required=True, help="CAMS CSV file(s) covering the track")
     p.add_argument("--crs", default=None, help="CRS of x/y columns (default: the city's)")
     p.add_argument("--out", type=Path, required=True, help="output CSV")
-    p.add_argument("--config", "-c", default=None, help="scenario YAML (irradiance settings)")
+    add_config(p)
     p.set_defaults(func=run)
 
 

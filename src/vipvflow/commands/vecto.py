@@ -6,6 +6,7 @@ from pathlib import Path
 from .. import vecto
 from ..config import load_config
 from ..vehicle import simulate_cycle
+from . import add_config
 
 
 def register(sub):
@@ -14,7 +15,7 @@ def register(sub):
 
     c = inner.add_parser("cycle", help="summarise a .vdri cycle and run the built-in model on it")
     c.add_argument("vdri", type=Path, help="VECTO distance-based cycle (.vdri)")
-    c.add_argument("--config", "-c", default=None, help="scenario YAML (vehicle, cycle limits)")
+    add_config(c)
     c.add_argument("--ambient-c", type=float, default=15.0, help="ambient temperature (deg C)")
     c.set_defaults(func=run_cycle)
 
@@ -24,7 +25,7 @@ def register(sub):
 
     j = inner.add_parser("job", help="write the configured vehicle as a VECTO engineering job")
     j.add_argument("--out", type=Path, required=True, help="output directory")
-    j.add_argument("--config", "-c", default=None, help="scenario YAML")
+    add_config(j)
     j.add_argument("--cycles", type=Path, nargs="*", default=[], help=".vdri files to list")
     j.add_argument("--ambient-c", type=float, default=15.0, help="ambient for Padd_electric")
     j.set_defaults(func=run_job)
