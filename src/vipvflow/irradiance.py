@@ -857,7 +857,8 @@ def pass_sample_key(segment_id, t_utc) -> np.ndarray:
 def evaluate_passes(passes: pd.DataFrame, segments: pd.DataFrame, geometry: pd.DataFrame,
                     radiation_table, scene, cfg: IrradianceCfg | None = None,
                     ground_albedo: float = 0.20, time_at: str = "mid",
-                    packed: dict | None = None, timings: dict | None = None) -> pd.DataFrame:
+                    packed: dict | None = None, timings: dict | None = None,
+                    kernel: str = "fused") -> pd.DataFrame:
     """Irradiance components on the roof for every pass (W/m2).
 
     Parameters
@@ -881,7 +882,11 @@ def evaluate_passes(passes: pd.DataFrame, segments: pd.DataFrame, geometry: pd.D
         Seconds by stage are added to it: ``lookup_s`` radiation and sun lookup,
         ``ray_setup_s`` building the occlusion batch, ``rays_s`` the Embree query,
         ``components_s`` the component arithmetic, ``pack_s`` packing the geometry and
-        filling the output (the caller times; the kernel keeps no state)
+        filling the output (the caller times; the kernel keeps no state); with the fused
+        kernel ``ray_setup_s`` includes the radiation lookup
+    kernel : ``'fused'`` (default) the compiled kernel of :mod:`vipvflow.passkernel` where
+        the packed geometry holds the scene's frame, else, and with ``'numpy'``, the numpy
+        reference (:func:`roof_irradiance` per chunk); equal to float32 precision
 
     Returns
     -------
@@ -910,6 +915,22 @@ def evaluate_passes(passes: pd.DataFrame, segments: pd.DataFrame, geometry: pd.D
     loc_col = geometry["rad_location"].to_numpy(np.int64) if "rad_location" in geometry else None
     n = len(passes)
     columns = list(COMPONENTS) + ["ghi", "ghi_clear"]
+    if kernel == "fused":
+        from . import passkernel
+
+        if passkernel.usable(geo, scene):
+            mid = time_at == "mid" and "dt_s" in passes.columns
+            dt = (np.ascontiguousarray(passes["dt_s"].to_numpy(np.float64)) if mid
+                  else np.zeros(n))
+            clock["pack_s"] += time.perf_counter() - t_pack
+            block, visible = passkernel.evaluate_block(
+                np.ascontiguousarray(seg), np.ascontiguousarray(t_start), dt, mid,
+                np.ascontiguousarray(row), geo, cfg, radiation_table, scene, loc_col, clock)
+            df = pd.DataFrame(block, index=passes.index, columns=columns, copy=False)
+            df["sun_visible"] = visible
+            return df
+    elif kernel != "numpy":
+        raise ValueError(f"kernel must be 'fused' or 'numpy', not {kernel!r}")
     block = np.zeros((len(columns), n), np.float32).T      # column-major: one block per column
     visible = np.zeros(n, bool)
     # passes at night (every radiation value exactly 0) have every component exactly 0:
