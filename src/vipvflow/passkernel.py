@@ -271,6 +271,13 @@ def usable(geo: dict, scene) -> bool:
     return "group_p_local" in geo and _local_frame(geo, scene)
 
 
+def _writable(a: np.ndarray) -> np.ndarray:
+    """*a* C-contiguous and writable (a copy only where it is not): numba compiles one
+    version per array flavour, and :func:`warm` loads the writable one."""
+    a = np.ascontiguousarray(a)
+    return a if a.flags.writeable else a.copy()
+
+
 def _inputs(geo: dict, cfg, radiation_table, rows_of_segment_loc):
     f32 = np.float32
     names, packed = radiation_table._packed()
@@ -285,11 +292,13 @@ def _inputs(geo: dict, cfg, radiation_table, rows_of_segment_loc):
     wn = geo["wn"] if J else np.zeros((n_seg, 0, 3), f32)
     loc = (np.zeros(n_seg, np.int64) if rows_of_segment_loc is None
            else np.asarray(rows_of_segment_loc, np.int64))
-    return dict(packed=packed, cols=cols, t0=float(radiation_table.t0),
-                step=float(radiation_table.step_s), nrm=nrm, wn=np.ascontiguousarray(wn, f32),
-                p_local=geo["p_local"], gp_local=np.ascontiguousarray(geo["group_p_local"], f32),
-                sky=np.ascontiguousarray(sky, f32), iso=iso, refl_sky=np.ascontiguousarray(r_sky, f32),
-                refl_ghi=np.ascontiguousarray(r_ghi, f32), loc=loc)
+    x = dict(packed=packed, cols=cols, nrm=nrm, wn=wn.astype(f32, copy=False), p_local=geo["p_local"],
+             gp_local=geo["group_p_local"].astype(f32, copy=False), sky=sky.astype(f32, copy=False),
+             iso=iso, refl_sky=r_sky.astype(f32, copy=False), refl_ghi=r_ghi.astype(f32, copy=False),
+             loc=loc)
+    x = {k: _writable(v) for k, v in x.items()}
+    x.update(t0=float(radiation_table.t0), step=float(radiation_table.step_s))
+    return x
 
 
 def _run(seg, t_start, dt, mid, row, geo, cfg, radiation_table, scene, loc_of_row, clock,
@@ -343,6 +352,7 @@ def evaluate_block(seg, t_start, dt, mid, row, geo, cfg, radiation_table, scene,
     block : (n, 12) float32, W/m2, columns :data:`BLOCK_COLUMNS`
     visible : (n,) bool, the sun ray from the roof point was free
     """
+    seg, t_start, dt, row = (_writable(a) for a in (seg, t_start, dt, row))
     n = len(row)
     block = np.zeros((len(BLOCK_COLUMNS), n), np.float32)      # one row per column
     visible = np.zeros(n, bool)
@@ -373,6 +383,7 @@ def accumulate(seg, t_start, dt, mid, row, geo, cfg, radiation_table, scene, seg
     seg_bins : (n_seg_hour, 12) float64, Wh/m2 per (segment, local hour), :data:`BLOCK_COLUMNS`
     run_bins : (n_runs, 12) float64, Wh/m2 per run
     """
+    seg, t_start, dt, row, seg_hour, run = (_writable(a) for a in (seg, t_start, dt, row, seg_hour, run))
     seg_bins = np.zeros((n_seg_hour, len(BLOCK_COLUMNS)))
     run_bins = np.zeros((n_runs, len(BLOCK_COLUMNS)))
 
