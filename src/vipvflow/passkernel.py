@@ -240,18 +240,19 @@ def _finish_bins(lo, hi, row, rad, cos_aoi, pass_ray, pair_w, pair_pass, occ, do
 
 
 class _Batch:
-    """The per-call work arrays of the kernel, sized for one chunk of passes."""
+    """The work arrays of the kernel, sized for one chunk of passes (uninitialised: the
+    setup loop writes every element the finishing loop reads)."""
 
     def __init__(self, chunk: int, rays_per_pass: int, pairs_per_pass: int):
         f32 = np.float32
-        self.rad = np.zeros((chunk, 9), f32)
-        self.cos_aoi = np.zeros(chunk, f32)
-        self.pass_ray = np.zeros(chunk + 1, np.int64)
-        self.done = np.zeros(chunk, np.bool_)
-        self.pair_w = np.zeros(chunk * pairs_per_pass, f32)
-        self.pair_pass = np.zeros(chunk * pairs_per_pass, np.int64)
-        self.o = np.zeros((chunk * rays_per_pass, 3), f32)
-        self.d = np.zeros((chunk * rays_per_pass, 3), f32)
+        self.rad = np.empty((chunk, 9), f32)
+        self.cos_aoi = np.empty(chunk, f32)
+        self.pass_ray = np.empty(chunk + 1, np.int64)
+        self.done = np.empty(chunk, np.bool_)
+        self.pair_w = np.empty(chunk * pairs_per_pass, f32)
+        self.pair_pass = np.empty(chunk * pairs_per_pass, np.int64)
+        self.o = np.empty((chunk * rays_per_pass, 3), f32)
+        self.d = np.empty((chunk * rays_per_pass, 3), f32)
 
 
 def _plan(geo: dict, cfg):
