@@ -141,3 +141,30 @@ def test_fused_equals_numpy_on_the_demo_passes(small_run, small_config):
 
 def test_block_columns_are_the_components():
     assert passkernel.BLOCK_COLUMNS == tuple(COMPONENTS) + ("ghi", "ghi_clear")
+
+
+@pytest.mark.parametrize("spread", [1, 10**9])
+def test_pass_groups_equal_the_numpy_reference(spread):
+    """Runs, segment positions and local hours of passes across the spring clock change
+    (2024-03-31 01:00 UTC in Luxembourg), compact and sparse segment ids."""
+    from vipvflow.simulation.partition import _dense_positions, _local_hours
+
+    rng = np.random.default_rng(1)
+    n = 50_000
+    t = np.sort(pd.Timestamp("2024-03-30 20:00", tz="UTC").timestamp() + rng.uniform(0, 12 * 3600, n))
+    trip = np.repeat(np.arange(n // 50), 50)
+    day = np.repeat(np.arange(n // 100), 100) + 19_800
+    seg = rng.integers(0, 300, n) * spread + 5
+    dt = rng.uniform(1, 9, n)
+    g = passkernel.pass_groups(trip, day, seg, t, dt, "Europe/Luxembourg")
+    hour = _local_hours(t, "Europe/Luxembourg")
+    # UTC+1 until 01:00 UTC, then UTC+2: local 21:00 .. 01:59, then from 03:00 (no 02:00)
+    assert (g["hour"] == hour).all() and set(hour[t < 1711846800]) == {21, 22, 23, 0, 1}
+    assert set(hour[t >= 1711846800]) == set(range(3, 10))
+    ids, pos = _dense_positions(seg)
+    assert (g["seg_ids"] == ids).all() and (g["seg_pos"] == pos).all()
+    assert (g["seg_hour"] == pos * 24 + hour).all()
+    assert (g["run"] == np.repeat(np.arange(n // 50), 50)).all() and len(g["starts"]) == n // 50
+    np.testing.assert_allclose(g["run_s"], np.bincount(g["run"], dt), rtol=1e-12)
+    np.testing.assert_allclose(g["hour_s"], np.bincount(hour, dt, 24), rtol=1e-12)
+    assert (g["seg_n"] == np.bincount(pos)).all() and g["seg_s"].sum() == pytest.approx(dt.sum())

@@ -239,6 +239,89 @@ def _finish_bins(lo, hi, row, rad, cos_aoi, pass_ray, pair_w, pair_pass, occ, do
             run_bins[k, j] += h
 
 
+@njit(cache=True, nogil=True)
+def _groups(trip_code, day, seg, t_utc, dt, seg_lo, seg_pos_of, hour_lo, offset_s,
+            run, seg_pos, seg_hour, hour):
+    """Each pass's run (a new one where trip or service day changes), segment position,
+    local clock hour (UTC offset per UTC hour from *hour_lo*) and (segment, hour) bin;
+    returns the number of runs."""
+    n_runs = 0
+    for i in range(len(seg)):
+        if i == 0 or trip_code[i] != trip_code[i - 1] or day[i] != day[i - 1]:
+            n_runs += 1
+        run[i] = n_runs - 1
+        p = seg_pos_of[seg[i] - seg_lo]
+        seg_pos[i] = p
+        t = t_utc[i]
+        h = np.int64(np.floor((t + offset_s[np.int64(np.floor(t / 3600.0)) - hour_lo]) / 3600.0)) % 24
+        hour[i] = h
+        seg_hour[i] = p * 24 + h
+    return n_runs
+
+
+@njit(cache=True, nogil=True)
+def _seconds(run, seg_pos, hour, dt, by_run, by_seg, by_hour, n_by_seg, n_by_hour):
+    """Time (s) per run, segment and hour, and passes per segment and hour, in pass order."""
+    for i in range(len(run)):
+        by_run[run[i]] += dt[i]
+        by_seg[seg_pos[i]] += dt[i]
+        by_hour[hour[i]] += dt[i]
+        n_by_seg[seg_pos[i]] += 1
+        n_by_hour[hour[i]] += 1
+
+
+def pass_groups(trip_code, day, seg, t_utc, dt, timezone: str) -> dict:
+    """The (trip, date) run, segment and local hour of every pass, in one compiled loop.
+
+    Parameters
+    ----------
+    trip_code : (n,) int64, trip of each pass (codes)
+    day : (n,) int64, service date (days since 1970)
+    seg : (n,) int64, segment id
+    t_utc : (n,) float64, Unix s
+    dt : (n,) float64, s on the segment
+    timezone : str, IANA name of the local clock
+
+    Returns
+    -------
+    dict of arrays: ``run``, ``seg_pos`` (position among the sorted distinct ``seg_ids``),
+    ``hour`` (local, 0..23), ``seg_hour`` (``seg_pos x 24 + hour``), ``starts`` (first pass
+    of each run), ``seg_ids``; and per run, segment and hour the seconds ``run_s, seg_s,
+    hour_s`` and the pass counts ``seg_n, hour_n``.
+    """
+    import pandas as pd
+
+    trip_code, day, seg, t_utc, dt = (_writable(a) for a in (trip_code, day, seg, t_utc, dt))
+    n = len(seg)
+    lo, hi = (int(seg.min()), int(seg.max())) if n else (0, 0)
+    if hi - lo > 8 * n + 1024:          # sparse ids: positions by sorting
+        seg_ids, seg = np.unique(seg, return_inverse=True)
+        seg, lo, seg_pos_of = _writable(seg.astype(np.int64)), 0, np.arange(len(seg_ids))
+    else:
+        present = np.zeros(hi - lo + 1, bool)
+        present[seg - lo] = True
+        seg_pos_of = np.cumsum(present) - 1
+        seg_ids = np.flatnonzero(present) + lo if n else seg[:0]
+    h_lo = int(np.floor(t_utc.min() / 3600.0)) if n else 0
+    h_hi = int(np.floor(t_utc.max() / 3600.0)) if n else 0
+    span = pd.DatetimeIndex(pd.to_datetime(np.arange(h_lo, h_hi + 1) * 3600, unit="s", utc=True))
+    local = span.tz_convert(timezone).tz_localize(None)
+    offset = ((local - span.tz_localize(None)) / pd.Timedelta(seconds=1)).to_numpy(np.float64)
+    out = {k: np.empty(n, np.int64) for k in ("run", "seg_pos", "seg_hour", "hour")}
+    n_runs = _groups(trip_code, day, seg, t_utc, dt, lo, seg_pos_of, h_lo, _writable(offset),
+                     out["run"], out["seg_pos"], out["seg_hour"], out["hour"])
+    new_run = np.empty(n, bool)
+    if n:
+        new_run[0] = True
+        np.not_equal(out["run"][1:], out["run"][:-1], out=new_run[1:])
+    out.update(starts=np.flatnonzero(new_run), seg_ids=seg_ids, run_s=np.zeros(n_runs),
+               seg_s=np.zeros(len(seg_ids)), hour_s=np.zeros(24),
+               seg_n=np.zeros(len(seg_ids), np.int64), hour_n=np.zeros(24, np.int64))
+    _seconds(out["run"], out["seg_pos"], out["hour"], dt, out["run_s"], out["seg_s"],
+             out["hour_s"], out["seg_n"], out["hour_n"])
+    return out
+
+
 class _Batch:
     """The work arrays of the kernel, sized for one chunk of passes (uninitialised: the
     setup loop writes every element the finishing loop reads)."""
@@ -417,4 +500,6 @@ def warm() -> float:
         _finish_bins(0, 1, one_i, rad, one_f, pr, one_f, one_i, np.zeros(1, bool),
                      np.zeros(1, np.bool_), one_f, one_f, one_f, one_f, rotate, 1, one_t,
                      one_i, one_i, np.zeros((1, 12)), np.zeros((1, 12)))
+    _groups(one_i, one_i, one_i, one_t, one_t, 0, one_i, 0, one_t, one_i, one_i, one_i, one_i)
+    _seconds(one_i, one_i, one_i, one_t, one_t, one_t, one_t, one_i, one_i)
     return time.perf_counter() - t

@@ -186,15 +186,15 @@ def _dense_positions(ids: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def partition_groups(passes: pd.DataFrame, ctx: RunContext) -> dict:
-    """Each pass's (trip, service date) run, segment position and local hour.
+    """Each pass's (trip, service date) run, segment position and local hour, and the
+    seconds per run, segment and hour (:func:`vipvflow.passkernel.pass_groups`).
 
-    Returns a dict: ``run`` (n,) and ``starts`` (first pass of each run), ``trip_code``,
-    ``trip_uniques``, ``day`` (days since 1970), ``seg_ids`` (sorted) and ``seg_pos`` (n,),
-    ``hour`` (n,) local clock hour, ``dt`` (n,) s on the segment.  The runs come from the
-    pass order (sorted by service date, trip and time, as
-    :func:`vipvflow.trajectory.iter_passes` gives them).
+    Returns its dict with ``trip_code``, ``trip_uniques``, ``day`` (days since 1970) and
+    ``dt`` (n,) s on the segment.  The runs come from the pass order (sorted by service
+    date, trip and time, as :func:`vipvflow.trajectory.iter_passes` gives them).
     """
-    n = len(passes)
+    from ..passkernel import pass_groups
+
     # trip codes in the order of the trip names (categories are sorted by iter_passes)
     trip_col = passes["trip_id"]
     if hasattr(trip_col, "cat"):
@@ -203,15 +203,11 @@ def partition_groups(passes: pd.DataFrame, ctx: RunContext) -> dict:
         trip_code, trip_uniques = pd.factorize(trip_col, sort=True)
     trip_code = np.asarray(trip_code, dtype=np.int64)
     day = passes["service_date"].to_numpy().astype("datetime64[D]").astype(np.int64)
-    new_run = np.ones(n, bool)
-    if n > 1:
-        new_run[1:] = (trip_code[1:] != trip_code[:-1]) | (day[1:] != day[:-1])
-    seg_ids, seg_pos = _dense_positions(passes["segment_id"].to_numpy(np.int64))
-    return {"run": np.cumsum(new_run) - 1, "starts": np.flatnonzero(new_run),
-            "trip_code": trip_code, "trip_uniques": trip_uniques, "day": day,
-            "seg_ids": seg_ids, "seg_pos": np.asarray(seg_pos, np.int64),
-            "hour": _local_hours(passes["t_utc"].to_numpy(np.float64), ctx.timezone).astype(np.int64),
-            "dt": np.ascontiguousarray(passes["dt_s"].to_numpy(np.float64))}
+    dt = np.ascontiguousarray(passes["dt_s"].to_numpy(np.float64))
+    g = pass_groups(trip_code, day, passes["segment_id"].to_numpy(np.int64),
+                    passes["t_utc"].to_numpy(np.float64), dt, ctx.timezone)
+    g.update(trip_code=trip_code, trip_uniques=trip_uniques, day=day, dt=dt)
+    return g
 
 
 def _irradiation_sums(irr: pd.DataFrame, g: dict, n_seg: int, n_runs: int):
@@ -227,7 +223,7 @@ def _irradiation_sums(irr: pd.DataFrame, g: dict, n_seg: int, n_runs: int):
     h_all = np.empty((len(COMPONENTS), len(act)), np.float64)   # one contiguous row per component
     for j, v in enumerate(comp.values()):
         np.multiply(v[act], w_act, out=h_all[j])
-    seg_hour = g["seg_pos"][act] * 24 + g["hour"][act]
+    seg_hour = g["seg_hour"][act]
     table = np.stack([np.bincount(seg_hour, h_all[j], n_seg * 24) for j in range(len(COMPONENTS))], 1)
     # per trip: the runs are contiguous, so one reduceat sums every component
     run_act = g["run"][act]
@@ -305,8 +301,7 @@ def aggregate_partition(passes: pd.DataFrame, irr: pd.DataFrame | None, month: i
             e = pv_energy_kwh(comp[col][act].astype(np.float64), dt[act], speed, month, ctx)
             sums["trip"][name] = np.bincount(run[act], e, n_runs)
             sums["seg"][name] = np.bincount(seg_pos[act], e, n_seg)
-    seconds = {"trip": np.bincount(run, dt, n_runs), "seg": np.bincount(seg_pos, dt, n_seg),
-               "hour": np.bincount(hour, dt, 24)}
+    seconds = {"trip": g["run_s"], "seg": g["seg_s"], "hour": g["hour_s"]}
     pv_cols = list(pv_source)
     h_cols = [f"h_{c}" for c in COMPONENTS]
 
@@ -322,11 +317,11 @@ def aggregate_partition(passes: pd.DataFrame, irr: pd.DataFrame | None, month: i
         trip = trip.groupby(["trip_id", "service_date"], sort=True).sum().reset_index()
 
     segm = pd.DataFrame({"segment_id": seg_ids,
-                         "n_passes": np.bincount(seg_pos, minlength=n_seg).astype(np.int64),
+                         "n_passes": g["seg_n"],
                          **{c: sums["seg"][c] for c in pv_cols + h_cols},
                          "seconds": seconds["seg"]})
 
-    present = np.flatnonzero(np.bincount(hour, minlength=24) > 0)
+    present = np.flatnonzero(g["hour_n"] > 0)
     hourly = pd.DataFrame({"hour": present.astype(np.int8),
                            **{c: sums["hour"][c][present] for c in h_cols},
                            "seconds": seconds["hour"][present]})
@@ -357,7 +352,7 @@ def _fused_sums(ctx: RunContext, tile: str, passes: pd.DataFrame, geometry: pd.D
     loc = geometry["rad_location"].to_numpy(np.int64) if "rad_location" in geometry else None
     t1 = time.perf_counter()
     groups = partition_groups(passes, ctx)
-    seg_hour = groups["seg_pos"] * 24 + groups["hour"]
+    seg_hour = groups["seg_hour"]
     t2 = time.perf_counter()
     stages: dict = {}
     seg_bins, run_bins = passkernel.accumulate(
