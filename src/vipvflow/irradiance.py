@@ -845,7 +845,24 @@ def roof_irradiance(geometry, rows, sun: np.ndarray, rad: dict, scene, cfg: Irra
 
 def pass_sample_key(segment_id, t_utc) -> np.ndarray:
     """A well-mixed integer per pass from its segment and time (splitmix64 finaliser), so
-    the reflector sample point a pass traces does not depend on batching or workers."""
+    the reflector sample point a pass traces does not depend on batching or workers.
+
+    Parameters
+    ----------
+    segment_id : (n,) int, segment of each pass
+    t_utc : (n,) float, Unix s at the segment start (rounded to the millisecond)
+
+    Returns
+    -------
+    (n,) int64 in [0, 2**31): reflector ``j`` of the pass traces sample point
+    ``(key + j) mod P`` (:func:`roof_irradiance`), and ``key >> 4`` seeds its roulette
+    (:func:`_roulette`).  The compiled kernel computes the same key per pass
+    (:mod:`vipvflow.passkernel`).
+
+    References
+    ----------
+    S. Vigna, splitmix64 (public domain), the finaliser of ``java.util.SplittableRandom``.
+    """
     x = (np.asarray(segment_id, np.int64).astype(np.uint64) * np.uint64(0x9E3779B97F4A7C15)
          + np.round(np.asarray(t_utc, np.float64) * 1000.0).astype(np.int64).astype(np.uint64))
     x = (x ^ (x >> np.uint64(30))) * np.uint64(0xBF58476D1CE4E5B9)

@@ -26,6 +26,8 @@ writable); :func:`warm` loads them (the Dask worker preload calls it).
 
 References
 ----------
+Paper (Pera et al., see ``CITATION.cff``) sections 3.2.1-3.2.3 (eqs. 1-3) and 3.3 (energy);
+pvlib ``irradiance.get_total_irradiance(model='isotropic')``, ``irradiance.aoi``.
 S. K. Lam, A. Pitrou, S. Seibert (2015), Numba: a LLVM-based Python JIT compiler, LLVM-HPC
 '15.  pvlib uses numba for its solar position algorithm (``pvlib.spa``).
 """

@@ -146,8 +146,26 @@ def tile_geometry(ctx: RunContext, tile: str) -> pd.DataFrame:
 
 def pv_energy_kwh(poa_wm2: np.ndarray, dt_s: np.ndarray, speed_mps: np.ndarray, month: int,
                   ctx: RunContext) -> np.ndarray:
-    """PV energy per pass (kWh) in the run's PV mode (:func:`vipvflow.pv.energy`), at the
-    month's mean temperature and the run's wind."""
+    """PV energy per pass in the run's PV mode (:func:`vipvflow.pv.energy`), at the month's
+    mean air temperature and the run's wind.
+
+    Parameters
+    ----------
+    poa_wm2 : (n,) plane-of-array irradiance on the roof, W/m2
+    dt_s : (n,) time at that irradiance, s
+    speed_mps : (n,) bus speed, m/s (cools the modules in ``pvlib`` mode)
+    month : int, 1..12
+    ctx : RunContext (PV system, mode, monthly temperatures in degC, wind in m/s)
+
+    Returns
+    -------
+    (n,) float64, kWh
+
+    References
+    ----------
+    Paper section 3.3 (``kWp x POA / 1000 x PR x dt``); pvlib ``pvsystem.pvwatts_dc``,
+    ``temperature.sapm_cell`` (``pvlib`` mode).
+    """
     from .. import pv
 
     return pv.energy(poa_wm2, dt_s, PVSystem(**ctx.pv_system), ctx.pv_mode,
