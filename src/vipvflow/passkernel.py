@@ -89,9 +89,7 @@ def _setup(lo, hi, seg, t_start, dt, mid, row, loc_of_row, packed, cols, t0, ste
         t = t_start[i] + 0.5 * dt[i] if mid else t_start[i]
         f = (t - t0) / step
         if not (f >= 0.0 and f <= n_t - 1):
-            continue                                  # outside the radiation grid: NaN -> 0
-        if f != f:
-            f = 0.0
+            continue              # outside the radiation grid (or NaN): every value 0
         ii = min(np.int64(f), n_t - 2) if n_t > 1 else np.int64(0)
         w = np.float32(f - ii)
         r = row[i]
@@ -102,7 +100,7 @@ def _setup(lo, hi, seg, t_start, dt, mid, row, loc_of_row, packed, cols, t0, ste
             b = packed[li, ii + 1, cols[q]] if n_t > 1 else a
             v = a + w * (b - a)
             if q < 6:
-                if v != v:
+                if np.isnan(v):
                     v = np.float32(0.0)
                 if v != 0:
                     dark = False

@@ -288,7 +288,7 @@ def aggregate_partition(passes: pd.DataFrame, irr: pd.DataFrame | None, month: i
     pv_source = {**{f"pv_kwh{suffix}": col for suffix, col in VARIANTS.items()},
                  **{f"pv_kwh_{c}": c for c in PV_COMPONENTS}}
     g = groups if groups is not None else partition_groups(passes, ctx)
-    dt, run, seg_pos, hour, starts = g["dt"], g["run"], g["seg_pos"], g["hour"], g["starts"]
+    dt, run, seg_pos, starts = g["dt"], g["run"], g["seg_pos"], g["starts"]
     trip_code, day = g["trip_code"], g["day"]
     n_runs, seg_ids = len(starts), g["seg_ids"]
     n_seg = len(seg_ids)
