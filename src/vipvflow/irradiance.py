@@ -978,7 +978,24 @@ def roof_irradiance(geometry, rows, sun: np.ndarray, rad: dict, scene, cfg: Irra
 
 def pass_sample_key(segment_id, t_utc) -> np.ndarray:
     """A well-mixed integer per pass from its segment and time (splitmix64 finaliser), so
-    the reflector sample point a pass traces does not depend on batching or workers."""
+    the reflector sample point a pass traces does not depend on batching or workers.
+
+    Parameters
+    ----------
+    segment_id : (n,) int, segment of each pass
+    t_utc : (n,) float, Unix s at the segment start (rounded to the millisecond)
+
+    Returns
+    -------
+    (n,) int64 in [0, 2**31): reflector ``j`` of the pass traces sample point
+    ``(key + j) mod P`` (:func:`roof_irradiance`), and ``key >> 4`` seeds its roulette
+    (:func:`_roulette`).  The compiled kernel computes the same key per pass
+    (:mod:`vipvflow.passkernel`).
+
+    References
+    ----------
+    S. Vigna, splitmix64 (public domain), the finaliser of ``java.util.SplittableRandom``.
+    """
     x = (np.asarray(segment_id, np.int64).astype(np.uint64) * np.uint64(0x9E3779B97F4A7C15)
          + np.round(np.asarray(t_utc, np.float64) * 1000.0).astype(np.int64).astype(np.uint64))
     x = (x ^ (x >> np.uint64(30))) * np.uint64(0xBF58476D1CE4E5B9)
@@ -990,7 +1007,8 @@ def pass_sample_key(segment_id, t_utc) -> np.ndarray:
 def evaluate_passes(passes: pd.DataFrame, segments: pd.DataFrame, geometry: pd.DataFrame,
                     radiation_table, scene, cfg: IrradianceCfg | None = None,
                     ground_albedo: float = 0.20, time_at: str = "mid",
-                    packed: dict | None = None, timings: dict | None = None) -> pd.DataFrame:
+                    packed: dict | None = None, timings: dict | None = None,
+                    kernel: str = "fused") -> pd.DataFrame:
     """Irradiance components on the roof for every pass (W/m2).
 
     Parameters
@@ -1014,7 +1032,11 @@ def evaluate_passes(passes: pd.DataFrame, segments: pd.DataFrame, geometry: pd.D
         Seconds by stage are added to it: ``lookup_s`` radiation and sun lookup,
         ``ray_setup_s`` building the occlusion batch, ``rays_s`` the Embree query,
         ``components_s`` the component arithmetic, ``pack_s`` packing the geometry and
-        filling the output (the caller times; the kernel keeps no state)
+        filling the output (the caller times; the kernel keeps no state); with the fused
+        kernel ``ray_setup_s`` includes the radiation lookup
+    kernel : ``'fused'`` (default) the compiled kernel of :mod:`vipvflow.passkernel` where
+        the packed geometry holds the scene's frame, else, and with ``'numpy'``, the numpy
+        reference (:func:`roof_irradiance` per chunk); equal to float32 precision
 
     Returns
     -------
@@ -1043,6 +1065,22 @@ def evaluate_passes(passes: pd.DataFrame, segments: pd.DataFrame, geometry: pd.D
     loc_col = geometry["rad_location"].to_numpy(np.int64) if "rad_location" in geometry else None
     n = len(passes)
     columns = list(COMPONENTS) + ["ghi", "ghi_clear"]
+    if kernel == "fused":
+        from . import passkernel
+
+        if passkernel.usable(geo, scene):
+            mid = time_at == "mid" and "dt_s" in passes.columns
+            dt = (np.ascontiguousarray(passes["dt_s"].to_numpy(np.float64)) if mid
+                  else np.zeros(n))
+            clock["pack_s"] += time.perf_counter() - t_pack
+            block, visible = passkernel.evaluate_block(
+                np.ascontiguousarray(seg), np.ascontiguousarray(t_start), dt, mid,
+                np.ascontiguousarray(row), geo, cfg, radiation_table, scene, loc_col, clock)
+            df = pd.DataFrame(block, index=passes.index, columns=columns, copy=False)
+            df["sun_visible"] = visible
+            return df
+    elif kernel != "numpy":
+        raise ValueError(f"kernel must be 'fused' or 'numpy', not {kernel!r}")
     block = np.zeros((len(columns), n), np.float32).T      # column-major: one block per column
     visible = np.zeros(n, bool)
     # passes at night (every radiation value exactly 0) have every component exactly 0:

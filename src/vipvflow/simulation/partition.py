@@ -146,8 +146,26 @@ def tile_geometry(ctx: RunContext, tile: str) -> pd.DataFrame:
 
 def pv_energy_kwh(poa_wm2: np.ndarray, dt_s: np.ndarray, speed_mps: np.ndarray, month: int,
                   ctx: RunContext) -> np.ndarray:
-    """PV energy per pass (kWh) in the run's PV mode (:func:`vipvflow.pv.energy`), at the
-    month's mean temperature and the run's wind."""
+    """PV energy per pass in the run's PV mode (:func:`vipvflow.pv.energy`), at the month's
+    mean air temperature and the run's wind.
+
+    Parameters
+    ----------
+    poa_wm2 : (n,) plane-of-array irradiance on the roof, W/m2
+    dt_s : (n,) time at that irradiance, s
+    speed_mps : (n,) bus speed, m/s (cools the modules in ``pvlib`` mode)
+    month : int, 1..12
+    ctx : RunContext (PV system, mode, monthly temperatures in degC, wind in m/s)
+
+    Returns
+    -------
+    (n,) float64, kWh
+
+    References
+    ----------
+    Paper section 3.3 (``kWp x POA / 1000 x PR x dt``); pvlib ``pvsystem.pvwatts_dc``,
+    ``temperature.sapm_cell`` (``pvlib`` mode).
+    """
     from .. import pv
 
     return pv.energy(poa_wm2, dt_s, PVSystem(**ctx.pv_system), ctx.pv_mode,
@@ -185,28 +203,16 @@ def _dense_positions(ids: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return np.flatnonzero(present) + lo, pos[ids - lo]
 
 
-def aggregate_partition(passes: pd.DataFrame, irr: pd.DataFrame, month: int, ctx: RunContext):
-    """Sum a partition's passes per trip and service date, per segment and per local hour.
+def partition_groups(passes: pd.DataFrame, ctx: RunContext) -> dict:
+    """Each pass's (trip, service date) run, segment position and local hour, and the
+    seconds per run, segment and hour (:func:`vipvflow.passkernel.pass_groups`).
 
-    Returns three tables: per trip (``trip_id, service_date``, PV kWh of all-sky, clear-sky,
-    the unshaded references and per component, ``seconds``), per segment (``segment_id,
-    n_passes``, the same kWh, irradiation ``h_<component>`` in Wh/m2, ``seconds``) and per
-    local clock hour (``hour``, irradiation, ``seconds``).
-
-    One ``bincount`` per component over (segment, local hour) bins and one ``reduceat`` over
-    the (trip, date) runs, over the passes that received any light only (night passes add
-    nothing but their time); the (trip, date) runs come from the pass
-    order (sorted by service date, trip and time, as :func:`vipvflow.trajectory.iter_passes`
-    gives them; a (trip, date) split over several runs is merged).
+    Returns its dict with ``trip_code``, ``trip_uniques``, ``day`` (days since 1970) and
+    ``dt`` (n,) s on the segment.  The runs come from the pass order (sorted by service
+    date, trip and time, as :func:`vipvflow.trajectory.iter_passes` gives them).
     """
-    n = len(passes)
-    dt = passes["dt_s"].to_numpy(np.float64)
-    system = PVSystem(**ctx.pv_system)
-    linear = ctx.pv_mode == "paper"
-    pv_source = {**{f"pv_kwh{suffix}": col for suffix, col in VARIANTS.items()},
-                 **{f"pv_kwh_{c}": c for c in PV_COMPONENTS}}
+    from ..passkernel import pass_groups
 
-    # groups: (trip, date) run, segment, local hour
     # trip codes in the order of the trip names (categories are sorted by iter_passes)
     trip_col = passes["trip_id"]
     if hasattr(trip_col, "cat"):
@@ -215,64 +221,111 @@ def aggregate_partition(passes: pd.DataFrame, irr: pd.DataFrame, month: int, ctx
         trip_code, trip_uniques = pd.factorize(trip_col, sort=True)
     trip_code = np.asarray(trip_code, dtype=np.int64)
     day = passes["service_date"].to_numpy().astype("datetime64[D]").astype(np.int64)
-    new_run = np.ones(n, bool)
-    if n > 1:
-        new_run[1:] = (trip_code[1:] != trip_code[:-1]) | (day[1:] != day[:-1])
-    starts = np.flatnonzero(new_run)
-    run = np.cumsum(new_run) - 1
-    n_runs = len(starts)
-    seg_ids, seg_pos = _dense_positions(passes["segment_id"].to_numpy(np.int64))
-    n_seg = len(seg_ids)
-    hour = _local_hours(passes["t_utc"].to_numpy(np.float64), ctx.timezone).astype(np.int64)
+    dt = np.ascontiguousarray(passes["dt_s"].to_numpy(np.float64))
+    g = pass_groups(trip_code, day, passes["segment_id"].to_numpy(np.int64),
+                    passes["t_utc"].to_numpy(np.float64), dt, ctx.timezone)
+    g.update(trip_code=trip_code, trip_uniques=trip_uniques, day=day, dt=dt)
+    return g
 
-    # irradiation (Wh/m2) of the passes that received any light
+
+def _irradiation_sums(irr: pd.DataFrame, g: dict, n_seg: int, n_runs: int):
+    """The numpy reference of the sums: irradiation (Wh/m2) of each component per (segment,
+    local hour) bin (n_seg x 24, C) and per run (n_runs, C), over the passes with light."""
     comp = {c: irr[c].to_numpy(np.float32) for c in COMPONENTS}
+    n = len(g["dt"])
     lit = np.zeros(n, bool)
     for v in comp.values():
         lit |= v != 0
     act = np.flatnonzero(lit)
-    w_act = dt[act] / 3600.0
-    names = list(comp)
-    h_all = np.empty((len(names), len(act)), np.float64)      # one contiguous row per component
+    w_act = g["dt"][act] / 3600.0
+    h_all = np.empty((len(COMPONENTS), len(act)), np.float64)   # one contiguous row per component
     for j, v in enumerate(comp.values()):
         np.multiply(v[act], w_act, out=h_all[j])
-    sums = {"trip": {}, "seg": {}, "hour": {}}
-    # per segment and local hour in one bincount per component: bins (segment, hour)
-    seg_hour = seg_pos[act] * 24 + hour[act]
-    for j, c in enumerate(names):
-        table = np.bincount(seg_hour, h_all[j], n_seg * 24).reshape(n_seg, 24)
-        sums["seg"][f"h_{c}"] = table.sum(axis=1)
-        sums["hour"][f"h_{c}"] = table.sum(axis=0)
+    seg_hour = g["seg_hour"][act]
+    table = np.stack([np.bincount(seg_hour, h_all[j], n_seg * 24) for j in range(len(COMPONENTS))], 1)
     # per trip: the runs are contiguous, so one reduceat sums every component
-    run_act = run[act]
-    per_run = np.zeros((len(names), n_runs))
+    run_act = g["run"][act]
+    per_run = np.zeros((len(COMPONENTS), n_runs))
     if len(act):
         first = np.flatnonzero(np.r_[True, run_act[1:] != run_act[:-1]])
         per_run[:, run_act[first]] = np.add.reduceat(h_all, first, axis=1)
-    for j, c in enumerate(names):
-        sums["trip"][f"h_{c}"] = per_run[j]
+    return table, per_run.T, comp, act
+
+
+def aggregate_partition(passes: pd.DataFrame, irr: pd.DataFrame | None, month: int, ctx: RunContext,
+                        groups: dict | None = None, bins: tuple | None = None):
+    """Sum a partition's passes per trip and service date, per segment and per local hour.
+
+    Returns three tables: per trip (``trip_id, service_date``, PV kWh of all-sky, clear-sky,
+    the unshaded references and per component, ``seconds``), per segment (``segment_id,
+    n_passes``, the same kWh, irradiation ``h_<component>`` in Wh/m2, ``seconds``) and per
+    local clock hour (``hour``, irradiation, ``seconds``).
+
+    Parameters
+    ----------
+    passes : DataFrame of the partition's passes (``trip_id, service_date, segment_id,
+        t_utc, dt_s, speed_mps``), in :func:`vipvflow.trajectory.iter_passes` order
+    irr : DataFrame of per-pass irradiance (W/m2, :func:`vipvflow.irradiance.evaluate_passes`),
+        or None with *bins*
+    month : int, 1..12 (the month's air temperature in ``pvlib`` mode)
+    ctx : RunContext
+    groups : dict, optional, :func:`partition_groups` of *passes* when the caller has it
+    bins : (seg_bins, run_bins), optional, irradiation (Wh/m2) already summed per (segment x
+        24 + local hour) bin and per run, columns ``COMPONENTS`` (the fused kernel,
+        :func:`vipvflow.passkernel.accumulate`); only in the linear ``paper`` PV mode
+
+    Notes
+    -----
+    Irradiation ``H = sum E dt / 3600`` (Wh/m2); in ``paper`` mode the energy is linear in
+    it, ``kWh = kWp x PR x H / 1000`` (:func:`vipvflow.pv.energy_paper`); in ``pvlib`` mode
+    it is summed per pass (:func:`pv_energy_kwh`).  Without *bins*: one ``bincount`` per
+    component over (segment, local hour) bins and one ``reduceat`` over the (trip, date)
+    runs, over the passes that received any light only (a (trip, date) split over several
+    runs is merged).
+    """
+    system = PVSystem(**ctx.pv_system)
+    linear = ctx.pv_mode == "paper"
+    pv_source = {**{f"pv_kwh{suffix}": col for suffix, col in VARIANTS.items()},
+                 **{f"pv_kwh_{c}": c for c in PV_COMPONENTS}}
+    g = groups if groups is not None else partition_groups(passes, ctx)
+    dt, run, seg_pos, starts = g["dt"], g["run"], g["seg_pos"], g["starts"]
+    trip_code, day = g["trip_code"], g["day"]
+    n_runs, seg_ids = len(starts), g["seg_ids"]
+    n_seg = len(seg_ids)
+    if bins is None:
+        table, per_run, comp, act = _irradiation_sums(irr, g, n_seg, n_runs)
+    else:
+        if not linear:
+            raise ValueError("summed bins need the linear 'paper' PV mode")
+        table, per_run = bins
+    table = table.reshape(n_seg, 24, len(COMPONENTS))
+    sums = {"trip": {}, "seg": {}, "hour": {}}
+    for j, c in enumerate(COMPONENTS):
+        t_c = np.ascontiguousarray(table[:, :, j])
+        sums["seg"][f"h_{c}"] = t_c.sum(axis=1)
+        sums["hour"][f"h_{c}"] = t_c.sum(axis=0)
+        sums["trip"][f"h_{c}"] = per_run[:, j]
     if linear:
         # paper mode is linear in the irradiation: kWh = kWp x PR x H / 1000 (H in Wh/m2)
         from ..pv import paper_kw_per_wm2
 
         k = paper_kw_per_wm2(system.kwp, system.performance_ratio)
-        for g in ("trip", "seg"):
+        for grp in ("trip", "seg"):
             for name, col in pv_source.items():
-                sums[g][name] = k * sums[g][f"h_{col}"]
+                sums[grp][name] = k * sums[grp][f"h_{col}"]
     else:
         speed = passes["speed_mps"].to_numpy(np.float64)[act]
         for name, col in pv_source.items():
             e = pv_energy_kwh(comp[col][act].astype(np.float64), dt[act], speed, month, ctx)
-            sums["trip"][name] = np.bincount(run_act, e, n_runs)
+            sums["trip"][name] = np.bincount(run[act], e, n_runs)
             sums["seg"][name] = np.bincount(seg_pos[act], e, n_seg)
-    seconds = {"trip": np.bincount(run, dt, n_runs), "seg": np.bincount(seg_pos, dt, n_seg),
-               "hour": np.bincount(hour, dt, 24)}
+    seconds = {"trip": g["run_s"], "seg": g["seg_s"], "hour": g["hour_s"]}
     pv_cols = list(pv_source)
     h_cols = [f"h_{c}" for c in COMPONENTS]
 
     # trips ordered by trip id and date
     order = np.lexsort((day[starts], trip_code[starts]))
-    trip_names = np.asarray(np.asarray(trip_uniques)[trip_code[starts][order]]).astype(str)
+    trip_names = np.asarray(np.asarray(g["trip_uniques"])[trip_code[starts][order]]).astype(str)
     trip = pd.DataFrame({"trip_id": trip_names,
                          "service_date": passes["service_date"].to_numpy()[starts][order],
                          **{c: sums["trip"][c][order] for c in pv_cols},
@@ -282,15 +335,54 @@ def aggregate_partition(passes: pd.DataFrame, irr: pd.DataFrame, month: int, ctx
         trip = trip.groupby(["trip_id", "service_date"], sort=True).sum().reset_index()
 
     segm = pd.DataFrame({"segment_id": seg_ids,
-                         "n_passes": np.bincount(seg_pos, minlength=n_seg).astype(np.int64),
+                         "n_passes": g["seg_n"],
                          **{c: sums["seg"][c] for c in pv_cols + h_cols},
                          "seconds": seconds["seg"]})
 
-    present = np.flatnonzero(np.bincount(hour, minlength=24) > 0)
+    present = np.flatnonzero(g["hour_n"] > 0)
     hourly = pd.DataFrame({"hour": present.astype(np.int8),
                            **{c: sums["hour"][c][present] for c in h_cols},
                            "seconds": seconds["hour"][present]})
     return trip, segm, hourly
+
+
+def _fused_sums(ctx: RunContext, tile: str, passes: pd.DataFrame, geometry: pd.DataFrame,
+                timings: dict):
+    """The partition's irradiation summed by the fused kernel (:mod:`vipvflow.passkernel`)
+    into (segment, local hour) and (trip, date) bins, without per-pass outputs; None where
+    the kernel cannot run (geometry not in the scene's frame).  Adds its stages to
+    *timings* (``irradiance_*`` like :func:`vipvflow.irradiance.evaluate_passes`; the pass
+    grouping to ``reduce_s``)."""
+    from .. import passkernel
+
+    t0 = time.perf_counter()
+    scene = _scene(ctx, tile)
+    geo = _packed_geometry(ctx, tile, geometry, scene)
+    if not passkernel.usable(geo, scene):
+        return None
+    radiation = _radiation(ctx.data_dir, ctx.year)
+    ids = geometry["segment_id"].to_numpy(np.int64)
+    pos = np.full(int(ids.max()) + 1 if len(ids) else 1, -1, np.int64)
+    pos[ids] = np.arange(len(ids))
+    seg = np.ascontiguousarray(passes["segment_id"].to_numpy(np.int64))
+    if seg.max() >= len(pos) or seg.min() < 0 or (pos[seg] < 0).any():
+        raise KeyError("passes reference segments missing from the geometry")
+    loc = geometry["rad_location"].to_numpy(np.int64) if "rad_location" in geometry else None
+    t1 = time.perf_counter()
+    groups = partition_groups(passes, ctx)
+    seg_hour = groups["seg_hour"]
+    t2 = time.perf_counter()
+    stages: dict = {}
+    seg_bins, run_bins = passkernel.accumulate(
+        seg, np.ascontiguousarray(passes["t_utc"].to_numpy(np.float64)), groups["dt"], True,
+        pos[seg], geo, IrradianceCfg(**ctx.irradiance), radiation, scene, seg_hour,
+        len(groups["seg_ids"]) * 24, groups["run"], len(groups["starts"]), loc, stages)
+    t3 = time.perf_counter()
+    order = [passkernel.BLOCK_COLUMNS.index(c) for c in COMPONENTS]
+    timings["irradiance_s"] = (t1 - t0) + (t3 - t2)
+    timings.update({f"irradiance_{k}": v for k, v in stages.items()})
+    timings["reduce_s"] = t2 - t1
+    return groups, (seg_bins[:, order], run_bins[:, order])
 
 
 def run_partition(ctx: RunContext, tile: str, month: str, geometry: pd.DataFrame | None = None) -> dict:
@@ -314,7 +406,12 @@ def run_partition(ctx: RunContext, tile: str, month: str, geometry: pd.DataFrame
     timings = {"passes_s": time.perf_counter() - t0}
     n = len(passes)
     seg = _segments(ctx.data_dir)
-    if n:
+    fused = None
+    if n and ctx.pv_mode == "paper":
+        fused = _fused_sums(ctx, tile, passes, geometry, timings)
+    if fused is not None:
+        irr = None
+    elif n:
         t1 = time.perf_counter()
         stages: dict = {}
         scene = _scene(ctx, tile)
@@ -328,12 +425,17 @@ def run_partition(ctx: RunContext, tile: str, month: str, geometry: pd.DataFrame
     else:
         irr = pd.DataFrame({c: np.zeros(0, np.float32) for c in COMPONENTS})
     t2 = time.perf_counter()
-    trip, segm, hourly = aggregate_partition(passes, irr, int(month[5:7]), ctx)
+    if fused is not None:
+        groups, bins = fused
+        trip, segm, hourly = aggregate_partition(passes, None, int(month[5:7]), ctx,
+                                                 groups=groups, bins=bins)
+    else:
+        trip, segm, hourly = aggregate_partition(passes, irr, int(month[5:7]), ctx)
     for df in (trip, segm, hourly):
         df["tile"] = tile
     segm["month"] = month
     hourly["month"] = month
-    timings["reduce_s"] = time.perf_counter() - t2
+    timings["reduce_s"] = timings.get("reduce_s", 0.0) + time.perf_counter() - t2
 
     t3 = time.perf_counter()
     write_parquet(hourly, run.part("hourly", tile, month))

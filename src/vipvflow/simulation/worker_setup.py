@@ -6,6 +6,9 @@ them too. They ignore it (the command closes the cluster), instead of each print
 line (a :class:`vipvflow.errors.VipvError`) or with its traceback (a bug): the worker's own
 "Compute Failed ... Traceback" log of the same failure is left out unless the command runs
 with ``-v`` (Dask setting ``vipvflow.worker-failure-log``).
+
+Each worker loads the fused per-pass kernel (:func:`vipvflow.passkernel.warm`: compiled once
+and cached on disk, loaded here) before its first task, so no task pays for the compilation.
 """
 from __future__ import annotations
 
@@ -31,3 +34,6 @@ def dask_setup(worker) -> None:
             pass
     if not dask.config.get("vipvflow.worker-failure-log", False):
         logging.getLogger("distributed.worker").addFilter(_not_compute_failed)
+    from .. import passkernel
+
+    passkernel.warm()

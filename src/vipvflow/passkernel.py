@@ -1,0 +1,505 @@
+"""The fused per-pass kernel: pass time -> radiation -> rays -> components -> sums.
+
+The same physics as :func:`vipvflow.irradiance.roof_irradiance` (eqs. 1-3 of the paper, the
+street reflectors, the rotating reflector sample point and its Russian roulette), compiled
+with numba into two loops over the passes around the one Embree occlusion query numba cannot
+call:
+
+1. :func:`_setup` looks up the radiation and the sun at each pass's time (linear in time,
+   the :meth:`vipvflow.radiation.RadiationTable.lookup` arithmetic), skips dark passes, and
+   writes the pass's rays (the roof point towards the sun, one per reflector facing it)
+   straight into the ray batch;
+2. Embree answers the batch (:meth:`vipvflow.shading.Scene.occluded_local`);
+3. :func:`_finish_block` sums the components per pass into the output block of
+   :func:`vipvflow.irradiance.evaluate_passes`, or :func:`_finish_bins` adds their
+   irradiation (Wh/m2) straight into the (segment, local hour) and (trip, date) bins of a
+   partition (:func:`vipvflow.simulation.partition.aggregate_partition`).
+
+No per-pass array is made beyond the ray batch, the radiation values of the chunk and the
+pass's place in the batch.  Every float32 operation is the numpy reference's, in the same
+order, so the components are equal to float32 precision (the tests check it); the sums are
+float64, like the reference's ``bincount``.
+
+The kernels compile once per process on first use and are cached on disk
+(``cache=True``: next to this module, or in numba's user cache directory when that is not
+writable); :func:`warm` loads them (the Dask worker preload calls it).
+
+References
+----------
+Paper (Pera et al., see ``CITATION.cff``) sections 3.2.1-3.2.3 (eqs. 1-3) and 3.3 (energy);
+pvlib ``irradiance.get_total_irradiance(model='isotropic')``, ``irradiance.aoi``.
+S. K. Lam, A. Pitrou, S. Seibert (2015), Numba: a LLVM-based Python JIT compiler, LLVM-HPC
+'15.  pvlib uses numba for its solar position algorithm (``pvlib.spa``).
+"""
+from __future__ import annotations
+
+import time
+
+import numpy as np
+from numba import njit
+
+from .irradiance import ROULETTE_WEIGHT
+
+#: components of a pass in the order of the kernel's output block (W/m2)
+BLOCK_COLUMNS = ("direct", "diffuse", "reflected", "total", "direct_clear", "diffuse_clear",
+                 "reflected_clear", "total_clear", "total_unshaded", "total_clear_unshaded",
+                 "ghi", "ghi_clear")
+#: rays in one batch (bounds the batch's memory: 24 bytes a ray)
+RAY_BUDGET = 1 << 21
+#: radiation columns the kernel reads, in this order
+_RAD = ("dni", "dhi", "ghi", "dni_clear", "dhi_clear", "ghi_clear", "sun_x", "sun_y", "sun_z")
+
+_M30, _M27, _M31 = np.uint64(30), np.uint64(27), np.uint64(31)
+_C1, _C2, _C3 = np.uint64(0x9E3779B97F4A7C15), np.uint64(0xBF58476D1CE4E5B9), np.uint64(0x94D049BB133111EB)
+
+
+@njit(cache=True, nogil=True)
+def _sample_key(segment_id, t_utc):
+    """:func:`vipvflow.irradiance.pass_sample_key` of one pass (splitmix64 finaliser)."""
+    x = np.uint64(segment_id) * _C1 + np.uint64(np.int64(np.rint(t_utc * 1000.0)))
+    x = (x ^ (x >> _M30)) * _C2
+    x = (x ^ (x >> _M27)) * _C3
+    x = x ^ (x >> _M31)
+    return np.int64(x >> np.uint64(33))
+
+
+@njit(cache=True, nogil=True)
+def _setup(lo, hi, seg, t_start, dt, mid, row, loc_of_row, packed, cols, t0, step,
+           nrm, wn, p_local, gp_local, rotate, roulette_w,
+           rad, cos_aoi, pass_ray, pair_w, pair_pass, o, d, done):
+    """Radiation lookup and ray batch of passes ``lo..hi`` (see the module docstring).
+
+    Fills, per pass ``i`` (chunk index ``i - lo``): ``rad`` (9 values, NaN as 0, sun
+    components as looked up), ``cos_aoi``, ``pass_ray`` (the pass's first ray in the batch;
+    ``pass_ray[i + 1] - pass_ray[i]`` rays: its direct ray first when the sun is in front of
+    the roof, then per reflector pair one ray, or P with ``rotate`` False), ``done[i]``
+    False for a dark pass (every component 0).  ``pair_w`` / ``pair_pass``: per pair its
+    beam weight and pass (chunk index).  Returns (rays, pairs).
+    """
+    n_t = packed.shape[1]
+    J = wn.shape[1]
+    P = gp_local.shape[1]
+    nr = 0
+    npair = 0
+    for i in range(lo, hi):
+        c = i - lo
+        pass_ray[c] = nr
+        cos_aoi[c] = np.float32(0.0)
+        done[c] = False
+        t = t_start[i] + 0.5 * dt[i] if mid else t_start[i]
+        f = (t - t0) / step
+        if not (f >= 0.0 and f <= n_t - 1):
+            continue              # outside the radiation grid (or NaN): every value 0
+        ii = min(np.int64(f), n_t - 2) if n_t > 1 else np.int64(0)
+        w = np.float32(f - ii)
+        r = row[i]
+        li = loc_of_row[r]
+        dark = True
+        for q in range(9):
+            a = packed[li, ii, cols[q]]
+            b = packed[li, ii + 1, cols[q]] if n_t > 1 else a
+            v = a + w * (b - a)
+            if q < 6:
+                if np.isnan(v):
+                    v = np.float32(0.0)
+                if v != 0:
+                    dark = False
+            rad[c, q] = v
+        if dark:
+            continue
+        done[c] = True
+        sx, sy, sz = rad[c, 6], rad[c, 7], rad[c, 8]
+        if not (sz > 0 and (rad[c, 0] > 0 or rad[c, 3] > 0)):
+            continue
+        ca = nrm[r, 0] * sx + nrm[r, 1] * sy + nrm[r, 2] * sz
+        ca = max(ca, np.float32(0.0))
+        cos_aoi[c] = ca
+        if ca > 0:
+            o[nr, 0], o[nr, 1], o[nr, 2] = p_local[r, 0], p_local[r, 1], p_local[r, 2]
+            d[nr, 0], d[nr, 1], d[nr, 2] = sx, sy, sz
+            nr += 1
+        if J == 0:
+            continue
+        key = _sample_key(seg[i], t_start[i]) if rotate else np.int64(0)
+        for g in range(J):
+            wc = wn[r, g, 0] * sx + wn[r, g, 1] * sy + wn[r, g, 2] * sz
+            if not wc > 0:
+                continue
+            beam = wc
+            if rotate and wc < roulette_w:
+                k = (key >> 4) * 0x2545F491 + np.int64(g) * 0x9E3779B1
+                u = np.float32((k ^ (k >> 29)) & 0xFFFFFF) * np.float32(1.0 / (1 << 24))
+                if not u * roulette_w < wc:
+                    continue
+                beam = max(wc, roulette_w)
+            pair_w[npair] = beam
+            pair_pass[npair] = c
+            npair += 1
+            base = (r * J + g)
+            if rotate:
+                k = (key + g) % P
+                for j in range(3):
+                    o[nr, j] = gp_local[base, k, j]
+                d[nr, 0], d[nr, 1], d[nr, 2] = sx, sy, sz
+                nr += 1
+            else:
+                for k in range(P):
+                    for j in range(3):
+                        o[nr, j] = gp_local[base, k, j]
+                    d[nr, 0], d[nr, 1], d[nr, 2] = sx, sy, sz
+                    nr += 1
+    pass_ray[hi - lo] = nr
+    return nr, npair
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _components(c, r, rad, cos_aoi, visible, beam_sum, sky, iso, refl_sky, refl_ghi, out):
+    """The 12 :data:`BLOCK_COLUMNS` of one pass into *out* (float32, as
+    :func:`vipvflow.irradiance.roof_components` sums them)."""
+    ca = cos_aoi[c]
+    vis = np.float32(1.0) if visible else np.float32(0.0)
+    for s in range(2):
+        b, dh, gh = rad[c, 3 * s], rad[c, 3 * s + 1], rad[c, 3 * s + 2]
+        beam = b * ca
+        direct = beam * vis
+        diffuse = dh * sky[r]
+        reflected = b * beam_sum + dh * refl_sky[r] + gh * refl_ghi[r]
+        out[4 * s] = direct
+        out[4 * s + 1] = diffuse
+        out[4 * s + 2] = reflected
+        out[4 * s + 3] = direct + diffuse + reflected
+        out[8 + s] = beam + dh * iso[r]
+    out[10] = rad[c, 2]
+    out[11] = rad[c, 5]
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _visibility(c, pass_ray, pair_w, pair_pass, q, occ, cos_aoi, rotate, P):
+    """Whether the pass's sun ray is free, its reflectors' beam sum ``sum weight x lit``
+    (float64 like the reference's bincount, then float32), and the next pair."""
+    r0, r1 = pass_ray[c], pass_ray[c + 1]
+    visible = False
+    if cos_aoi[c] > 0:
+        visible = not occ[r0]
+        r0 += 1
+    acc = 0.0
+    while r0 < r1:
+        if rotate:
+            acc += np.float64(pair_w[q] * (np.float32(0.0) if occ[r0] else np.float32(1.0)))
+            r0 += 1
+        else:
+            cnt = 0
+            for k in range(P):
+                cnt += occ[r0 + k]
+            share = np.float64(np.int32(P - cnt)) * np.float64(np.float32(1.0 / P))
+            acc += np.float64(pair_w[q]) * share
+            r0 += P
+        q += 1
+    return visible, np.float32(acc), q
+
+
+@njit(cache=True, nogil=True)
+def _finish_block(lo, hi, row, rad, cos_aoi, pass_ray, pair_w, pair_pass, occ, done,
+                  sky, iso, refl_sky, refl_ghi, rotate, P, block, visible_out):
+    """Components of passes ``lo..hi`` into columns of *block* (12, n) and *visible_out*."""
+    out = np.empty(12, np.float32)
+    q = 0
+    for i in range(lo, hi):
+        c = i - lo
+        if not done[c]:
+            continue
+        visible, beam_sum, q = _visibility(c, pass_ray, pair_w, pair_pass, q, occ, cos_aoi,
+                                           rotate, P)
+        r = row[i]
+        _components(c, r, rad, cos_aoi, visible, beam_sum, sky, iso, refl_sky, refl_ghi, out)
+        for j in range(12):
+            block[j, i] = out[j]
+        visible_out[i] = visible
+
+
+@njit(cache=True, nogil=True)
+def _finish_bins(lo, hi, row, rad, cos_aoi, pass_ray, pair_w, pair_pass, occ, done,
+                 sky, iso, refl_sky, refl_ghi, rotate, P, dt, seg_hour, run, seg_bins, run_bins):
+    """Irradiation (Wh/m2) of passes ``lo..hi`` added into ``seg_bins[seg_hour[i]]`` and
+    ``run_bins[run[i]]`` ((bins, 12) float64, :data:`BLOCK_COLUMNS`)."""
+    out = np.empty(12, np.float32)
+    q = 0
+    for i in range(lo, hi):
+        c = i - lo
+        if not done[c]:
+            continue
+        visible, beam_sum, q = _visibility(c, pass_ray, pair_w, pair_pass, q, occ, cos_aoi,
+                                           rotate, P)
+        _components(c, row[i], rad, cos_aoi, visible, beam_sum, sky, iso, refl_sky, refl_ghi, out)
+        w = dt[i] / 3600.0
+        b, k = seg_hour[i], run[i]
+        for j in range(12):
+            h = np.float64(out[j]) * w
+            seg_bins[b, j] += h
+            run_bins[k, j] += h
+
+
+@njit(cache=True, nogil=True)
+def _groups(trip_code, day, seg, t_utc, dt, seg_lo, seg_pos_of, hour_lo, offset_s,
+            run, seg_pos, seg_hour, hour):
+    """Each pass's run (a new one where trip or service day changes), segment position,
+    local clock hour (UTC offset per UTC hour from *hour_lo*) and (segment, hour) bin;
+    returns the number of runs."""
+    n_runs = 0
+    for i in range(len(seg)):
+        if i == 0 or trip_code[i] != trip_code[i - 1] or day[i] != day[i - 1]:
+            n_runs += 1
+        run[i] = n_runs - 1
+        p = seg_pos_of[seg[i] - seg_lo]
+        seg_pos[i] = p
+        t = t_utc[i]
+        h = np.int64(np.floor((t + offset_s[np.int64(np.floor(t / 3600.0)) - hour_lo]) / 3600.0)) % 24
+        hour[i] = h
+        seg_hour[i] = p * 24 + h
+    return n_runs
+
+
+@njit(cache=True, nogil=True)
+def _seconds(run, seg_pos, hour, dt, by_run, by_seg, by_hour, n_by_seg, n_by_hour):
+    """Time (s) per run, segment and hour, and passes per segment and hour, in pass order."""
+    for i in range(len(run)):
+        by_run[run[i]] += dt[i]
+        by_seg[seg_pos[i]] += dt[i]
+        by_hour[hour[i]] += dt[i]
+        n_by_seg[seg_pos[i]] += 1
+        n_by_hour[hour[i]] += 1
+
+
+def pass_groups(trip_code, day, seg, t_utc, dt, timezone: str) -> dict:
+    """The (trip, date) run, segment and local hour of every pass, in one compiled loop.
+
+    Parameters
+    ----------
+    trip_code : (n,) int64, trip of each pass (codes)
+    day : (n,) int64, service date (days since 1970)
+    seg : (n,) int64, segment id
+    t_utc : (n,) float64, Unix s
+    dt : (n,) float64, s on the segment
+    timezone : str, IANA name of the local clock
+
+    Returns
+    -------
+    dict of arrays: ``run``, ``seg_pos`` (position among the sorted distinct ``seg_ids``),
+    ``hour`` (local, 0..23), ``seg_hour`` (``seg_pos x 24 + hour``), ``starts`` (first pass
+    of each run), ``seg_ids``; and per run, segment and hour the seconds ``run_s, seg_s,
+    hour_s`` and the pass counts ``seg_n, hour_n``.
+    """
+    import pandas as pd
+
+    trip_code, day, seg, t_utc, dt = (_writable(a) for a in (trip_code, day, seg, t_utc, dt))
+    n = len(seg)
+    lo, hi = (int(seg.min()), int(seg.max())) if n else (0, 0)
+    if hi - lo > 8 * n + 1024:          # sparse ids: positions by sorting
+        seg_ids, seg = np.unique(seg, return_inverse=True)
+        seg, lo, seg_pos_of = _writable(seg.astype(np.int64)), 0, np.arange(len(seg_ids))
+    else:
+        present = np.zeros(hi - lo + 1, bool)
+        present[seg - lo] = True
+        seg_pos_of = np.cumsum(present) - 1
+        seg_ids = np.flatnonzero(present) + lo if n else seg[:0]
+    h_lo = int(np.floor(t_utc.min() / 3600.0)) if n else 0
+    h_hi = int(np.floor(t_utc.max() / 3600.0)) if n else 0
+    span = pd.DatetimeIndex(pd.to_datetime(np.arange(h_lo, h_hi + 1) * 3600, unit="s", utc=True))
+    local = span.tz_convert(timezone).tz_localize(None)
+    offset = ((local - span.tz_localize(None)) / pd.Timedelta(seconds=1)).to_numpy(np.float64)
+    out = {k: np.empty(n, np.int64) for k in ("run", "seg_pos", "seg_hour", "hour")}
+    n_runs = _groups(trip_code, day, seg, t_utc, dt, lo, seg_pos_of, h_lo, _writable(offset),
+                     out["run"], out["seg_pos"], out["seg_hour"], out["hour"])
+    new_run = np.empty(n, bool)
+    if n:
+        new_run[0] = True
+        np.not_equal(out["run"][1:], out["run"][:-1], out=new_run[1:])
+    out.update(starts=np.flatnonzero(new_run), seg_ids=seg_ids, run_s=np.zeros(n_runs),
+               seg_s=np.zeros(len(seg_ids)), hour_s=np.zeros(24),
+               seg_n=np.zeros(len(seg_ids), np.int64), hour_n=np.zeros(24, np.int64))
+    _seconds(out["run"], out["seg_pos"], out["hour"], dt, out["run_s"], out["seg_s"],
+             out["hour_s"], out["seg_n"], out["hour_n"])
+    return out
+
+
+class _Batch:
+    """The work arrays of the kernel, sized for one chunk of passes (uninitialised: the
+    setup loop writes every element the finishing loop reads)."""
+
+    def __init__(self, chunk: int, rays_per_pass: int, pairs_per_pass: int):
+        f32 = np.float32
+        self.rad = np.empty((chunk, 9), f32)
+        self.cos_aoi = np.empty(chunk, f32)
+        self.pass_ray = np.empty(chunk + 1, np.int64)
+        self.done = np.empty(chunk, np.bool_)
+        self.pair_w = np.empty(chunk * pairs_per_pass, f32)
+        self.pair_pass = np.empty(chunk * pairs_per_pass, np.int64)
+        self.o = np.empty((chunk * rays_per_pass, 3), f32)
+        self.d = np.empty((chunk * rays_per_pass, 3), f32)
+
+
+def _plan(geo: dict, cfg):
+    """Reflectors J, sample points P, rotate, rays and pairs per pass at most, chunk size."""
+    J = geo["wn"].shape[1] if (cfg.reflection and cfg.max_reflector_groups) else 0
+    P = geo["group_p_local"].shape[1]
+    rotate = cfg.reflector_sampling == "rotate" and P > 1
+    per_pass = 1 + J * (1 if rotate else P)
+    chunk = max(1024, RAY_BUDGET // per_pass)
+    return J, P, rotate, per_pass, chunk
+
+
+def usable(geo: dict, scene) -> bool:
+    """Whether the fused kernel can run: origins packed in *scene*'s float32 frame."""
+    from .irradiance import _local_frame
+
+    return "group_p_local" in geo and _local_frame(geo, scene)
+
+
+def _writable(a: np.ndarray) -> np.ndarray:
+    """*a* C-contiguous and writable (a copy only where it is not): numba compiles one
+    version per array flavour, and :func:`warm` loads the writable one."""
+    a = np.ascontiguousarray(a)
+    return a if a.flags.writeable else a.copy()
+
+
+def _inputs(geo: dict, cfg, radiation_table, rows_of_segment_loc):
+    f32 = np.float32
+    names, packed = radiation_table._packed()
+    cols = np.array([names.index(c) for c in _RAD], np.int64)
+    n_seg = len(geo["n"])
+    nrm = geo["n"]
+    iso = ((f32(1) + nrm[:, 2]) * f32(0.5)).astype(f32)
+    sky = geo["svf"] if cfg.diffuse_model == "sky_view_factor" else iso
+    J = geo["wn"].shape[1] if (cfg.reflection and cfg.max_reflector_groups) else 0
+    zero = np.zeros(n_seg, f32)
+    r_sky, r_ghi = (geo["refl_sky"], geo["refl_ghi"]) if J else (zero, zero)
+    wn = geo["wn"] if J else np.zeros((n_seg, 0, 3), f32)
+    loc = (np.zeros(n_seg, np.int64) if rows_of_segment_loc is None
+           else np.asarray(rows_of_segment_loc, np.int64))
+    x = dict(packed=packed, cols=cols, nrm=nrm, wn=wn.astype(f32, copy=False), p_local=geo["p_local"],
+             gp_local=geo["group_p_local"].astype(f32, copy=False), sky=sky.astype(f32, copy=False),
+             iso=iso, refl_sky=r_sky.astype(f32, copy=False), refl_ghi=r_ghi.astype(f32, copy=False),
+             loc=loc)
+    x = {k: _writable(v) for k, v in x.items()}
+    x.update(t0=float(radiation_table.t0), step=float(radiation_table.step_s))
+    return x
+
+
+def _run(seg, t_start, dt, mid, row, geo, cfg, radiation_table, scene, loc_of_row, clock,
+         finish):
+    """Chunks of passes through setup -> Embree -> *finish(lo, hi, batch, occ, P, rotate)*."""
+    x = _inputs(geo, cfg, radiation_table, loc_of_row)
+    J, P, rotate, per_pass, chunk = _plan(geo, cfg)
+    n = len(row)
+    chunk = min(chunk, max(n, 1))
+    bt = _Batch(chunk, per_pass, max(J, 1))
+    rw = np.float32(ROULETTE_WEIGHT)
+    for lo in range(0, n, chunk):
+        hi = min(n, lo + chunk)
+        t_a = time.perf_counter()
+        nr, _ = _setup(lo, hi, seg, t_start, dt, mid, row, x["loc"], x["packed"], x["cols"],
+                       x["t0"], x["step"], x["nrm"], x["wn"], x["p_local"], x["gp_local"],
+                       rotate, rw, bt.rad, bt.cos_aoi, bt.pass_ray, bt.pair_w, bt.pair_pass,
+                       bt.o, bt.d, bt.done)
+        t_b = time.perf_counter()
+        occ = (scene.occluded_local(bt.o[:nr], bt.d[:nr], cfg.ray_length_m) if nr
+               else np.zeros(0, bool))
+        t_c = time.perf_counter()
+        finish(lo, hi, x, bt, occ, P, rotate)
+        t_d = time.perf_counter()
+        clock["ray_setup_s"] = clock.get("ray_setup_s", 0.0) + t_b - t_a
+        clock["rays_s"] = clock.get("rays_s", 0.0) + t_c - t_b
+        clock["components_s"] = clock.get("components_s", 0.0) + t_d - t_c
+
+
+def evaluate_block(seg, t_start, dt, mid, row, geo, cfg, radiation_table, scene,
+                   loc_of_row=None, timings: dict | None = None):
+    """Per-pass components of the fused kernel (:func:`vipvflow.irradiance.evaluate_passes`).
+
+    Parameters
+    ----------
+    seg : (n,) int64, segment id of each pass (the reflector sample key)
+    t_start : (n,) float64, Unix s at the segment start
+    dt : (n,) float64, s on the segment (used when *mid*: radiation at ``t_start + dt / 2``)
+    mid : bool
+    row : (n,) int64, row of each pass's segment in the packed geometry *geo*
+    geo : dict from :func:`vipvflow.irradiance.pack_geometry` with a scene (local frame)
+    cfg : IrradianceCfg
+    radiation_table : vipvflow.radiation.RadiationTable
+    scene : vipvflow.shading.Scene
+    loc_of_row : (segments,) int64, optional, radiation location of each geometry row
+    timings : dict, optional, seconds added to ``ray_setup_s`` (includes the radiation
+        lookup), ``rays_s`` and ``components_s``
+
+    Returns
+    -------
+    block : (n, 12) float32, W/m2, columns :data:`BLOCK_COLUMNS`
+    visible : (n,) bool, the sun ray from the roof point was free
+    """
+    seg, t_start, dt, row = (_writable(a) for a in (seg, t_start, dt, row))
+    n = len(row)
+    block = np.zeros((len(BLOCK_COLUMNS), n), np.float32)      # one row per column
+    visible = np.zeros(n, bool)
+
+    def finish(lo, hi, x, bt, occ, P, rotate):
+        _finish_block(lo, hi, row, bt.rad, bt.cos_aoi, bt.pass_ray, bt.pair_w, bt.pair_pass,
+                      occ, bt.done, x["sky"], x["iso"], x["refl_sky"], x["refl_ghi"],
+                      rotate, P, block, visible)
+
+    _run(seg, t_start, dt, mid, row, geo, cfg, radiation_table, scene, loc_of_row,
+         {} if timings is None else timings, finish)
+    return block.T, visible
+
+
+def accumulate(seg, t_start, dt, mid, row, geo, cfg, radiation_table, scene, seg_hour, n_seg_hour,
+               run, n_runs, loc_of_row=None, timings: dict | None = None):
+    """Irradiation of every pass summed into bins, without per-pass outputs.
+
+    Parameters
+    ----------
+    seg, t_start, dt, mid, row, geo, cfg, radiation_table, scene, loc_of_row, timings :
+        as in :func:`evaluate_block`
+    seg_hour : (n,) int64, bin of each pass (segment x 24 + local hour), < *n_seg_hour*
+    run : (n,) int64, (trip, service date) run of each pass, < *n_runs*
+
+    Returns
+    -------
+    seg_bins : (n_seg_hour, 12) float64, Wh/m2 per (segment, local hour), :data:`BLOCK_COLUMNS`
+    run_bins : (n_runs, 12) float64, Wh/m2 per run
+    """
+    seg, t_start, dt, row, seg_hour, run = (_writable(a) for a in (seg, t_start, dt, row, seg_hour, run))
+    seg_bins = np.zeros((n_seg_hour, len(BLOCK_COLUMNS)))
+    run_bins = np.zeros((n_runs, len(BLOCK_COLUMNS)))
+
+    def finish(lo, hi, x, bt, occ, P, rotate):
+        _finish_bins(lo, hi, row, bt.rad, bt.cos_aoi, bt.pass_ray, bt.pair_w, bt.pair_pass,
+                     occ, bt.done, x["sky"], x["iso"], x["refl_sky"], x["refl_ghi"],
+                     rotate, P, dt, seg_hour, run, seg_bins, run_bins)
+
+    _run(seg, t_start, dt, mid, row, geo, cfg, radiation_table, scene, loc_of_row,
+         {} if timings is None else timings, finish)
+    return seg_bins, run_bins
+
+
+def warm() -> float:
+    """Compile (or load from the on-disk cache) the kernels for the types a run passes;
+    returns the seconds it took."""
+    t = time.perf_counter()
+    f32, i64 = np.float32, np.int64
+    one_i, one_f, one_t = np.zeros(1, i64), np.zeros(1, f32), np.zeros(1)
+    rad, pr = np.zeros((1, 9), f32), np.zeros(2, i64)
+    o3 = np.zeros((1, 3), f32)
+    packed = np.zeros((1, 2, 9), f32)
+    for rotate in (True, False):
+        _setup(0, 1, one_i, one_t, one_t, True, one_i, one_i, packed, np.arange(9, dtype=i64),
+               0.0, 60.0, o3, np.zeros((1, 1, 3), f32), o3, np.zeros((1, 1, 3), f32), rotate,
+               f32(0.02), rad, one_f, pr, one_f, one_i, o3, o3, np.zeros(1, np.bool_))
+        _finish_block(0, 1, one_i, rad, one_f, pr, one_f, one_i, np.zeros(1, bool),
+                      np.zeros(1, np.bool_), one_f, one_f, one_f, one_f, rotate, 1,
+                      np.zeros((12, 1), f32), np.zeros(1, bool))
+        _finish_bins(0, 1, one_i, rad, one_f, pr, one_f, one_i, np.zeros(1, bool),
+                     np.zeros(1, np.bool_), one_f, one_f, one_f, one_f, rotate, 1, one_t,
+                     one_i, one_i, np.zeros((1, 12)), np.zeros((1, 12)))
+    _groups(one_i, one_i, one_i, one_t, one_t, 0, one_i, 0, one_t, one_i, one_i, one_i, one_i)
+    _seconds(one_i, one_i, one_i, one_t, one_t, one_t, one_t, one_i, one_i)
+    return time.perf_counter() - t

@@ -1,0 +1,170 @@
+"""The fused per-pass kernel (numba) against the numpy reference of the same physics."""
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from vipvflow import passkernel
+from vipvflow.config import IrradianceCfg
+from vipvflow.irradiance import COMPONENTS, evaluate_passes, pack_geometry, segment_geometry
+from vipvflow.radiation import COLUMNS, RadiationTable
+from vipvflow.shading import Scene, box_mesh
+
+LAT, LON, ALT = 49.61, 6.13, 300.0
+
+
+def _assert_same(ref: pd.DataFrame, new: pd.DataFrame):
+    """Equal to float32 precision (W/m2), the sun visibility exactly."""
+    assert list(ref.columns) == list(new.columns)
+    for c in ref.columns:
+        a, b = ref[c].to_numpy(), new[c].to_numpy()
+        if a.dtype == bool:
+            assert (a == b).all(), c
+        else:
+            np.testing.assert_allclose(b, a, rtol=2e-7, atol=1e-4, err_msg=c)
+
+
+def _clear_day_table(day: str):
+    """pvlib's Ineichen clear sky at Luxembourg on a minute grid around *day*, the all-sky
+    DNI at 70 % of the clear sky's."""
+    import pvlib
+
+    t = pd.date_range(pd.Timestamp(day, tz="UTC") - pd.Timedelta("1D"), periods=3 * 1440,
+                      freq="1min") + pd.Timedelta("30s")
+    loc = pvlib.location.Location(LAT, LON, altitude=ALT)
+    cs = loc.get_clearsky(t, model="ineichen")
+    sp = loc.get_solarposition(t)
+    cos_z = np.maximum(np.cos(np.radians(sp["apparent_zenith"].to_numpy())), 0)
+    vals = {"ghi_clear": cs["ghi"], "dni_clear": cs["dni"], "dhi_clear": cs["dhi"],
+            "dni": 0.7 * cs["dni"], "dhi": 1.2 * cs["dhi"], "azimuth": sp["azimuth"]}
+    vals["ghi"] = vals["dni"] * cos_z + vals["dhi"]
+    grid = ((t - pd.Timestamp(0, tz="UTC")) / pd.Timedelta(seconds=1)).to_numpy(float)
+    return RadiationTable.from_grid(grid, {c: np.asarray(vals[c], float) for c in COLUMNS}, LAT, LON, ALT)
+
+
+def _canyon_scene(H=16.0, W=18.0, L=400.0):
+    """A street canyon along y (facades of two blocks) over a road in the mesh, and a
+    tower at its end."""
+    from vipvflow.mesh import SURFACE_CODE, TileMesh
+
+    walls = box_mesh([[-W / 2 - 20, -L, 0, -W / 2, L, H], [W / 2, -L, 0, W / 2 + 20, L, H],
+                      [-30, L + 10, 0, 30, L + 40, 60]], albedo_wall=0.35)
+    g = 2 * L
+    road = np.array([[[-g, -g, 0], [g, -g, 0], [g, g, 0]], [[-g, -g, 0], [g, g, 0], [-g, g, 0]]])
+    mesh = TileMesh.from_triangles(np.concatenate([walls.vertices[walls.triangles], road]),
+                                   albedo=np.r_[walls.albedo, [0.15] * 2])
+    mesh.surface_type[:] = np.r_[walls.surface_type, [SURFACE_CODE["ground"]] * 2]
+    return Scene(mesh)
+
+
+@pytest.mark.parametrize("sampling, diffuse", [("rotate", "sky_view_factor"), ("all", "isotropic")])
+def test_fused_equals_numpy_on_a_canyon_with_layovers(sampling, diffuse):
+    """Driving passes (climbing and descending segments along the canyon) and a layover's
+    minutes (a standing point, :mod:`vipvflow.simulation.standing`) over a clear June day:
+    every component of the fused kernel equals the numpy reference's."""
+    table = _clear_day_table("2024-06-10")
+    scene = _canyon_scene()
+    cfg = IrradianceCfg(reflector_sampling=sampling, diffuse_model=diffuse, reflector_points=4,
+                        reflection_rays=256, svf_rays=256)
+    n_seg = 12
+    segs = pd.DataFrame({"segment_id": np.arange(n_seg) + 100,
+                         "x": np.linspace(-6.0, 6.0, n_seg), "y": np.linspace(-300.0, 300.0, n_seg),
+                         "z": np.full(n_seg, 3.2),
+                         "heading_deg": np.where(np.arange(n_seg) % 2, 0.0, 180.0),
+                         "gradient": np.linspace(-0.06, 0.06, n_seg)})
+    # the layover: a flat roof standing in the canyon (segment id = point id)
+    segs.loc[n_seg] = [7, 2.0, 350.0, 3.2, 0.0, 0.0]
+    segs["segment_id"] = segs["segment_id"].astype(np.int64)
+    geometry = segment_geometry(scene, segs, cfg)
+    rng = np.random.default_rng(5)
+    day0 = pd.Timestamp("2024-06-10", tz="UTC").timestamp()
+    drive = pd.DataFrame({"segment_id": rng.choice(segs["segment_id"].to_numpy()[:n_seg], 20_000),
+                          "t_utc": day0 + rng.uniform(0, 86400, 20_000),
+                          "dt_s": rng.uniform(1, 8, 20_000).astype(np.float32)})
+    minutes = np.arange(day0, day0 + 86400, 60.0)
+    layover = pd.DataFrame({"segment_id": np.full(len(minutes), 7, np.int64), "t_utc": minutes,
+                            "dt_s": np.full(len(minutes), 60.0, np.float32)})
+    geo = pack_geometry(geometry, cfg, 0.2, scene)
+    assert passkernel.usable(geo, scene)
+    for passes in (drive, layover):
+        ref = evaluate_passes(passes, None, geometry, table, scene, cfg, packed=geo, kernel="numpy")
+        new = evaluate_passes(passes, None, geometry, table, scene, cfg, packed=geo)
+        _assert_same(ref, new)
+        lit = ref["direct_clear"] > 0
+        # the case has it all: sun and shade, light reflected onto the roof, night
+        assert lit.any() and (~ref["sun_visible"] & (ref["diffuse"] > 0)).any()
+        assert (ref["reflected"] > 0).any() and (ref["total"] == 0).any()
+
+
+def test_fused_equals_numpy_on_the_demo_passes(small_run, small_config):
+    """The small demo's passes of June, tile by tile: the fused kernel's components equal
+    the numpy reference's, and so do the partition sums it accumulates without per-pass
+    outputs (trip, segment and hourly tables of :func:`aggregate_partition`)."""
+    from vipvflow.config import load_config
+    from vipvflow.simulation import partition as part
+    from vipvflow.trajectory import iter_passes
+
+    cfg = load_config(small_config)
+    data_dir = str(cfg.data_dir)
+    irr_cfg = IrradianceCfg(**cfg.irradiance.model_dump())
+    ctx = part.RunContext(data_dir=data_dir, run_dir=str(small_run), year=2024,
+                          irradiance=irr_cfg.model_dump(), pv_system=cfg.pv_system().model_dump(),
+                          pv_mode="paper", monthly_temperature_c=(15.0,) * 12, wind_speed_mps=2.0,
+                          timezone="Europe/Luxembourg")
+    table = part._radiation(data_dir, 2024)
+    tiles = sorted(p.name[5:-8] for p in (small_run / "parts" / "geometry").glob("tile=*.parquet"))
+    assert tiles
+    n_passes = 0
+    for tile in tiles:
+        passes = iter_passes(data_dir, tile, "2024-06", 2024)
+        if not len(passes):
+            continue
+        n_passes += len(passes)
+        geometry = pd.read_parquet(small_run / "parts" / "geometry" / f"tile={tile}.parquet")
+        scene = part._scene(ctx, tile)
+        geo = part._packed_geometry(ctx, tile, geometry, scene)
+        ref = evaluate_passes(passes, None, geometry, table, scene, irr_cfg, packed=geo, kernel="numpy")
+        _assert_same(ref, evaluate_passes(passes, None, geometry, table, scene, irr_cfg, packed=geo))
+        want = part.aggregate_partition(passes, ref, 6, ctx)
+        groups, bins = part._fused_sums(ctx, tile, passes, geometry, {})
+        got = part.aggregate_partition(passes, None, 6, ctx, groups=groups, bins=bins)
+        for a, b in zip(want, got):
+            assert list(a.columns) == list(b.columns) and len(a) == len(b)
+            for c in a.columns:
+                if a[c].dtype.kind == "f":
+                    np.testing.assert_allclose(b[c], a[c], rtol=1e-9, atol=1e-12, err_msg=c)
+                else:
+                    assert (a[c].to_numpy() == b[c].to_numpy()).all(), c
+    assert n_passes > 1000
+
+
+def test_block_columns_are_the_components():
+    assert passkernel.BLOCK_COLUMNS == tuple(COMPONENTS) + ("ghi", "ghi_clear")
+
+
+@pytest.mark.parametrize("spread", [1, 10**9])
+def test_pass_groups_equal_the_numpy_reference(spread):
+    """Runs, segment positions and local hours of passes across the spring clock change
+    (2024-03-31 01:00 UTC in Luxembourg), compact and sparse segment ids."""
+    from vipvflow.simulation.partition import _dense_positions, _local_hours
+
+    rng = np.random.default_rng(1)
+    n = 50_000
+    t = np.sort(pd.Timestamp("2024-03-30 20:00", tz="UTC").timestamp() + rng.uniform(0, 12 * 3600, n))
+    trip = np.repeat(np.arange(n // 50), 50)
+    day = np.repeat(np.arange(n // 100), 100) + 19_800
+    seg = rng.integers(0, 300, n) * spread + 5
+    dt = rng.uniform(1, 9, n)
+    g = passkernel.pass_groups(trip, day, seg, t, dt, "Europe/Luxembourg")
+    hour = _local_hours(t, "Europe/Luxembourg")
+    # UTC+1 until 01:00 UTC, then UTC+2: local 21:00 .. 01:59, then from 03:00 (no 02:00)
+    assert (g["hour"] == hour).all() and set(hour[t < 1711846800]) == {21, 22, 23, 0, 1}
+    assert set(hour[t >= 1711846800]) == set(range(3, 10))
+    ids, pos = _dense_positions(seg)
+    assert (g["seg_ids"] == ids).all() and (g["seg_pos"] == pos).all()
+    assert (g["seg_hour"] == pos * 24 + hour).all()
+    assert (g["run"] == np.repeat(np.arange(n // 50), 50)).all() and len(g["starts"]) == n // 50
+    np.testing.assert_allclose(g["run_s"], np.bincount(g["run"], dt), rtol=1e-12)
+    np.testing.assert_allclose(g["hour_s"], np.bincount(hour, dt, 24), rtol=1e-12)
+    assert (g["seg_n"] == np.bincount(pos)).all() and g["seg_s"].sum() == pytest.approx(dt.sum())
