@@ -29,7 +29,6 @@ May although it runs on 1 June. Every pass is thus in exactly one (tile, month) 
 """
 from __future__ import annotations
 
-import datetime as dt
 import functools
 import json
 from pathlib import Path
@@ -430,13 +429,6 @@ def passes_for_trip(data_dir, trip_id: str, service_date) -> pd.DataFrame:
     sd = pd.DataFrame({"service_id": trips["service_id"].astype(str).to_numpy(),
                        "date": pd.DatetimeIndex([date]).astype("datetime64[ns]")})
     return _passes(data_dir, trips.astype({"service_id": str}), sd, pat)
-
-
-def date_of(value) -> dt.date:
-    """A service date given as ``YYYYMMDD``, ``YYYY-MM-DD``, date or Timestamp."""
-    if isinstance(value, str) and len(value) == 8 and value.isdigit():
-        return dt.datetime.strptime(value, "%Y%m%d").date()
-    return pd.Timestamp(value).date()
 
 
 # ---------------------------------------------------------------------------------------------
