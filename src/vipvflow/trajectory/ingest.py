@@ -397,28 +397,29 @@ def _trip_times(d, arr, dep, found: Counter):
     return arr, dep, start
 
 
+#: problem lines of the trips dropped or repaired, by finding: those an unusable feed's
+#: error names, then those found in a usable one
+_TRIP_FINDINGS = (
+    ("short", "{} trips have fewer than two stop times; dropped"),
+    ("untimed", "{} trips have too few timed stops; dropped"),
+    ("still", "{} trips arrive at their last stop no later than they leave the first (stop "
+              "times backwards or all equal); dropped"),
+    ("backwards", "{} trips have stop times that decrease along the trip; made non-decreasing"))
+_TRIP_REPAIRS = (
+    ("spread", "{} trips give consecutive stops the same time; those stops were re-timed "
+               "along distance between the stops whose times change"),
+    ("nonmonotone", "{} trips have shape_dist_traveled missing, decreasing or beyond the "
+                    "shape; their stops were projected onto the shape"))
+
+
 def _trip_findings(found: Counter, n_patterns: int, feed_path, problems: list[str]) -> None:
     """The trips dropped or repaired, as problem lines; a feed without any usable trip is
     an :class:`InputError`."""
-    if found["short"]:
-        problems.append(f"{found['short']} trips have fewer than two stop times; dropped")
-    if found["untimed"]:
-        problems.append(f"{found['untimed']} trips have too few timed stops; dropped")
-    if found["still"]:
-        problems.append(f"{found['still']} trips arrive at their last stop no later than they "
-                        "leave the first (stop times backwards or all equal); dropped")
-    if found["backwards"]:
-        problems.append(f"{found['backwards']} trips have stop times that decrease along the "
-                        "trip; made non-decreasing")
+    problems.extend(line.format(found[key]) for key, line in _TRIP_FINDINGS if found[key])
     if not n_patterns:
         raise InputError(f"{feed_path}: no usable trip in the feed ("
                          + "; ".join(problems or ["no trip with two stops on a shape"]) + ")")
-    if found["spread"]:
-        problems.append(f"{found['spread']} trips give consecutive stops the same time; those "
-                        "stops were re-timed along distance between the stops whose times change")
-    if found["nonmonotone"]:
-        problems.append(f"{found['nonmonotone']} trips have shape_dist_traveled missing, "
-                        "decreasing or beyond the shape; their stops were projected onto the shape")
+    problems.extend(line.format(found[key]) for key, line in _TRIP_REPAIRS if found[key])
 
 
 def _segment_timing(pstops: pd.DataFrame, pattern_shape: list, segs: pd.DataFrame,
