@@ -184,17 +184,3 @@ def prepare_polygon(rings: list[np.ndarray], planarity_tolerance_m: float = 0.1,
         tri[flip] = tri[flip][:, [0, 2, 1]]
     return PreparedPolygon(vertices=vertices, ring_sizes=sizes, normal=normal, area=area,
                            triangles=tri[cross != 0], repairs=repairs)
-
-
-def triangle_normals(vertices: np.ndarray, triangles: np.ndarray) -> np.ndarray:
-    """Unit normals (m, 3) of triangles from their winding (zero for degenerate ones)."""
-    p = vertices[triangles]
-    n = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
-    length = np.linalg.norm(n, axis=1, keepdims=True)
-    return np.divide(n, length, out=np.zeros_like(n), where=length > 0)
-
-
-def triangle_areas(vertices: np.ndarray, triangles: np.ndarray) -> np.ndarray:
-    """Areas (m2) of triangles."""
-    p = vertices[triangles]
-    return 0.5 * np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=1)

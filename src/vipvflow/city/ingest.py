@@ -348,62 +348,24 @@ def ingest_city(paths, data_dir, city_cfg: CityCfg | None = None, crs: str | Non
     """
     t0 = time.perf_counter()
     cfg = city_cfg or CityCfg()
-    if isinstance(paths, (str, os.PathLike)):
-        paths = [paths]
-    paths = [Path(p) for p in paths]
-    for path in paths:
-        if not path.exists():
-            raise InputError(f"{path}: file not found")
-    target = horizontal(normalise_crs(crs)) if crs else None
-    if target and not is_projected(target):
-        raise InputError(f"--crs {crs}: tiles need a projected CRS in metres, not {target}")
+    paths, target = _input_paths(paths, crs)
     data_dir = Path(data_dir)
     data_dir.mkdir(parents=True, exist_ok=True)
     remove_stale_ingests(data_dir)
     final_dir = DataDir(data_dir).city.root
     city_dir = staging_dir(final_dir)           # data_dir/.city-ingest-<pid>, swapped in at the end
-    albedo = cfg.albedo.model_dump()
     report = IngestReport(crs_source="--crs" if target else "")
     counts = _Counts()
-    ignored = Counter()
     spool = city_dir / ".spool"
     bar = Progress("CityGML ingest", citygml_bytes(paths), unit="B")
-    read_before = 0
     try:
         spool.mkdir()
         acc = _Accumulator(spool, cfg, chunk_surfaces)
-        for path in paths:
-            with open_sources(path) as sources:
-                for label, opener in sources:
-                    report.files.append(label)
-                    with opener() as fh:
-                        reader = CityGMLReader(fh, label)
-                        src = None
-                        for n_feature, feature in enumerate(reader):
-                            if n_feature % 64 == 0:
-                                bar.advance_to(read_before + file_position(fh))
-                            if src is None and _has_coordinates(feature):
-                                src, target = _resolve_crs(reader, label, feature, target, report,
-                                                           axis_order)
-                            _add_feature(feature, acc, src, target, cfg, albedo, counts)
-                            counts.problems.update(feature.problems)
-                            if feature.kind == "building":
-                                report.buildings += 1
-                                report.building_parts += feature.n_parts
-                                counts.lods[feature.lod_used] += 1
-                            elif feature.kind == "terrain":
-                                report.terrain_features += 1
-                            else:
-                                report.vegetation_features += 1
-                        ignored.update(reader.ignored)
-                        if src is None:
-                            report.file_crs[label] = None
-                        read_before += file_position(fh)
-                        bar.advance_to(read_before, "tiles and meshes next")
-                    log.info("read %s", label)
+        read = _CityRead(acc, cfg, target, report, counts, bar, axis_order)
+        read.files(paths)
         acc.flush()
-        report.crs = target
-        _check_not_empty(report, counts, ignored, final_dir)
+        target = report.crs = read.target
+        _check_not_empty(report, counts, read.ignored, final_dir)
         tiles = {}
         for name in sorted(acc.own_tiles):
             tiles[name] = _write_tile(name, spool, city_dir, cfg, target)
@@ -412,17 +374,7 @@ def ingest_city(paths, data_dir, city_cfg: CityCfg | None = None, crs: str | Non
         write_json({
             "crs": target, "tile_size_m": cfg.tile_size_m, "buffer_m": cfg.buffer_m,
             "tiles": tiles}, CityDir(city_dir).tiles_json, sort_keys=True)
-        report.surfaces = dict(counts.written)
-        report.thematic_surfaces = dict(counts.thematic)
-        report.area_m2 = {k: round(v, 3) for k, v in counts.area.items()}
-        report.skipped = dict(counts.skipped)
-        report.skipped_by_type = dict(counts.skipped_by_type)
-        report.repaired = dict(counts.repaired)
-        report.problems, report.ignored_features = dict(counts.problems), dict(ignored)
-        report.buildings_by_lod = dict(counts.lods)
-        report.tiles = len(tiles)
-        report.triangles = int(sum(t["n_triangles"] for t in tiles.values()))
-        report.terrain_triangles = terrain_tris
+        _sum_up(report, counts, read.ignored, tiles, terrain_tris)
         report.elapsed_s = round(time.perf_counter() - t0, 3)
         report.report_path = str(CityDir(final_dir).report)
         write_json(json.loads(report.to_json()), CityDir(city_dir).report, sort_keys=True)
@@ -434,6 +386,89 @@ def ingest_city(paths, data_dir, city_cfg: CityCfg | None = None, crs: str | Non
         bar.close()
         shutil.rmtree(city_dir, ignore_errors=True)
     return report
+
+
+def _input_paths(paths, crs: str | None) -> tuple[list[Path], str | None]:
+    """(the CityGML files, each of which must exist; the output CRS *crs* when given, which
+    must be projected)."""
+    if isinstance(paths, (str, os.PathLike)):
+        paths = [paths]
+    paths = [Path(p) for p in paths]
+    for path in paths:
+        if not path.exists():
+            raise InputError(f"{path}: file not found")
+    target = horizontal(normalise_crs(crs)) if crs else None
+    if target and not is_projected(target):
+        raise InputError(f"--crs {crs}: tiles need a projected CRS in metres, not {target}")
+    return paths, target
+
+
+class _CityRead:
+    """One pass over the CityGML files: their city objects into the accumulator, counted."""
+
+    def __init__(self, acc: _Accumulator, cfg: CityCfg, target: str | None,
+                 report: IngestReport, counts: _Counts, bar: Progress, axis_order: str):
+        self.acc, self.cfg, self.target, self.axis_order = acc, cfg, target, axis_order
+        self.report, self.counts, self.bar = report, counts, bar
+        self.albedo = cfg.albedo.model_dump()
+        self.ignored = Counter()               # city objects not read, per class
+        self.read_before = 0                   # bytes of the files read before this one
+
+    def files(self, paths: list[Path]) -> None:
+        """Read every file (each GML file of a ``.zip``)."""
+        for path in paths:
+            with open_sources(path) as sources:
+                for label, opener in sources:
+                    self.report.files.append(label)
+                    with opener() as fh:
+                        self._file(fh, label)
+                    log.info("read %s", label)
+
+    def _file(self, fh, label: str) -> None:
+        """Read one file; its CRS is settled on its first feature with coordinates."""
+        reader = CityGMLReader(fh, label)
+        src = None
+        for n_feature, feature in enumerate(reader):
+            if n_feature % 64 == 0:
+                self.bar.advance_to(self.read_before + file_position(fh))
+            if src is None and _has_coordinates(feature):
+                src, self.target = _resolve_crs(reader, label, feature, self.target,
+                                                self.report, self.axis_order)
+            _add_feature(feature, self.acc, src, self.target, self.cfg, self.albedo, self.counts)
+            self._count(feature)
+        self.ignored.update(reader.ignored)
+        if src is None:
+            self.report.file_crs[label] = None
+        self.read_before += file_position(fh)
+        self.bar.advance_to(self.read_before, "tiles and meshes next")
+
+    def _count(self, feature) -> None:
+        """Count a feature by kind (buildings by LoD) and its problems."""
+        self.counts.problems.update(feature.problems)
+        if feature.kind == "building":
+            self.report.buildings += 1
+            self.report.building_parts += feature.n_parts
+            self.counts.lods[feature.lod_used] += 1
+        elif feature.kind == "terrain":
+            self.report.terrain_features += 1
+        else:
+            self.report.vegetation_features += 1
+
+
+def _sum_up(report: IngestReport, counts: _Counts, ignored: Counter, tiles: dict,
+            terrain_triangles: int) -> None:
+    """Put the counts of the ingest and the tiles written into *report*."""
+    report.surfaces = dict(counts.written)
+    report.thematic_surfaces = dict(counts.thematic)
+    report.area_m2 = {k: round(v, 3) for k, v in counts.area.items()}
+    report.skipped = dict(counts.skipped)
+    report.skipped_by_type = dict(counts.skipped_by_type)
+    report.repaired = dict(counts.repaired)
+    report.problems, report.ignored_features = dict(counts.problems), dict(ignored)
+    report.buildings_by_lod = dict(counts.lods)
+    report.tiles = len(tiles)
+    report.triangles = int(sum(t["n_triangles"] for t in tiles.values()))
+    report.terrain_triangles = terrain_triangles
 
 
 @dataclass

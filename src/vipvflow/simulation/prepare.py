@@ -7,7 +7,7 @@ from pathlib import Path
 
 from ..config import Config
 from ..errors import InputError
-from ..store import DataDir, sha256, write_text
+from ..store import DataDir, GtfsDir, sha256, write_text
 
 log = logging.getLogger(__name__)
 
@@ -193,10 +193,7 @@ def preflight(cfg: Config, year: int, say=print) -> dict:
     dict
         ``service_days``, ``radiation_gaps_interpolated``, ``radiation_gap_minutes_interpolated``.
     """
-    import numpy as np
     import pandas as pd
-
-    from ..trajectory.schedule import service_dates, service_day_origin_utc
 
     check_year(year)
     data_dir = Path(cfg.data_dir)
@@ -206,56 +203,96 @@ def preflight(cfg: Config, year: int, say=print) -> dict:
     trips = pd.read_parquet(data.gtfs.trips,
                             columns=["trip_id", "route_id", "shape_id", "service_id", "pattern_id",
                                      "start_s"])
-    routes = cfg.run.routes
-    if routes is not None:
-        unknown = sorted(set(routes) - set(trips["route_id"].astype(str)))
-        if unknown:
-            known = sorted(trips["route_id"].astype(str).unique())
-            raise InputError(f"{cfg._source}: run.routes: route_id(s) not in the feed: "
-                             f"{', '.join(unknown)} (the feed has {', '.join(known[:10])}"
-                             f"{' ...' if len(known) > 10 else ''})")
-        trips = trips[trips["route_id"].astype(str).isin(routes)]
+    trips = _run_trips(cfg, trips)
+    sd = _run_service_dates(data_dir, trips, year, set(cfg.run.months))
+    _check_city_covers(data_dir, trips, say)
+    days, lo, hi = _hours_on_the_road(gdir, trips, sd, feed["timezone"])
+    n_short, short_min = _check_radiation(data_dir, days, lo, hi, cfg.radiation.max_gap_minutes)
+    if n_short:
+        say(f"  radiation: {n_short} gaps ({short_min} min) within the buses' hours were "
+            "interpolated")
+    return {"service_days": int(len(days)), "radiation_gaps_interpolated": n_short,
+            "radiation_gap_minutes_interpolated": int(short_min)}
 
-    # --- calendar
+
+def _run_trips(cfg: Config, trips):
+    """The trips of ``run.routes`` (all when not set); a route not in the feed is an error."""
+    routes = cfg.run.routes
+    if routes is None:
+        return trips
+    unknown = sorted(set(routes) - set(trips["route_id"].astype(str)))
+    if unknown:
+        known = sorted(trips["route_id"].astype(str).unique())
+        raise InputError(f"{cfg._source}: run.routes: route_id(s) not in the feed: "
+                         f"{', '.join(unknown)} (the feed has {', '.join(known[:10])}"
+                         f"{' ...' if len(known) > 10 else ''})")
+    return trips[trips["route_id"].astype(str).isin(routes)]
+
+
+def _run_service_dates(data_dir: Path, trips, year: int, months: set):
+    """The service dates of *trips* in the run's months; none is an error naming the
+    calendar's range."""
+    from ..trajectory.schedule import service_dates
+
+    gdir = DataDir(data_dir).gtfs.root
     sd = service_dates(data_dir, year)
-    months = set(cfg.run.months)
     sd = sd[sd["date"].dt.month.isin(months) & sd["service_id"].isin(set(trips["service_id"]))]
     if sd.empty:
         lo, hi = _calendar_range(gdir)
         which = "" if len(months) == 12 else f" (months {sorted(months)})"
         raise InputError(f"{gdir / 'calendar.parquet'}: the GTFS calendar has no service in "
                          f"{year}{which}; it runs from {lo} to {hi}")
+    return sd
 
-    # --- city
+
+def _check_city_covers(data_dir: Path, trips, say) -> None:
+    """The city model, when ingested, must cover some of the routes' segments (the share
+    outside it is said)."""
+    import pandas as pd
+
+    data = DataDir(data_dir)
     tiles_json = data.city.tiles_json
-    if tiles_json.exists():
-        city = json.loads(tiles_json.read_text())
-        seg = pd.read_parquet(data.gtfs.segments, columns=["tile", "shape_id"])
-        seg = seg[seg["shape_id"].isin(set(trips["shape_id"]))]
-        inside = seg["tile"].isin(set(city.get("tiles", {})))
-        if len(seg) and not inside.any():
-            raise InputError(f"{tiles_json}: the city model ({len(city.get('tiles', {}))} tiles "
-                             f"in {city.get('crs')}) covers none of the routes' {len(seg)} "
-                             f"segments (tiles {', '.join(sorted(seg['tile'].unique())[:3])} ...); "
-                             "is the city the one the feed serves, in the same CRS?")
-        if len(seg) and not inside.all():
-            say(f"  {100 * (1 - inside.mean()):.0f} % of the route segments lie outside the city "
-                "model's tiles (nothing shades them there)")
+    if not tiles_json.exists():
+        return
+    city = json.loads(tiles_json.read_text())
+    seg = pd.read_parquet(data.gtfs.segments, columns=["tile", "shape_id"])
+    seg = seg[seg["shape_id"].isin(set(trips["shape_id"]))]
+    inside = seg["tile"].isin(set(city.get("tiles", {})))
+    if len(seg) and not inside.any():
+        raise InputError(f"{tiles_json}: the city model ({len(city.get('tiles', {}))} tiles "
+                         f"in {city.get('crs')}) covers none of the routes' {len(seg)} "
+                         f"segments (tiles {', '.join(sorted(seg['tile'].unique())[:3])} ...); "
+                         "is the city the one the feed serves, in the same CRS?")
+    if len(seg) and not inside.all():
+        say(f"  {100 * (1 - inside.mean()):.0f} % of the route segments lie outside the city "
+            "model's tiles (nothing shades them there)")
 
-    # --- radiation over every service day's hours on the road
-    pat = pd.read_parquet(data.gtfs.patterns, columns=["pattern_id", "t_offset_s", "dt_s"])
+
+def _hours_on_the_road(gdir: Path, trips, sd, timezone: str):
+    """(service days, their first departure and last arrival in Unix s UTC)."""
+    import pandas as pd
+
+    from ..trajectory.schedule import service_day_origin_utc
+
+    pat = pd.read_parquet(GtfsDir(gdir).patterns, columns=["pattern_id", "t_offset_s", "dt_s"])
     dur = (pat["t_offset_s"] + pat["dt_s"]).groupby(pat["pattern_id"]).max()
     tr = trips.assign(end_s=trips["start_s"] + trips["pattern_id"].map(dur).fillna(0.0))
     span = tr.groupby("service_id").agg(lo=("start_s", "min"), hi=("end_s", "max"))
     days = sd.join(span, on="service_id").groupby("date").agg(lo=("lo", "min"), hi=("hi", "max"))
-    origin = service_day_origin_utc(days.index.to_numpy(), feed["timezone"])
-    lo, hi = origin + days["lo"].to_numpy(), origin + days["hi"].to_numpy()
-    report_path = data.radiation.report
+    origin = service_day_origin_utc(days.index.to_numpy(), timezone)
+    return days, origin + days["lo"].to_numpy(), origin + days["hi"].to_numpy()
+
+
+def _check_radiation(data_dir: Path, days, lo, hi, limit_min: float) -> tuple[int, float]:
+    """Radiation must cover the buses' hours (*lo* to *hi*, Unix s) of every service day at
+    every location, without a gap over *limit_min*; (shorter gaps hit, their minutes)."""
+    import numpy as np
+
+    report_path = DataDir(data_dir).radiation.report
     try:
         rad = json.loads(report_path.read_text())
     except (OSError, ValueError):
         raise InputError(f"{report_path}: missing or unreadable; run 'vipvflow ingest cams'") from None
-    limit_min = cfg.radiation.max_gap_minutes
     n_short = short_min = 0
     for loc in rad["locations"]:
         # lookups interpolate between minute centres: the data hold from the first centre to
@@ -286,11 +323,7 @@ def preflight(cfg: Config, year: int, say=print) -> dict:
                     f"(limit radiation.max_gap_minutes = {limit_min:g})")
             n_short += 1
             short_min += g["minutes"]
-    if n_short:
-        say(f"  radiation: {n_short} gaps ({short_min} min) within the buses' hours were "
-            "interpolated")
-    return {"service_days": int(len(days)), "radiation_gaps_interpolated": n_short,
-            "radiation_gap_minutes_interpolated": int(short_min)}
+    return n_short, short_min
 
 
 def _dark(t0, t1, loc: dict, step_s: float = 300.0):

@@ -152,6 +152,27 @@ def read_feed(feed_path, dist_units: str | None = None, timezone: str | None = N
     import gtfs_kit as gk
 
     path = Path(feed_path)
+    gfeed = _read_tables(gk, path, dist_units)
+    problems: list[str] = []
+    _check_dates(gfeed, path)
+    _clean_coordinates(gfeed, path, problems)
+    tz = _feed_timezone(gfeed, path, timezone, problems)
+    gfeed = _select_routes(gfeed, path, route_types, problems)
+    _fill_single_times(gfeed, path, problems)
+    gfeed, n_freq = _expand_frequencies(gk, gfeed, problems)
+    _drop_unusable_shapes(gfeed, problems)
+    gfeed, n_built = _build_missing_shapes(gk, gfeed, problems)
+    st = _stop_times_in_seconds(gfeed.stop_times, problems)
+    trips, st = _drop_unmatched(gfeed.trips, st, gfeed.stops, problems)
+    return Feed(path=path, timezone=tz, routes=gfeed.routes, trips=trips.reset_index(drop=True),
+                stops=gfeed.stops, stop_times=st, shapes=gfeed.shapes, calendar=gfeed.calendar,
+                calendar_dates=gfeed.calendar_dates, dist_units=gfeed.dist_units,
+                shapes_built_from_stops=n_built, frequency_trips=n_freq, problems=problems,
+                gk_feed=gfeed)
+
+
+def _read_tables(gk, path: Path, dist_units: str | None):
+    """gtfs-kit's feed of *path*, with the trips, stop times, stops and a calendar it needs."""
     if not path.exists():
         raise InputError(f"{path}: GTFS feed not found")
     check_tables(path)
@@ -167,10 +188,11 @@ def read_feed(feed_path, dist_units: str | None = None, timezone: str | None = N
     if (gfeed.calendar is None or gfeed.calendar.empty) and (
             gfeed.calendar_dates is None or gfeed.calendar_dates.empty):
         raise InputError(f"{path}: neither calendar.txt nor calendar_dates.txt has service dates")
-    problems: list[str] = []
-    _check_dates(gfeed, path)
-    _clean_coordinates(gfeed, path, problems)
+    return gfeed
 
+
+def _feed_timezone(gfeed, path: Path, timezone: str | None, problems: list[str]) -> str:
+    """The timetable's IANA zone: agency.txt's, else *timezone* as given, else an error."""
     tz = None
     if gfeed.agency is not None and "agency_timezone" in gfeed.agency:
         zones = gfeed.agency["agency_timezone"].dropna().unique()
@@ -178,31 +200,38 @@ def read_feed(feed_path, dist_units: str | None = None, timezone: str | None = N
             problems.append(f"agency.txt has several timezones {list(zones)}; using {zones[0]}")
         tz = str(zones[0]) if len(zones) else None
     if tz is not None:
-        tz = _check_timezone(tz, f"{path}: agency.txt agency_timezone")
-    elif timezone:
+        return _check_timezone(tz, f"{path}: agency.txt agency_timezone")
+    if timezone:
         tz = _check_timezone(timezone, "--timezone")
         what = "agency.txt is missing" if gfeed.agency is None else "agency.txt has no agency_timezone"
         problems.append(f"{what}; timezone {tz} as given")
-    elif gfeed.agency is None:
+        return tz
+    if gfeed.agency is None:
         raise InputError(f"{path}: agency.txt is missing, so the timetable's time zone is unknown; "
                          "pass --timezone (or inputs.gtfs_timezone), e.g. Europe/Berlin")
-    else:
-        raise InputError(f"{path}: agency.txt has no agency_timezone; pass --timezone "
-                         "(or inputs.gtfs_timezone), e.g. Europe/Berlin")
+    raise InputError(f"{path}: agency.txt has no agency_timezone; pass --timezone "
+                     "(or inputs.gtfs_timezone), e.g. Europe/Berlin")
 
-    gfeed = _select_routes(gfeed, path, route_types, problems)
-    _fill_single_times(gfeed, path, problems)
-    n_freq = 0
-    if gfeed.frequencies is not None and not gfeed.frequencies.empty:
-        n_before = len(gfeed.trips)
-        fr = gfeed.frequencies
-        exact = (pd.to_numeric(fr["exact_times"], errors="coerce").fillna(0).astype(int)
-                 if "exact_times" in fr else pd.Series(0, index=fr.index))
-        gfeed = gk.expand_frequencies(gfeed)
-        n_freq = len(gfeed.trips) - n_before
-        if (exact == 0).any():
-            problems.append(f"{int((exact == 0).sum())} frequencies.txt rows are headway-based "
-                            "(exact_times 0): departures placed at start_time + n x headway")
+
+def _expand_frequencies(gk, gfeed, problems: list[str]):
+    """frequencies.txt expanded into trips: (feed, number of trips added)."""
+    if gfeed.frequencies is None or gfeed.frequencies.empty:
+        return gfeed, 0
+    n_before = len(gfeed.trips)
+    fr = gfeed.frequencies
+    exact = (pd.to_numeric(fr["exact_times"], errors="coerce").fillna(0).astype(int)
+             if "exact_times" in fr else pd.Series(0, index=fr.index))
+    gfeed = gk.expand_frequencies(gfeed)
+    n_freq = len(gfeed.trips) - n_before
+    if (exact == 0).any():
+        problems.append(f"{int((exact == 0).sum())} frequencies.txt rows are headway-based "
+                        "(exact_times 0): departures placed at start_time + n x headway")
+    return gfeed, n_freq
+
+
+def _drop_unusable_shapes(gfeed, problems: list[str]) -> None:
+    """Trips naming a shape missing from shapes.txt (or with fewer than two distinct
+    points) lose their shape_id, to get one built from their stops."""
     trips = gfeed.trips
     if "shape_id" not in trips:
         trips = trips.assign(shape_id=pd.Series(pd.NA, index=trips.index, dtype="string"))
@@ -226,16 +255,25 @@ def read_feed(feed_path, dist_units: str | None = None, timezone: str | None = N
             problems.append(f"{int(named.sum())} trips name a shape_id but the feed has no "
                             "shapes.txt; shapes built from their stops")
             gfeed.trips.loc[named, "shape_id"] = pd.NA
-    n_missing = int(gfeed.trips["shape_id"].isna().sum())
-    n_built = 0
-    if n_missing:
-        before = set() if gfeed.shapes is None else set(gfeed.shapes["shape_id"])
-        gfeed = gk.create_shapes(gfeed)
-        n_built = len(set(gfeed.shapes["shape_id"]) - before)
-        problems.append(f"{n_missing} trips without a shape: {n_built} shapes built from the "
-                        "stop sequence (straight lines between stops)")
 
-    st = gfeed.stop_times.copy()
+
+def _build_missing_shapes(gk, gfeed, problems: list[str]):
+    """A shape from the stop sequence for every trip without one: (feed, shapes built)."""
+    n_missing = int(gfeed.trips["shape_id"].isna().sum())
+    if not n_missing:
+        return gfeed, 0
+    before = set() if gfeed.shapes is None else set(gfeed.shapes["shape_id"])
+    gfeed = gk.create_shapes(gfeed)
+    n_built = len(set(gfeed.shapes["shape_id"]) - before)
+    problems.append(f"{n_missing} trips without a shape: {n_built} shapes built from the "
+                    "stop sequence (straight lines between stops)")
+    return gfeed, n_built
+
+
+def _stop_times_in_seconds(stop_times: pd.DataFrame, problems: list[str]) -> pd.DataFrame:
+    """Stop times with ``arr_s`` and ``dep_s`` (s), repaired where one is missing or the
+    departure precedes the arrival, in trip and stop order."""
+    st = stop_times.copy()
     st["arr_s"] = time_to_seconds(st["arrival_time"])
     st["dep_s"] = time_to_seconds(st["departure_time"])
     unreadable = ((st["arrival_time"].notna() & st["arr_s"].isna())
@@ -253,24 +291,22 @@ def read_feed(feed_path, dist_units: str | None = None, timezone: str | None = N
         problems.append(f"{int(bad.sum())} stop_times depart before they arrive; departure set "
                         "to arrival")
         st.loc[bad, "dep_s"] = st.loc[bad, "arr_s"]
-    st = st.sort_values(["trip_id", "stop_sequence"], kind="stable").reset_index(drop=True)
+    return st.sort_values(["trip_id", "stop_sequence"], kind="stable").reset_index(drop=True)
 
-    trips = gfeed.trips
+
+def _drop_unmatched(trips: pd.DataFrame, st: pd.DataFrame, stops: pd.DataFrame,
+                    problems: list[str]):
+    """(trips, stop times) without the trips that have no stop times and the stop times at
+    unknown stops (counted)."""
     no_times = ~trips["trip_id"].isin(st["trip_id"])
     if no_times.any():
         problems.append(f"{int(no_times.sum())} trips have no stop_times; dropped")
         trips = trips[~no_times]
-    stops = gfeed.stops
     missing_stop = ~st["stop_id"].isin(stops["stop_id"])
     if missing_stop.any():
         problems.append(f"{int(missing_stop.sum())} stop_times reference unknown stops; dropped")
         st = st[~missing_stop]
-
-    return Feed(path=path, timezone=tz, routes=gfeed.routes, trips=trips.reset_index(drop=True),
-                stops=stops, stop_times=st, shapes=gfeed.shapes, calendar=gfeed.calendar,
-                calendar_dates=gfeed.calendar_dates, dist_units=gfeed.dist_units,
-                shapes_built_from_stops=n_built, frequency_trips=n_freq, problems=problems,
-                gk_feed=gfeed)
+    return trips, st
 
 
 def _check_dates(gfeed, path: Path) -> None:

@@ -15,6 +15,8 @@ from __future__ import annotations
 import json
 import logging
 import time
+from collections import Counter
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -207,8 +209,54 @@ def ingest_gtfs(feed_path, data_dir, traj_cfg, crs=None, dist_units: str | None 
     tile_size = float(tile_size or TILE_SIZE_M)
     to_xy = Transformer.from_crs("EPSG:4326", crs_obj, always_xy=True)
 
-    trips = feed.trips.copy()
-    used = set(trips["shape_id"].astype(str))
+    shape_xy = _used_shapes(feed, to_xy, problems)
+    shape_len = {s: float(cumulative_distance(p)[-1]) for s, p in shape_xy.items()}
+    terrain = _terrain(data_dir, problems)
+    segs, geom = build_segments(shape_xy, traj_cfg.segment_length_m, traj_cfg.roof_height_m,
+                                tile_size, terrain, traj_cfg.default_elevation_m)
+    trips, st, st_xy = _stops_along_shapes(feed, shape_xy, to_xy)
+    feed_d = _feed_distances(st, shape_len, feed.dist_units, problems)
+    pats = _group_trips(st, st_xy, feed_d, shape_xy, shape_len)
+    _trip_findings(pats.found, len(pats), feed.path, problems)
+    pstops = pats.stops_frame()
+    timing = getattr(traj_cfg, "timing", "stop_times")
+    patterns = _segment_timing(pstops, pats.shape, segs, timing, traj_cfg, problems)
+    trips_out = _trips_table(trips, feed.routes, pats)
+
+    report = {
+        "feed": str(Path(feed_path)),
+        "timezone": feed.timezone,
+        "crs": crs_obj.to_string(),
+        "crs_source": crs_source,
+        "tile_size_m": tile_size,
+        "segment_length_m": float(traj_cfg.segment_length_m),
+        "timing": timing,
+        "terrain": terrain is not None,
+        "counts": {
+            "routes": int(trips_out["route_id"].nunique()),
+            "shapes": len(shape_xy),
+            "segments": len(segs),
+            "tiles": int(segs["tile"].nunique()) if len(segs) else 0,
+            "trips": len(trips_out),
+            "patterns": len(pats),
+            "stops": int(st["stop_id"].nunique()),
+            "frequency_trips": int(feed.frequency_trips),
+            "shapes_built_from_stops": int(feed.shapes_built_from_stops),
+            "route_types": _route_type_counts(feed.routes, trips_out),
+            "trips_with_feed_distances": pats.found["feed_distances"],
+            "trips_with_projected_stops": pats.found["projected"],
+        },
+        "total_shape_length_km": round(sum(shape_len.values()) / 1000.0, 3),
+        "problems": problems,
+    }
+    _write_stage(out, feed, segs, geom, crs_obj, trips_out, patterns, pstops, report, t_start)
+    return report
+
+
+def _used_shapes(feed, to_xy, problems: list[str]) -> dict:
+    """The feed's shapes that trips use, projected (m); shapes without two distinct points
+    are dropped (counted)."""
+    used = set(feed.trips["shape_id"].astype(str))
     shape_xy = project_shapes(feed.shapes[feed.shapes["shape_id"].astype(str).isin(used)], to_xy)
     degenerate = [s for s, p in shape_xy.items() if len(p) < 2 or not np.isfinite(p).all()]
     if degenerate:
@@ -216,12 +264,12 @@ def ingest_gtfs(feed_path, data_dir, traj_cfg, crs=None, dist_units: str | None 
                         "trips are dropped")
         for s in degenerate:
             shape_xy.pop(s)
-    shape_len = {s: float(cumulative_distance(p)[-1]) for s, p in shape_xy.items()}
-    terrain = _terrain(data_dir, problems)
-    segs, geom = build_segments(shape_xy, traj_cfg.segment_length_m, traj_cfg.roof_height_m,
-                                tile_size, terrain, traj_cfg.default_elevation_m)
+    return shape_xy
 
-    # ---- stop distances along shapes, per trip --------------------------------------------
+
+def _stops_along_shapes(feed, shape_xy: dict, to_xy):
+    """Trips on a usable shape, their stop times in stop order and the stops' points (m)."""
+    trips = feed.trips.copy()
     trips["shape_id"] = trips["shape_id"].astype(str)
     trips = trips[trips["shape_id"].isin(shape_xy.keys())]
     st = feed.stop_times.merge(trips[["trip_id", "shape_id"]], on="trip_id")
@@ -230,94 +278,147 @@ def ingest_gtfs(feed_path, data_dir, traj_cfg, crs=None, dist_units: str | None 
                              feed.stops["stop_lat"].to_numpy(float))
     stop_pos = pd.DataFrame({"x": sx, "y": sy}, index=feed.stops["stop_id"].astype(str))
     st_xy = stop_pos.loc[st["stop_id"].astype(str)].to_numpy()
-    factor = _dist_factor(st, shape_len, feed.dist_units, problems)
-    feed_d = (st["shape_dist_traveled"].to_numpy(float) * factor
-              if factor is not None else np.full(len(st), np.nan))
+    return trips, st, st_xy
 
+
+def _feed_distances(st: pd.DataFrame, shape_len: dict, feed_units: str | None,
+                    problems: list[str]) -> np.ndarray:
+    """The feed's ``shape_dist_traveled`` of each stop time in metres (NaN when unusable)."""
+    factor = _dist_factor(st, shape_len, feed_units, problems)
+    if factor is None:
+        return np.full(len(st), np.nan)
+    return st["shape_dist_traveled"].to_numpy(float) * factor
+
+
+@dataclass
+class _Patterns:
+    """Trips grouped into patterns: same shape, stops, stop distances and time offsets."""
+
+    shape: list = field(default_factory=list)          # shape id, by pattern id
+    stops: list = field(default_factory=list)          # pattern_stops rows, by pattern id
+    trip_pattern: dict = field(default_factory=dict)   # trip id -> pattern id
+    trip_start: dict = field(default_factory=dict)     # trip id -> first departure (s)
+    found: Counter = field(default_factory=Counter)    # trips by finding (dropped, repaired...)
+    _ids: dict = field(default_factory=dict)           # pattern key -> pattern id
+
+    def __len__(self) -> int:
+        return len(self._ids)
+
+    def add(self, trip, shape, stop_ids, d, arr, dep, start: float) -> None:
+        """File *trip* under its pattern (a new one when no trip before had the same)."""
+        key = (shape, tuple(stop_ids), tuple(np.round(d, 1)), tuple(arr), tuple(dep))
+        pid = self._ids.get(key)
+        if pid is None:
+            pid = self._ids[key] = len(self._ids)
+            self.shape.append(shape)
+            self.stops.append(pd.DataFrame({
+                "pattern_id": np.int64(pid), "stop_index": np.arange(len(stop_ids), dtype=np.int32),
+                "stop_id": stop_ids, "dist_m": d, "arr_s": arr, "dep_s": dep}))
+        self.trip_pattern[trip] = pid
+        self.trip_start[trip] = start
+
+    def stops_frame(self) -> pd.DataFrame:
+        """``pattern_stops.parquet``: per pattern and stop, distance and times."""
+        if not self.stops:
+            return pd.DataFrame(columns=["pattern_id", "stop_index", "stop_id", "dist_m",
+                                         "arr_s", "dep_s"])
+        return pd.concat(self.stops, ignore_index=True)
+
+
+def _group_trips(st: pd.DataFrame, st_xy: np.ndarray, feed_d: np.ndarray, shape_xy: dict,
+                 shape_len: dict) -> _Patterns:
+    """Each trip's stop distances and times, grouped into patterns (findings counted)."""
     tid = st["trip_id"].astype(str).to_numpy()
     bounds = np.flatnonzero(np.r_[True, tid[1:] != tid[:-1], True])
     shape_of = st["shape_id"].to_numpy()
     stop_ids = st["stop_id"].astype(str).to_numpy()
     arr_all, dep_all = st["arr_s"].to_numpy(float), st["dep_s"].to_numpy(float)
     projected: dict = {}
-    n_projected = n_feed = n_nonmono = n_short = n_untimed = n_spread = 0
-    n_backwards = n_still = 0
-    keys, rows = {}, []
-    trip_pattern, trip_start = {}, {}
-    pattern_stops, pattern_shape = [], []
+    pats = _Patterns()
     for a, b in zip(bounds[:-1], bounds[1:]):
         trip, shape = tid[a], shape_of[a]
         if b - a < 2:
-            n_short += 1
+            pats.found["short"] += 1
             continue
-        length = shape_len[shape]
-        d = feed_d[a:b]
-        if np.isnan(d).any() or np.any(np.diff(d) < 0) or d[-1] > 1.05 * length:
-            if not np.isnan(d).all():
-                n_nonmono += 1
-            key = (shape, tuple(stop_ids[a:b]))
-            if key not in projected:
-                projected[key] = project_stops_monotone(shape_xy[shape], st_xy[a:b])
-            d = projected[key]
-            n_projected += 1
-        else:
-            d = np.clip(d, 0.0, length)
-            n_feed += 1
-        arr, dep = _fill_times(d, arr_all[a:b]), _fill_times(d, dep_all[a:b])
-        if np.isnan(arr).any() or np.isnan(dep).any():
-            n_untimed += 1
-            continue
-        start = dep[0]
-        arr, dep = arr - start, dep - start
-        arr[0] = 0.0                      # the trip begins at its first departure
-        if d[-1] > d[0] and arr[-1] <= 0:
-            # it ends no later than it starts: no timing can be made of it
-            n_still += 1
-            continue
-        if np.any(np.diff(np.column_stack([arr, dep]).ravel()) < 0):
-            # times going backwards inside the trip: keep it, make times non-decreasing
-            seq = np.maximum.accumulate(np.column_stack([arr, dep]).ravel())
-            arr, dep = seq[0::2], seq[1::2]
-            n_backwards += 1
-        arr2, dep2, _ = spread_repeated_times(d, arr, dep)
-        if not (np.array_equal(arr2, arr) and np.array_equal(dep2, dep)):
-            n_spread += 1
-            arr, dep = arr2, dep2
-        key = (shape, tuple(stop_ids[a:b]), tuple(np.round(d, 1)), tuple(arr), tuple(dep))
-        pid = keys.get(key)
-        if pid is None:
-            pid = keys[key] = len(keys)
-            pattern_shape.append(shape)
-            pattern_stops.append(pd.DataFrame({
-                "pattern_id": np.int64(pid), "stop_index": np.arange(b - a, dtype=np.int32),
-                "stop_id": stop_ids[a:b], "dist_m": d, "arr_s": arr, "dep_s": dep}))
-        trip_pattern[trip] = pid
-        trip_start[trip] = start
-    if n_short:
-        problems.append(f"{n_short} trips have fewer than two stop times; dropped")
-    if n_untimed:
-        problems.append(f"{n_untimed} trips have too few timed stops; dropped")
-    if n_still:
-        problems.append(f"{n_still} trips arrive at their last stop no later than they leave "
-                        "the first (stop times backwards or all equal); dropped")
-    if n_backwards:
-        problems.append(f"{n_backwards} trips have stop times that decrease along the trip; "
-                        "made non-decreasing")
-    if not keys:
-        raise InputError(f"{feed.path}: no usable trip in the feed ("
-                         + "; ".join(problems or ["no trip with two stops on a shape"]) + ")")
-    if n_spread:
-        problems.append(f"{n_spread} trips give consecutive stops the same time; those stops "
-                        "were re-timed along distance between the stops whose times change")
-    if n_nonmono:
-        problems.append(f"{n_nonmono} trips have shape_dist_traveled missing, decreasing or "
-                        "beyond the shape; their stops were projected onto the shape")
+        d = _stop_distances(feed_d[a:b], shape_len[shape], (shape, tuple(stop_ids[a:b])),
+                            shape_xy[shape], st_xy[a:b], projected, pats.found)
+        timed = _trip_times(d, arr_all[a:b], dep_all[a:b], pats.found)
+        if timed is not None:
+            pats.add(trip, shape, stop_ids[a:b], d, *timed)
+    return pats
 
-    # ---- per-pattern segment timing -------------------------------------------------------
+
+def _stop_distances(d, length: float, key, shape_line, stop_xy, projected: dict,
+                    found: Counter) -> np.ndarray:
+    """A trip's stop distances along its shape (m): the feed's when usable, else the stops
+    projected onto the shape (once per shape and stop sequence, in *projected*)."""
+    if np.isnan(d).any() or np.any(np.diff(d) < 0) or d[-1] > 1.05 * length:
+        if not np.isnan(d).all():
+            found["nonmonotone"] += 1
+        if key not in projected:
+            projected[key] = project_stops_monotone(shape_line, stop_xy)
+        found["projected"] += 1
+        return projected[key]
+    found["feed_distances"] += 1
+    return np.clip(d, 0.0, length)
+
+
+def _trip_times(d, arr, dep, found: Counter):
+    """A trip's stop times repaired: (arr, dep) in s after its first departure and that
+    departure (s); None when no timing can be made of it."""
+    arr, dep = _fill_times(d, arr), _fill_times(d, dep)
+    if np.isnan(arr).any() or np.isnan(dep).any():
+        found["untimed"] += 1
+        return None
+    start = dep[0]
+    arr, dep = arr - start, dep - start
+    arr[0] = 0.0                      # the trip begins at its first departure
+    if d[-1] > d[0] and arr[-1] <= 0:
+        # it ends no later than it starts: no timing can be made of it
+        found["still"] += 1
+        return None
+    if np.any(np.diff(np.column_stack([arr, dep]).ravel()) < 0):
+        # times going backwards inside the trip: keep it, make times non-decreasing
+        seq = np.maximum.accumulate(np.column_stack([arr, dep]).ravel())
+        arr, dep = seq[0::2], seq[1::2]
+        found["backwards"] += 1
+    arr2, dep2, _ = spread_repeated_times(d, arr, dep)
+    if not (np.array_equal(arr2, arr) and np.array_equal(dep2, dep)):
+        found["spread"] += 1
+        arr, dep = arr2, dep2
+    return arr, dep, start
+
+
+#: problem lines of the trips dropped or repaired, by finding: those an unusable feed's
+#: error names, then those found in a usable one
+_TRIP_FINDINGS = (
+    ("short", "{} trips have fewer than two stop times; dropped"),
+    ("untimed", "{} trips have too few timed stops; dropped"),
+    ("still", "{} trips arrive at their last stop no later than they leave the first (stop "
+              "times backwards or all equal); dropped"),
+    ("backwards", "{} trips have stop times that decrease along the trip; made non-decreasing"))
+_TRIP_REPAIRS = (
+    ("spread", "{} trips give consecutive stops the same time; those stops were re-timed "
+               "along distance between the stops whose times change"),
+    ("nonmonotone", "{} trips have shape_dist_traveled missing, decreasing or beyond the "
+                    "shape; their stops were projected onto the shape"))
+
+
+def _trip_findings(found: Counter, n_patterns: int, feed_path, problems: list[str]) -> None:
+    """The trips dropped or repaired, as problem lines; a feed without any usable trip is
+    an :class:`InputError`."""
+    problems.extend(line.format(found[key]) for key, line in _TRIP_FINDINGS if found[key])
+    if not n_patterns:
+        raise InputError(f"{feed_path}: no usable trip in the feed ("
+                         + "; ".join(problems or ["no trip with two stops on a shape"]) + ")")
+    problems.extend(line.format(found[key]) for key, line in _TRIP_REPAIRS if found[key])
+
+
+def _segment_timing(pstops: pd.DataFrame, pattern_shape: list, segs: pd.DataFrame,
+                    timing: str, traj_cfg, problems: list[str]) -> pd.DataFrame:
+    """``patterns.parquet``: per pattern and segment, start offset, running time and speed
+    (from the stop times, or from a driving cycle through them)."""
     seg_by_shape = {s: g for s, g in segs.groupby("shape_id", sort=False)}
-    pstops = pd.concat(pattern_stops, ignore_index=True) if pattern_stops else pd.DataFrame(
-        columns=["pattern_id", "stop_index", "stop_id", "dist_m", "arr_s", "dep_s"])
-    timing = getattr(traj_cfg, "timing", "stop_times")
     frames, n_zero, cycle_delays = [], 0, []
     for pid, g in pstops.groupby("pattern_id", sort=True):
         sg = seg_by_shape[pattern_shape[pid]]
@@ -340,27 +441,31 @@ def ingest_gtfs(feed_path, data_dir, traj_cfg, crs=None, dist_units: str | None 
             "dt_s": dtt.astype(np.float32),
             "speed_mps": np.where(dtt > 0, cov / np.where(dtt > 0, dtt, 1), 0).astype(np.float32),
         }))
-    patterns = pd.concat(frames, ignore_index=True) if frames else pd.DataFrame(
-        columns=["pattern_id", "segment_id", "t_offset_s", "dt_s", "speed_mps"])
     if n_zero:
         problems.append(f"{n_zero} pattern segments are scheduled with zero running time "
                         "(stop times repeat between distinct stops); their dt_s is 0")
     if cycle_delays:
         problems.append(f"driving cycles: {len(cycle_delays)} patterns cannot keep their "
                         f"schedule within the limits (max delay {max(cycle_delays):.0f} s)")
+    if not frames:
+        return pd.DataFrame(columns=["pattern_id", "segment_id", "t_offset_s", "dt_s",
+                                     "speed_mps"])
+    return pd.concat(frames, ignore_index=True)
 
-    # ---- trips table ----------------------------------------------------------------------
-    trips = trips[trips["trip_id"].astype(str).isin(trip_pattern.keys())].copy()
+
+def _trips_table(trips: pd.DataFrame, routes: pd.DataFrame, pats: _Patterns) -> pd.DataFrame:
+    """``trips.parquet``: the trips kept, with route name, pattern and start (s)."""
+    trips = trips[trips["trip_id"].astype(str).isin(pats.trip_pattern.keys())].copy()
     trips["trip_id"] = trips["trip_id"].astype(str)
-    routes = feed.routes[["route_id", "route_short_name"]] if "route_short_name" in \
-        feed.routes else feed.routes[["route_id"]].assign(route_short_name=pd.NA)
+    routes = routes[["route_id", "route_short_name"]] if "route_short_name" in \
+        routes else routes[["route_id"]].assign(route_short_name=pd.NA)
     trips = trips.merge(routes, on="route_id", how="left")
     for col in ("direction_id", "block_id"):
         if col not in trips:
             trips[col] = pd.NA
-    trips["pattern_id"] = trips["trip_id"].map(trip_pattern).astype(np.int64)
-    trips["start_s"] = trips["trip_id"].map(trip_start).astype(np.float64)
-    trips_out = pd.DataFrame({
+    trips["pattern_id"] = trips["trip_id"].map(pats.trip_pattern).astype(np.int64)
+    trips["start_s"] = trips["trip_id"].map(pats.trip_start).astype(np.float64)
+    return pd.DataFrame({
         "trip_id": trips["trip_id"].astype(str),
         "route_id": trips["route_id"].astype(str),
         "route_short_name": trips["route_short_name"].astype("string"),
@@ -372,7 +477,23 @@ def ingest_gtfs(feed_path, data_dir, traj_cfg, crs=None, dist_units: str | None 
         "start_s": trips["start_s"],
     }).sort_values(["route_id", "start_s", "trip_id"], kind="stable", ignore_index=True)
 
-    # ---- write: into a new folder, swapped in for gtfs/ as a whole at the end -------------
+
+def _calendar_tables(feed):
+    """``calendar`` and ``calendar_dates`` with text ids and dates (empty when absent)."""
+    cal_cols = ["service_id", "monday", "tuesday", "wednesday", "thursday", "friday",
+                "saturday", "sunday", "start_date", "end_date"]
+    cal = (feed.calendar[cal_cols] if feed.calendar is not None
+           else pd.DataFrame(columns=cal_cols)).astype({"service_id": str, "start_date": str,
+                                                        "end_date": str})
+    cd_cols = ["service_id", "date", "exception_type"]
+    cd = (feed.calendar_dates[cd_cols] if feed.calendar_dates is not None
+          else pd.DataFrame(columns=cd_cols)).astype({"service_id": str, "date": str})
+    return cal, cd
+
+
+def _write_stage(out: Path, feed, segs, geom, crs_obj, trips_out, patterns, pstops,
+                 report: dict, t_start: float) -> None:
+    """Write the stage files into a new folder, swapped in for gtfs/ as a whole at the end."""
     import geopandas as gpd
 
     # (a folder a failed write leaves is removed by the next ingest, once its process is gone)
@@ -382,44 +503,9 @@ def ingest_gtfs(feed_path, data_dir, traj_cfg, crs=None, dist_units: str | None 
     write_parquet(trips_out, out.table("trips"), pandas_dtypes=True)
     write_parquet(patterns, out.table("patterns"), pandas_dtypes=True)
     write_parquet(pstops, out.table("pattern_stops"), pandas_dtypes=True)
-    cal_cols = ["service_id", "monday", "tuesday", "wednesday", "thursday", "friday",
-                "saturday", "sunday", "start_date", "end_date"]
-    cal = (feed.calendar[cal_cols] if feed.calendar is not None
-           else pd.DataFrame(columns=cal_cols)).astype({"service_id": str, "start_date": str,
-                                                        "end_date": str})
-    cd_cols = ["service_id", "date", "exception_type"]
-    cd = (feed.calendar_dates[cd_cols] if feed.calendar_dates is not None
-          else pd.DataFrame(columns=cd_cols)).astype({"service_id": str, "date": str})
+    cal, cd = _calendar_tables(feed)
     write_parquet(cal, out.table("calendar"), pandas_dtypes=True)
     write_parquet(cd, out.table("calendar_dates"), pandas_dtypes=True)
-
-    report = {
-        "feed": str(Path(feed_path)),
-        "timezone": feed.timezone,
-        "crs": crs_obj.to_string(),
-        "crs_source": crs_source,
-        "tile_size_m": tile_size,
-        "segment_length_m": float(traj_cfg.segment_length_m),
-        "timing": timing,
-        "terrain": terrain is not None,
-        "counts": {
-            "routes": int(trips_out["route_id"].nunique()),
-            "shapes": int(len(shape_xy)),
-            "segments": int(len(segs)),
-            "tiles": int(segs["tile"].nunique()) if len(segs) else 0,
-            "trips": int(len(trips_out)),
-            "patterns": int(len(keys)),
-            "stops": int(st["stop_id"].nunique()),
-            "frequency_trips": int(feed.frequency_trips),
-            "shapes_built_from_stops": int(feed.shapes_built_from_stops),
-            "route_types": _route_type_counts(feed.routes, trips_out),
-            "trips_with_feed_distances": n_feed,
-            "trips_with_projected_stops": n_projected,
-        },
-        "total_shape_length_km": round(sum(shape_len.values()) / 1000.0, 3),
-        "problems": problems,
-        "seconds": round(time.perf_counter() - t_start, 2),
-    }
+    report["seconds"] = round(time.perf_counter() - t_start, 2)
     write_text(json.dumps(report, indent=2), out.feed_json)
     swap_dir(out.root, final)
-    return report

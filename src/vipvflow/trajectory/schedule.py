@@ -29,7 +29,6 @@ May although it runs on 1 June. Every pass is thus in exactly one (tile, month) 
 """
 from __future__ import annotations
 
-import datetime as dt
 import functools
 import json
 from pathlib import Path
@@ -434,13 +433,6 @@ def passes_for_trip(data_dir, trip_id: str, service_date) -> pd.DataFrame:
     return _passes(data_dir, trips.astype({"service_id": str}), sd, pat)
 
 
-def date_of(value) -> dt.date:
-    """A service date given as ``YYYYMMDD``, ``YYYY-MM-DD``, date or Timestamp."""
-    if isinstance(value, str) and len(value) == 8 and value.isdigit():
-        return dt.datetime.strptime(value, "%Y%m%d").date()
-    return pd.Timestamp(value).date()
-
-
 # ---------------------------------------------------------------------------------------------
 # the whole day of a vehicle block: trips, layovers, parked
 
@@ -524,6 +516,39 @@ def block_timeline(data_dir, year: int, months=None, routes=None, depot=None,
         ``covered`` for a depot not in the city model); ``trip_runs``: ``trip_id,
         service_date, block_id, position`` (the trip's place in its block-day); ``buses``.
     """
+    trips, ends = _block_trips(data_dir, routes)
+    pts, stop_point, depot_point = _timeline_points(data_dir, trips, ends, depot, depot_shading)
+    runs, tz = _block_runs(data_dir, trips, year, months)
+    bd, runs = _block_days(runs)
+    lay, over, pos = _layovers(runs, stop_point)
+    dp = bd["first_stop_id"].map(depot_point) if depot is None else pd.Series(
+        depot_point["depot"], index=bd.index)
+    am = pd.DataFrame({"block_id": bd["block_id"], "date": bd["date"], "kind": "parked", "after_trip": -1,
+                       "point_id": dp, "t0_utc": bd["window_start_utc"], "t1_utc": bd["first_departure_utc"]})
+    pm = pd.DataFrame({"block_id": bd["block_id"], "date": bd["date"], "kind": "parked",
+                       "after_trip": bd["trips"] - 1, "point_id": dp, "t0_utc": bd["last_arrival_utc"],
+                       "t1_utc": bd["window_end_utc"]})
+    fleet_depot = (depot_point["depot"] if depot is not None
+                   else int(dp.mode().iloc[0]) if len(dp) else -1)
+    idle, n_buses = _idle_buses(bd, year, months, fleet_depot, tz)
+    iv = pd.concat([am.assign(buses=1), lay.assign(buses=1), pm.assign(buses=1), idle], ignore_index=True)
+    iv = iv[iv["t1_utc"] > iv["t0_utc"]]
+    iv = iv.sort_values(_BLOCK_DAY + ["t0_utc"], kind="stable").reset_index(drop=True)
+    iv = iv.rename(columns={"date": "service_date"}).astype({"point_id": np.int64, "after_trip": np.int64,
+                                                             "buses": np.int64})
+    iv["month"] = iv["service_date"].dt.strftime("%Y-%m")
+    bd = _block_day_totals(bd, runs, over, iv)
+    trip_runs = pd.DataFrame({"trip_id": runs["trip_id"].astype(str), "service_date": runs["date"],
+                              "block_id": runs["block_id"].astype(str), "position": pos})
+    return {"block_days": bd, "intervals": iv, "points": pts, "trip_runs": trip_runs, "buses": n_buses}
+
+
+#: the columns that name a block-day
+_BLOCK_DAY = ["block_id", "date"]
+
+
+def _block_trips(data_dir, routes):
+    """(trips with their pattern's end stops, end time and block, the patterns' ends)."""
     from ..vehicle import infer_blocks
 
     trips = _read(data_dir, "trips", columns=["trip_id", "route_id", "service_id", "block_id",
@@ -537,8 +562,12 @@ def block_timeline(data_dir, year: int, months=None, routes=None, depot=None,
     trips = trips.merge(ends, left_on="pattern_id", right_index=True, how="inner")
     trips["end_s"] = trips["start_s"] + trips["duration_s"]
     trips["block_id"] = infer_blocks(trips).to_numpy()
+    return trips, ends
 
-    # points: the trips' first and last stops (by stop id) and the depot
+
+def _timeline_points(data_dir, trips, ends, depot, depot_shading: str):
+    """The points a bus stands at: the trips' first and last stops (by stop id) and the
+    depot; (points, stop id -> city point id, stop id -> depot point id)."""
     shape_of = trips.drop_duplicates("pattern_id").set_index("pattern_id")["shape_id"]
     stops = pd.concat([
         pd.DataFrame({"stop_id": ends["first_stop_id"], "dist_m": ends["first_dist_m"]}),
@@ -563,10 +592,14 @@ def block_timeline(data_dir, year: int, months=None, routes=None, depot=None,
     stop_point = dict(zip(city["stop_id"], city["point_id"]))
     depot_point = dict(zip(pts.loc[pts["shading"] == depot_shading, "stop_id"],
                            pts.loc[pts["shading"] == depot_shading, "point_id"]))
+    return pts, stop_point, depot_point
 
-    # runs of the year (months), in block, date and time order
+
+def _block_runs(data_dir, trips, year: int, months):
+    """(runs of the year's months and of the day before each, in block, date and time order,
+    with UTC times ``t0, t1`` and the service day ``day0, day1``; the feed's time zone)."""
     # the run's months, and the day before each (its block past midnight moves the first
-    # day's start, as in a run of the whole year); the days before are dropped below
+    # day's start, as in a run of the whole year); the days before are dropped later
     sd = service_dates(data_dir, year)
     in_run = sd["date"].dt.month.isin(list(months)) if months is not None else pd.Series(True, sd.index)
     before = (sd["date"] + pd.Timedelta(days=1)).dt.month.isin(list(months)) if months is not None else in_run
@@ -581,8 +614,12 @@ def block_timeline(data_dir, year: int, months=None, routes=None, depot=None,
                        t1=origin[k] + runs["end_s"].to_numpy(float),
                        day0=origin[k], day1=next_origin[k])
     runs = runs.sort_values(["block_id", "date", "t0", "trip_id"], kind="stable").reset_index(drop=True)
+    return runs, tz
 
-    key = ["block_id", "date"]
+
+def _block_days(runs):
+    """(block-days of the run's months with their windows, the runs of those months)."""
+    key = _BLOCK_DAY
     bd = runs.groupby(key, sort=True).agg(
         trips=("trip_id", "size"), first_departure_utc=("t0", "min"), last_arrival_utc=("t1", "max"),
         day0=("day0", "first"), day1=("day1", "first"),
@@ -594,12 +631,16 @@ def block_timeline(data_dir, year: int, months=None, routes=None, depot=None,
     keep = bd.set_index(key).index.isin(pd.MultiIndex.from_frame(runs.loc[runs["in_run"], key]))
     bd = bd[keep].reset_index(drop=True)
     runs = runs[runs["in_run"].to_numpy()].reset_index(drop=True)
+    return bd, runs
 
-    # layovers: from a trip's arrival to the next trip's departure of the same block-day
+
+def _layovers(runs, stop_point: dict):
+    """Layovers from a trip's arrival to the next trip's departure of the same block-day;
+    (layovers, overlaps of trips that run into the next, trip positions in the block-day)."""
     same = ((runs["block_id"].to_numpy()[1:] == runs["block_id"].to_numpy()[:-1])
             & (runs["date"].to_numpy()[1:] == runs["date"].to_numpy()[:-1]))
     a = np.flatnonzero(same)
-    pos = runs.groupby(key, sort=False).cumcount().to_numpy()
+    pos = runs.groupby(_BLOCK_DAY, sort=False).cumcount().to_numpy()
     gap = runs["t0"].to_numpy()[a + 1] - runs["t1"].to_numpy()[a]
     lay = pd.DataFrame({"block_id": runs["block_id"].to_numpy()[a], "date": runs["date"].to_numpy()[a],
                         "kind": "layover", "after_trip": pos[a],
@@ -607,34 +648,27 @@ def block_timeline(data_dir, year: int, months=None, routes=None, depot=None,
                         "t0_utc": runs["t1"].to_numpy()[a], "t1_utc": runs["t0"].to_numpy()[a + 1]})
     over = pd.DataFrame({"block_id": lay["block_id"], "date": lay["date"],
                          "overlap_s": np.maximum(-gap, 0.0)})
-    lay = lay[gap > 0]
-    dp = bd["first_stop_id"].map(depot_point) if depot is None else pd.Series(
-        depot_point["depot"], index=bd.index)
-    am = pd.DataFrame({"block_id": bd["block_id"], "date": bd["date"], "kind": "parked", "after_trip": -1,
-                       "point_id": dp, "t0_utc": bd["window_start_utc"], "t1_utc": bd["first_departure_utc"]})
-    pm = pd.DataFrame({"block_id": bd["block_id"], "date": bd["date"], "kind": "parked",
-                       "after_trip": bd["trips"] - 1, "point_id": dp, "t0_utc": bd["last_arrival_utc"],
-                       "t1_utc": bd["window_end_utc"]})
-    # idle buses: on a day with fewer blocks than the fleet has buses (the most blocks of
-    # any day), the others stand parked at the depot from the day's origin to the next
+    return lay[gap > 0], over, pos
+
+
+def _idle_buses(bd, year: int, months, fleet_depot: int, tz: str):
+    """Idle buses: on a day with fewer blocks than the fleet has buses (the most blocks of
+    any day), the others stand parked at the depot from the day's origin to the next;
+    (their parked rows, the fleet's size)."""
     per_day = bd.groupby("date").size()
     n_buses = int(per_day.max()) if len(per_day) else 0
     days = pd.DatetimeIndex(sorted({d for d in pd.date_range(f"{year}-01-01", f"{year}-12-31", freq="D")
                                     if months is None or d.month in set(months)})).astype("datetime64[ns]")
     idle_n = n_buses - per_day.reindex(days, fill_value=0).to_numpy()
-    fleet_depot = (depot_point["depot"] if depot is not None
-                   else int(dp.mode().iloc[0]) if len(dp) else -1)
     d0, d1 = service_day_origin_utc(days, tz), service_day_origin_utc(days + pd.Timedelta(days=1), tz)
     idle = pd.DataFrame({"block_id": IDLE_BLOCK, "date": days, "kind": "parked", "after_trip": -1,
                          "point_id": fleet_depot, "t0_utc": d0, "t1_utc": d1, "buses": idle_n})
-    idle = idle[idle["buses"] > 0]
-    iv = pd.concat([am.assign(buses=1), lay.assign(buses=1), pm.assign(buses=1), idle], ignore_index=True)
-    iv = iv[iv["t1_utc"] > iv["t0_utc"]]
-    iv = iv.sort_values(key + ["t0_utc"], kind="stable").reset_index(drop=True)
-    iv = iv.rename(columns={"date": "service_date"}).astype({"point_id": np.int64, "after_trip": np.int64,
-                                                             "buses": np.int64})
-    iv["month"] = iv["service_date"].dt.strftime("%Y-%m")
+    return idle[idle["buses"] > 0], n_buses
 
+
+def _block_day_totals(bd, runs, over, iv):
+    """The block-days with their driving, overlap, layover and parked seconds and month."""
+    key = _BLOCK_DAY
     driving = runs.assign(s=runs["t1"] - runs["t0"]).groupby(key, sort=True)["s"].sum()
     bd["driving_s"] = driving.to_numpy()
     bd["overlap_s"] = over.groupby(key, sort=True)["overlap_s"].sum().reindex(
@@ -645,6 +679,4 @@ def block_timeline(data_dir, year: int, months=None, routes=None, depot=None,
             pd.MultiIndex.from_frame(bd[key]), fill_value=0.0).to_numpy()
     bd = bd.rename(columns={"date": "service_date"}).drop(columns=["day0", "day1", "first_stop_id"])
     bd["month"] = bd["service_date"].dt.strftime("%Y-%m")
-    trip_runs = pd.DataFrame({"trip_id": runs["trip_id"].astype(str), "service_date": runs["date"],
-                              "block_id": runs["block_id"].astype(str), "position": pos})
-    return {"block_days": bd, "intervals": iv, "points": pts, "trip_runs": trip_runs, "buses": n_buses}
+    return bd
