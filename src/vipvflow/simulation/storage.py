@@ -54,14 +54,15 @@ def _atomic(path: Path):
         raise
 
 
-def write_parquet(df: pd.DataFrame, path: Path) -> Path:
+def write_parquet(df: pd.DataFrame, path: Path, compact: bool = False) -> Path:
     """Write *df* (DataFrame or GeoDataFrame) to *path* atomically (temporary name, rename).
 
     Plain tables (numbers, bools, dates, strings) go straight to pyarrow: pandas' own
     conversion costs more than the write for the run's wide, small tables.  A file named as
     one of the run's outputs (``trip_energy.parquet``, ... :data:`dictionary.OUTPUTS`) is
     written as the data dictionary describes it: ``month`` as a date, every documented
-    column with its unit and meaning in the field metadata."""
+    column with its unit and meaning in the field metadata.  *compact* (partition files):
+    zstd, dictionaries for the non-float columns only, floats byte-stream split."""
     import pyarrow.parquet as pq
 
     from .dictionary import OUTPUTS, annotate
@@ -73,9 +74,21 @@ def write_parquet(df: pd.DataFrame, path: Path) -> Path:
             table = _arrow_table(df)
         if table is None:
             df.to_parquet(tmp, index=False)
+        elif compact:
+            pq.write_table(table, tmp, **_compact_options(table))
         else:
             pq.write_table(annotate(table, output) if output else table, tmp)
     return path
+
+
+def _compact_options(table) -> dict:
+    """Parquet settings of the partition files: floats (most of their bytes) byte-stream
+    split before zstd, dictionaries for the rest only (ids, dates)."""
+    import pyarrow as pa
+
+    floats = [f.name for f in table.schema if pa.types.is_floating(f.type)]
+    return {"compression": "zstd", "use_byte_stream_split": floats,
+            "use_dictionary": [f.name for f in table.schema if f.name not in floats]}
 
 
 def _arrow_table(df: pd.DataFrame):
