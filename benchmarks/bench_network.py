@@ -1,20 +1,26 @@
-"""A national-size network for one representative week, and the year extrapolated.
+"""A national-size network over a full year, measured end to end (or one week or month).
 
 A synthetic GTFS feed of 200 bus lines over the demo town's streets (the demo
 city, its terrain and its CAMS year are reused as ingested): each line is a stretch of one
 demo street (5-15 km), or runs along one street to the centre and out along the other; the
 lines overlap like the trunk corridors of a real network.  Stops every 400 m, 20 km/h with
 dwell, two directions, weekday headways of 10 to 120 min (05:00-23:00), Saturday at twice
-and Sunday at three times the weekday headway.  The calendar holds one week, Monday
-10 to Sunday 16 June 2024 (long days: more daytime passes, more rays than an average week).
+and Sunday at three times the weekday headway.
 
-The feed is ingested (timed apart), then :func:`run_simulation` runs the week (run.months
-[6]) on a LocalCluster of 2 workers from a fresh output folder.  Figures: lines, segments,
-trips and passes of the week, wall time, passes per second, peak RSS, and the year
-**extrapolated** as the week x 52.2 (passes and wall time; not measured).
+The feed is ingested (timed apart), then :func:`run_simulation` runs the period on a
+LocalCluster of 2 workers (or on the cluster at ``VIPVFLOW_BENCH_SCHEDULER``, e.g. one
+started with ``dask scheduler`` and two ``dask worker``; the run folder must be on a path
+the workers see) from a fresh output folder.  Figures: lines, segments, trips and passes,
+wall time, map and reduce time, the reduce's share of the wall time, passes per second,
+peak RSS of the process tree (this process and a LocalCluster's workers; not the workers of
+an outside cluster).
 
-``tiny``: the small demo's street, 4 lines, one weekday.
-"""
+Periods (``VIPVFLOW_BENCH_NETWORK`` or ``--week``/``--month`` on the module's command line):
+``year`` (default: every day of 2024, all 12 months: ~3.5 G passes, 20-40 min of both
+cores), ``month`` (June 2024) and ``week`` (Monday 10 to Sunday 16 June 2024; long days:
+more daytime passes than an average week), the last two with the year extrapolated from
+them.  ``tiny``: the small demo's street, 4 lines, one weekday.
+
 from __future__ import annotations
 
 import datetime as dt
@@ -34,6 +40,7 @@ from benchmarks.common import (WORK, YEAR, PeakRSS, demo_config, demo_paths, fre
 
 WEEKS_PER_YEAR = 365.25 / 7
 WEEK_START = dt.date(2024, 6, 10)         # a Monday
+PERIODS = ("year", "month", "week")
 HEADWAYS_MIN = (10, 15, 20, 30, 30, 60, 60, 120)
 SERVICES = {"WD": ((1, 1, 1, 1, 1, 0, 0), "05:00", "23:00", 1),
             "SA": ((0, 0, 0, 0, 0, 1, 0), "06:00", "23:00", 2),
@@ -165,17 +172,34 @@ def write_network_gtfs(path: Path, paths: list[np.ndarray], days: list[dt.date],
             "network_km": round(sum(float(np.hypot(*np.diff(p, axis=0).T).sum()) for p in paths) / 1000, 1)}
 
 
-def run(tiny: bool = False) -> dict:
+def period_days(period: str, tiny: bool = False) -> tuple[list[dt.date], list[int]]:
+    """The service days and the run's months of a benchmark period."""
+    if tiny:
+        return [dt.date(2024, 6, 12)], [6]
+    if period == "year":
+        first = dt.date(YEAR, 1, 1)
+        return [first + dt.timedelta(days=i) for i in range((dt.date(YEAR + 1, 1, 1) - first).days)], \
+            list(range(1, 13))
+    if period == "month":
+        return [dt.date(YEAR, 6, d) for d in range(1, 31)], [6]
+    if period == "week":
+        return [WEEK_START + dt.timedelta(days=i) for i in range(7)], [6]
+    raise ValueError(f"benchmark period {period!r}: not one of {', '.join(PERIODS)}")
+
+
+def run(tiny: bool = False, period: str | None = None, scheduler: str | None = None) -> dict:
     from vipvflow.demo.layout import build_layout
     from vipvflow.simulation.prepare import ensure_ingested
 
+    period = period or os.environ.get("VIPVFLOW_BENCH_NETWORK", "year")
+    scheduler = scheduler or os.environ.get("VIPVFLOW_BENCH_SCHEDULER") or None
     size = "small" if tiny else "full"
     n_lines = 4 if tiny else 200
-    days = [dt.date(2024, 6, 12)] if tiny else [WEEK_START + dt.timedelta(days=i) for i in range(7)]
+    days, months = period_days(period, tiny)
     prepare_demo(size)
     demo = demo_paths(size)
     root = WORK / f"network-{size}"
-    data_dir = root / "data"
+    data_dir = root / f"data-{len(days)}d"
     data_dir.mkdir(parents=True, exist_ok=True)
     for part in ("city", "radiation"):                   # the demo's city and sun, as ingested
         link = data_dir / part
@@ -189,44 +213,68 @@ def run(tiny: bool = False) -> dict:
               "cams": [str(demo["input"] / "cams_radiation_demo.csv")]}
     out = fresh_dir("network")
     try:
-        cfg = demo_config(size, data_dir=data_dir, out_dir=out, months=[6], n_workers=2,
+        cfg = demo_config(size, data_dir=data_dir, out_dir=out, months=months, n_workers=2,
                           inputs=inputs, scenario=f"network-{size}")
         with PeakRSS() as mem:
             t = time.perf_counter()
             ensure_ingested(cfg, say=lambda *a: None)
             ingest_s = time.perf_counter() - t
-        r = run_pipeline(cfg, YEAR, n_workers=2)
+        r = run_pipeline(cfg, YEAR, n_workers=None if scheduler else 2, scheduler=scheduler)
         segments = len(pd.read_parquet(data_dir / "gtfs" / "segments.parquet", columns=["tile"]))
         trip_days = len(pd.read_parquet(r["run_dir"] / "trip_energy.parquet", columns=["trip_id"]))
+        part_bytes = _part_bytes(r["run_dir"])
     finally:
         remove(out)
+    return _result(r, counts, days, period if not tiny else "day", scheduler,
+                   {"segments": segments, "trips_run": trip_days, "gtfs_ingest_s": round(ingest_s, 1),
+                    "partition_bytes_per_pass": round(part_bytes / max(r["manifest"]["passes_computed"], 1), 3)},
+                   feed_write_s=round(write_s, 1), ingest_peak_rss_mb=round(mem.peak_mb))
+
+
+def _part_bytes(run_dir: Path) -> int:
+    """Bytes of the per-pass partition files (trip, segment_month, hourly) of a run."""
+    return sum(f.stat().st_size for kind in ("trip", "segment_month", "hourly")
+               for f in (run_dir / "parts" / kind).glob("tile=*/month=*.parquet"))
+
+
+def _result(r: dict, counts: dict, days: list, period: str, scheduler, extra: dict, **more) -> dict:
     m = r["manifest"]
     passes = m["passes_computed"]
-    week = len(days) == 7
+    wall = r["wall_s"]
+    reduce_s = m["timings_s"].get("reduce_s")
     figures = {
+        "period": period,
         "lines": counts["lines"],
         "network_km": counts["network_km"],
-        "segments": segments,
-        "trips_run": trip_days,
+        **{k: extra[k] for k in ("segments", "trips_run")},
         "passes": passes,
-        "wall_s": round(r["wall_s"], 1),
+        "wall_s": round(wall, 1),
+        "wall_min": round(wall / 60, 2),
         "map_s": m["timings_s"].get("map_s"),
-        "reduce_s": m["timings_s"].get("reduce_s"),
-        "passes_per_s": round(passes / r["wall_s"]),
+        "reduce_s": reduce_s,
+        "reduce_share": round(reduce_s / wall, 4) if reduce_s is not None else None,
+        "passes_per_s": round(passes / wall),
         "peak_rss_gb": round(r["peak_rss_mb"] / 1024, 3),
-        "gtfs_ingest_s": round(ingest_s, 1),
-        "year_passes_extrapolated": round(passes * (WEEKS_PER_YEAR if week else 365.25)),
-        "year_wall_min_extrapolated": round(r["wall_s"] * (WEEKS_PER_YEAR if week else 365.25) / 60, 1),
+        "partition_bytes_per_pass": extra["partition_bytes_per_pass"],
+        "gtfs_ingest_s": extra["gtfs_ingest_s"],
     }
-    targets = {"wall_s": "< 600 here", "year_wall_min_extrapolated": "minutes (national network-year)"}
-    return {"figures": figures, "targets": targets,
-            "extrapolation": f"year = this {'week' if week else 'day'} x "
-                             f"{WEEKS_PER_YEAR if week else 365.25:.2f} (not measured; June days are "
-                             "long, so it leans high)",
-            "feed": counts, "feed_write_s": round(write_s, 1), "ingest_peak_rss_mb": round(mem.peak_mb),
-            "days": [d.isoformat() for d in days], "run_timings_s": m["timings_s"],
-            "partition_timings_s": m["partition_timings_s"]}
+    targets = {"wall_min": "< 30 for the year (issue 21)", "reduce_share": "< 0.10",
+               "peak_rss_gb": "< 2 (wish)"}
+    out = {"figures": figures, "targets": targets, "feed": counts,
+           "cluster": scheduler or "LocalCluster, 2 workers",
+           "peak_rss_note": "process tree of the benchmark (a LocalCluster's workers included; "
+                            "an outside cluster's workers are not)",
+           "days": [days[0].isoformat(), days[-1].isoformat(), len(days)],
+           "run_timings_s": m["timings_s"], "partition_timings_s": m["partition_timings_s"], **more}
+    if period != "year":
+        scale = 365.25 / len(days) if period != "week" else WEEKS_PER_YEAR
+        figures["year_wall_min_extrapolated"] = round(wall * scale / 60, 1)
+        out["extrapolation"] = (f"year = this {period} x {scale:.2f} (not measured; June days are long, "
+                                "so it leans high)")
+    return out
 
 
 if __name__ == "__main__":  # pragma: no cover
-    print(json.dumps(run(tiny="--tiny" in sys.argv), indent=2, default=str))
+    args = sys.argv[1:]
+    chosen = next((a[2:] for a in args if a[2:] in PERIODS), None)
+    print(json.dumps(run(tiny="--tiny" in args, period=chosen), indent=2, default=str))

@@ -147,14 +147,17 @@ def remove(path: Path) -> None:
         shutil.rmtree(path, ignore_errors=True)
 
 
-def run_pipeline(cfg, year: int = YEAR, n_workers: int | None = None, rss_interval_s: float = 0.25) -> dict:
-    """One :func:`run_simulation` of *cfg*: wall time, peak RSS of the process tree, manifest."""
+def run_pipeline(cfg, year: int = YEAR, n_workers: int | None = None, rss_interval_s: float = 0.25,
+                 scheduler: str | None = None) -> dict:
+    """One :func:`run_simulation` of *cfg* (on the cluster at *scheduler*, if given): wall
+    time, peak RSS of the process tree, manifest."""
     from vipvflow.simulation.run import run_simulation
 
     log: list[str] = []
     with PeakRSS(interval_s=rss_interval_s) as mem:
         t0 = time.perf_counter()
-        run_dir = run_simulation(cfg, year, n_workers=n_workers, say=lambda *a: log.append(" ".join(map(str, a))))
+        run_dir = run_simulation(cfg, year, scheduler=scheduler, n_workers=n_workers,
+                                 say=lambda *a: log.append(" ".join(map(str, a))))
         wall = time.perf_counter() - t0
     manifest = json.loads((run_dir / "manifest.json").read_text())
     return {"wall_s": wall, "peak_rss_mb": mem.peak_mb, "peak_rss_main_mb": mem.peak_self_mb,

@@ -315,15 +315,17 @@ def atomic_path(path: str | Path, suffix: str = "") -> Iterator[Path]:
         raise
 
 
-def write_parquet(df, path: str | Path, pandas_dtypes: bool = False) -> Path:
+def write_parquet(df, path: str | Path, pandas_dtypes: bool = False, compact: bool = False) -> Path:
     """Write *df* (DataFrame or GeoDataFrame) to *path* atomically.
 
     With *pandas_dtypes* pandas writes it, with its metadata: nullable integers and pandas'
-    string flavours read back as they were (the GTFS tables). Otherwise plain tables (numbers, bools, dates, strings) go straight to pyarrow: pandas' own
-    conversion costs more than the write for the run's wide, small tables.  A file named as
-    one of the run's outputs (``trip_energy.parquet``, ... :data:`dictionary.OUTPUTS`) is
-    written as the data dictionary describes it: ``month`` as a date, every documented
-    column with its unit and meaning in the field metadata."""
+    string flavours read back as they were (the GTFS tables).  Otherwise plain tables
+    (numbers, bools, dates, strings) go straight to pyarrow: pandas' own conversion costs
+    more than the write for the run's wide, small tables.  A file named as one of the run's
+    outputs (``trip_energy.parquet``, ... :data:`dictionary.OUTPUTS`) is written as the data
+    dictionary describes it: ``month`` as a date, every documented column with its unit and
+    meaning in the field metadata.  *compact* (partition files): zstd, dictionaries for the
+    non-float columns only, floats byte-stream split."""
     import pyarrow.parquet as pq
 
     from .simulation.dictionary import OUTPUTS, annotate
@@ -336,9 +338,21 @@ def write_parquet(df, path: str | Path, pandas_dtypes: bool = False) -> Path:
             table = _arrow_table(df)
         if table is None:
             df.to_parquet(tmp, index=False)
+        elif compact:
+            pq.write_table(table, tmp, **_compact_options(table))
         else:
             pq.write_table(annotate(table, output) if output else table, tmp)
     return path
+
+
+def _compact_options(table) -> dict:
+    """Parquet settings of the partition files: floats (most of their bytes) byte-stream
+    split before zstd, dictionaries for the rest only (ids, dates)."""
+    import pyarrow as pa
+
+    floats = [f.name for f in table.schema if pa.types.is_floating(f.type)]
+    return {"compression": "zstd", "use_byte_stream_split": floats,
+            "use_dictionary": [f.name for f in table.schema if f.name not in floats]}
 
 
 def write_json(obj, path: str | Path, sort_keys: bool = False) -> Path:

@@ -431,17 +431,10 @@ def run_partition(ctx: RunContext, tile: str, month: str, geometry: pd.DataFrame
                                                  groups=groups, bins=bins)
     else:
         trip, segm, hourly = aggregate_partition(passes, irr, int(month[5:7]), ctx)
-    for df in (trip, segm, hourly):
-        df["tile"] = tile
-    segm["month"] = month
-    hourly["month"] = month
     timings["reduce_s"] = timings.get("reduce_s", 0.0) + time.perf_counter() - t2
 
     t3 = time.perf_counter()
-    write_parquet(hourly, run.part("hourly", tile, month))
-    write_parquet(trip, run.part("trip", tile, month))
-    # segment_month last: its presence marks the partition complete
-    write_parquet(segm, run.part("segment_month", tile, month))
+    write_partition_files(run, tile, month, trip, segm, hourly)
     timings["write_s"] = time.perf_counter() - t3
 
     by_route: dict[str, float] = {}
@@ -452,6 +445,23 @@ def run_partition(ctx: RunContext, tile: str, month: str, geometry: pd.DataFrame
             "kwh": float(trip["pv_kwh"].sum()) if len(trip) else 0.0,
             "kwh_by_route": by_route, "timings": timings,
             "elapsed_s": time.perf_counter() - t0}
+
+
+#: float columns of the trip partitions stored as float32: the per-trip kWh and seconds of
+#: one tile-month (7 significant digits; the reduce sums them in float64)
+TRIP_FLOAT32 = ("pv_kwh", "seconds")
+
+
+def write_partition_files(run: RunDir, tile: str, month: str, trip: pd.DataFrame,
+                          segm: pd.DataFrame, hourly: pd.DataFrame) -> None:
+    """Write a partition's three files, holding what the reduce reads: no tile or month
+    columns (the path names them), the trip kWh and seconds as float32 (the segment and
+    hour sums, whose ratios the summary reports, stay float64), compact Parquet."""
+    trip = trip.astype({c: np.float32 for c in trip.columns if c.startswith(TRIP_FLOAT32)})
+    write_parquet(hourly, run.part("hourly", tile, month), compact=True)
+    write_parquet(trip, run.part("trip", tile, month), compact=True)
+    # segment_month last: its presence marks the partition complete
+    write_parquet(segm, run.part("segment_month", tile, month), compact=True)
 
 
 def partition_done(run_dir: Path, tile: str, month: str) -> bool:

@@ -26,19 +26,18 @@ from ..store import DataDir, RunDir, write_json, write_parquet
 log = logging.getLogger(__name__)
 
 
-def _part_table(run_dir: Path, kind: str, pattern: str = "tile=*/month=*.parquet") -> pa.Table | None:
-    """Every partition file of *kind* (``parts/<kind>/<pattern>``), in path order, as one Arrow
-    table (``None``: no files).
+def _read_files(files) -> pa.Table | None:
+    """The partition *files* (in the given order) as one Arrow table (``None``: no files).
 
     One pyarrow dataset over the files, read by Arrow's own threads (a run has hundreds to
     thousands of small files: one pandas read each cost most of the reduce); files whose
-    schemas differ (an empty partition's columns, say) are read one by one and their
-    schemas promoted instead."""
-    files = RunDir(run_dir).part_files(kind, pattern)
+    schemas differ (an empty partition's columns, an older run's extra ``tile`` column, say)
+    are read one by one and their schemas promoted instead."""
+    files = [str(f) for f in files]
     if not files:
         return None
     try:
-        return ds.dataset([str(f) for f in files], format="parquet").to_table()
+        return ds.dataset(files, format="parquet").to_table()
     except (pa.ArrowInvalid, pa.ArrowTypeError, pa.ArrowNotImplementedError):
         pass
     with ThreadPoolExecutor(max_workers=4) as pool:
@@ -47,28 +46,146 @@ def _part_table(run_dir: Path, kind: str, pattern: str = "tile=*/month=*.parquet
     return pa.concat_tables(filled, promote_options="permissive")
 
 
+def _part_table(run_dir: Path, kind: str, pattern: str = "tile=*/month=*.parquet") -> pa.Table | None:
+    """Every partition file of *kind* (``parts/<kind>/<pattern>``), in path order, as one Arrow
+    table (``None``: no files)."""
+    return _read_files(RunDir(run_dir).part_files(kind, pattern))
+
+
 def _read_parts(run_dir: Path, kind: str) -> pd.DataFrame:
     """Every partition file of *kind*, in path order, as one DataFrame."""
     table = _part_table(run_dir, kind)
     return pd.DataFrame() if table is None else table.to_pandas()
 
 
-def _trip_totals(run_dir: Path) -> pd.DataFrame:
-    """The trip partitions summed per trip and service date (a trip crosses many tiles),
-    sorted by both; the PV columns (``pv_kwh*``) and ``seconds``.
+# --- the partial sums, computed where the partitions are (Dask tasks on the run's workers)
 
-    Summed by Arrow on one thread (a fixed order of addition, so a run gives the same
-    figures every time) before anything becomes a pandas object."""
-    table = _part_table(run_dir, "trip")
+#: trip partition files summed by one task: bounds a task's memory (a network-year month has
+#: hundreds of tiles), and with two levels (files -> month -> run) the client sums a table
+#: about as long as its output
+TRIP_FILES_PER_TASK = 64
+
+
+def _tile_of(path: Path) -> str:
+    return path.parent.name.split("=", 1)[1]
+
+
+def _month_files(run_dir: Path, kind: str) -> dict[str, list[Path]]:
+    """The partition files of *kind* per month (``YYYY-MM``), each list in path order."""
+    out: dict[str, list[Path]] = {}
+    for f in RunDir(run_dir).part_files(kind):
+        out.setdefault(f.stem.split("=", 1)[1], []).append(f)
+    return dict(sorted(out.items()))
+
+
+def sum_trips(parts: list) -> pa.Table | None:
+    """Trip rows summed per trip and service date: the PV columns (``pv_kwh*``) and
+    ``seconds``, sorted by both keys.  *parts* are partition files or tables of trip sums;
+    summed by Arrow on one thread (a fixed order of addition, so a run gives the same figures
+    every time).  A Dask task of the reduce; ``None`` when no part has a row."""
+    if parts and isinstance(parts[0], (str, Path)):
+        table = _read_files(parts)
+    else:
+        tables = [t for t in parts if t is not None and t.num_rows]
+        table = pa.concat_tables(tables, promote_options="permissive") if tables else None
     if table is None or not table.num_rows:
-        raise InputError(f"{run_dir / 'parts' / 'trip'}: no trip partitions with passes: "
-                         "the run's routes never pass its tiles in its months")
+        return None
+    # float32 partition columns summed in float64
+    table = table.cast(pa.schema([f.with_type(pa.float64()) if pa.types.is_floating(f.type) else f
+                                  for f in table.schema]))
     cols = [c for c in table.column_names if c.startswith("pv_kwh")] + ["seconds"]
     keys = ["trip_id", "service_date"]
     summed = table.group_by(keys, use_threads=False).aggregate([(c, "sum") for c in cols])
     summed = summed.select(keys + [f"{c}_sum" for c in cols]).rename_columns(keys + cols)
-    summed = summed.sort_by([(k, "ascending") for k in keys])
-    return summed.to_pandas()
+    return summed.sort_by([(k, "ascending") for k in keys])
+
+
+def segment_month_part(files: list, month: str) -> pd.DataFrame:
+    """The segment partitions of one month as one table, each row with its ``tile`` and
+    ``month`` (named by the file's path; older runs stored them as columns).  A Dask task of
+    the reduce."""
+    frames = []
+    for f in map(Path, files):
+        df = pq.read_table(f).to_pandas()
+        if "tile" not in df:
+            df["tile"] = _tile_of(f)
+        if "month" not in df:
+            df["month"] = month
+        frames.append(df)
+    frames = [d for d in frames if len(d)] or frames[:1]
+    return pd.concat(frames, ignore_index=True) if frames else pd.DataFrame()
+
+
+def hourly_part(files: list, month: str) -> pd.DataFrame:
+    """The hourly partitions of one month summed per local hour (``month, hour``, the
+    irradiation sums ``h_*`` in Wh/m2, ``seconds``).  A Dask task of the reduce."""
+    table = _read_files(files)
+    hourly = table.to_pandas() if table is not None else pd.DataFrame({"hour": []})
+    cols = [c for c in hourly.columns if c.startswith("h_")] + ["seconds"]
+    out = hourly.groupby("hour", sort=True)[cols].sum().reset_index()
+    out.insert(0, "month", month)
+    return out
+
+
+class _InProcess:
+    """The reduce's tasks run in this process (no cluster given): ``submit`` calls at once."""
+
+    @staticmethod
+    def submit(fn, *args, **_):
+        return fn(*args)
+
+    @staticmethod
+    def gather(results):
+        return results
+
+
+def _trip_tree(run_dir: Path, client) -> list:
+    """Submit the tree of trip sums: files -> tasks of up to :data:`TRIP_FILES_PER_TASK`
+    files -> one per month; returns the months' futures (or tables) in month order."""
+    months = []
+    for files in _month_files(run_dir, "trip").values():
+        batches = [files[i:i + TRIP_FILES_PER_TASK] for i in range(0, len(files), TRIP_FILES_PER_TASK)]
+        sums = [client.submit(sum_trips, [str(f) for f in b], pure=False) for b in batches]
+        months.append(sums[0] if len(sums) == 1 else client.submit(sum_trips, sums, pure=False))
+    return months
+
+
+def _join_months(tables: list) -> pa.Table | None:
+    """The months' trip sums as one table (a trip past midnight at a month's end is in two)."""
+    return sum_trips(tables) if len(tables) > 1 else (tables[0] if tables else None)
+
+
+def partial_sums(run_dir: Path, client=None) -> dict:
+    """The partitions read and summed on the cluster of *client* (in this process without
+    one): ``trip`` (Arrow: per trip and service date, sorted), ``segment_month`` (per segment
+    and month, with tile and month) and ``hourly`` (per month and local hour).
+
+    Each month's files are read by tasks of their own (trips in a tree of partial sums), so
+    the reduce's reading grows with the partitions per worker; the client only joins the
+    months' tables."""
+    client = client or _InProcess()
+    run_dir = Path(run_dir)
+    trip = _trip_tree(run_dir, client)
+    sm = [client.submit(segment_month_part, [str(f) for f in files], m, pure=False)
+          for m, files in _month_files(run_dir, "segment_month").items()]
+    hourly = [client.submit(hourly_part, [str(f) for f in files], m, pure=False)
+              for m, files in _month_files(run_dir, "hourly").items()]
+    trip, sm, hourly = client.gather([trip, sm, hourly])
+    return {"trip": _join_months(trip),
+            "segment_month": pd.concat(sm, ignore_index=True) if sm else pd.DataFrame(),
+            "hourly": pd.concat(hourly, ignore_index=True) if hourly else pd.DataFrame()}
+
+
+def _trip_totals(run_dir: Path, table: pa.Table | None = None) -> pd.DataFrame:
+    """The trip partitions summed per trip and service date (a trip crosses many tiles),
+    sorted by both; the PV columns (``pv_kwh*``) and ``seconds``.  *table*: the trip sums of
+    :func:`partial_sums` (without: summed here, in this process)."""
+    if table is None:
+        table = _join_months(_trip_tree(Path(run_dir), _InProcess()))
+    if table is None or not table.num_rows:
+        raise InputError(f"{Path(run_dir) / 'parts' / 'trip'}: no trip partitions with passes: "
+                         "the run's routes never pass its tiles in its months")
+    return table.to_pandas()
 
 
 def trip_consumption(cfg: Config, data_dir: Path, year: int, pattern_ids, vecto_dir: Path | None = None,
@@ -255,41 +372,72 @@ def block_day_table(cfg: Config, run_dir: Path, trip: pd.DataFrame, vehicle):
     return bd, idle, trip
 
 
-def reduce_run(cfg: Config, year: int, run_dir: Path, say=print) -> dict:
+def reduce_run(cfg: Config, year: int, run_dir: Path, say=print, client=None, read=None) -> dict:
     """Write trip_energy, segments, segment_month, route_month, block_day, monthly, hourly
-    outputs, ``summary.json`` and ``report.html``; return the summary."""
-    from .. import economics
-    from . import annual
+    outputs, ``summary.json`` and ``report.html``; return the summary.
+
+    The partitions are read and summed by tasks on the cluster of *client* (its workers see
+    *run_dir* at the same path), or in this process without one (:func:`partial_sums`);
+    the joins, the vehicles' balance and the outputs are computed here.  *read* is called
+    once the cluster's part is done (the run shuts its cluster down then)."""
     from .report import write_report
 
-    data_dir = Path(cfg.data_dir)
-    trips_meta = pd.read_parquet(DataDir(data_dir).gtfs.trips)
+    parts = partial_sums(run_dir, client)
+    if read is not None:
+        read()
+    trips_meta = pd.read_parquet(DataDir(cfg.data_dir).gtfs.trips)
+    trip, bd, idle = _trip_outputs(cfg, year, run_dir, parts["trip"], trips_meta, say)
+    smg, segments, sm = _segment_outputs(cfg, run_dir, parts["segment_month"], trip, trips_meta)
+    rm = _route_month(trip)
+    write_parquet(rm, RunDir(run_dir).output("route_month.parquet"))
+    write_parquet(bd, RunDir(run_dir).output("block_day.parquet"))
+    hp = _hourly_pattern(parts["hourly"])
+    write_parquet(hp, RunDir(run_dir).output("hourly_pattern.parquet"))
+    monthly, summary = _fleet_year(cfg, year, run_dir, trip, bd, idle, sm, segments)
+    write_parquet(monthly, RunDir(run_dir).output("monthly.parquet"))
+    write_json(summary, RunDir(run_dir).output("summary.json"))
+    write_report(run_dir, summary, monthly, smg, hp, rm, cfg=cfg, segments=segments)
+    return summary
 
-    # --- per trip and service date
-    trip = _trip_totals(run_dir)
-    kwh_cols = [c for c in trip.columns if c.startswith("pv_kwh")] + ["seconds"]
+
+def _n_buses(trip: pd.DataFrame) -> int:
+    """The fleet: the most vehicle blocks on one service date."""
+    return int(trip.groupby("service_date")["block_id"].nunique().max())
+
+
+def _trip_outputs(cfg: Config, year: int, run_dir: Path, sums: pa.Table | None,
+                  trips_meta: pd.DataFrame, say):
+    """Per trip and service date (PV, the trip's metadata, the vehicle model's consumption)
+    and per block-day (driving, layovers, parked; the battery's share); writes
+    ``trip_energy.parquet``.  Returns the trips, the block-days and the idle buses' days."""
+    trip = _trip_totals(run_dir, sums)
     trip = trip.merge(trips_meta[["trip_id", "route_id", "route_short_name", "direction_id",
                                   "shape_id", "service_id", "block_id", "pattern_id", "start_s"]],
                       on="trip_id", how="left", validate="many_to_one")
     trip["month"] = pd.to_datetime(trip["service_date"]).dt.strftime("%Y-%m")
-    cons = trip_consumption(cfg, data_dir, year, trip["pattern_id"].unique(),
+    cons = trip_consumption(cfg, Path(cfg.data_dir), year, trip["pattern_id"].unique(),
                             vecto_dir=RunDir(run_dir).vecto, say=say)
     trip = trip.merge(cons, on=["pattern_id", "month"], how="left", validate="many_to_one")
     trip["coverage"] = trip["pv_kwh"] / trip["consumption_kwh"]
     # vehicle block per day: driving, layovers, parked; the battery's share (sets the
     # trips' block_id to the timeline's: the GTFS block or the inferred one)
-    vehicle = cfg.vehicle_params()
-    bd, idle, trip = block_day_table(cfg, run_dir, trip, vehicle)
-    write_parquet(trip, run_dir / "trip_energy.parquet")
+    bd, idle, trip = block_day_table(cfg, run_dir, trip, cfg.vehicle_params())
+    write_parquet(trip, RunDir(run_dir).output("trip_energy.parquet"))
+    return trip, bd, idle
 
-    # --- segments (their geometry factors and year: after the segment-months)
+
+def _segment_outputs(cfg: Config, run_dir: Path, sm: pd.DataFrame, trip: pd.DataFrame,
+                     trips_meta: pd.DataFrame):
+    """Per segment and month (GeoParquet for maps) and per segment over the run (geometry
+    factors and year); writes ``segment_month.parquet`` and ``segments.parquet``.  Returns
+    both and the segment-month sums."""
+    from . import annual
+
+    data_dir = Path(cfg.data_dir)
     segments = gpd.read_parquet(DataDir(data_dir).gtfs.segments)
     segments = segments[segments["shape_id"].isin(trip["shape_id"].unique())]
     geo = _part_table(run_dir, "geometry", "tile=*.parquet")
     geo = geo.to_pandas() if geo is not None else None
-
-    # --- segment-month (GeoParquet for maps)
-    sm = _read_parts(run_dir, "segment_month")
     # shading loss: sky and sun light the buildings take away (1 - (direct + diffuse) / unshaded);
     # the reflected light they add is reported apart as reflection gain
     sm["shading_loss"] = shading_loss(sm["h_direct"], sm["h_diffuse"], sm["h_total_unshaded"])
@@ -300,45 +448,42 @@ def reduce_run(cfg: Config, year: int, run_dir: Path, say=print) -> dict:
     smg = segments[["segment_id", "shape_id", "geometry"]].merge(sm, on="segment_id", how="inner")
     smg = gpd.GeoDataFrame(smg.merge(shape_route, on="shape_id", how="left"),
                            geometry="geometry", crs=segments.crs)
-    write_parquet(smg, run_dir / "segment_month.parquet")
-    hours_per_bus = annual.service_hours_per_bus(
-        float(trip["seconds"].sum()), int(trip.groupby("service_date")["block_id"].nunique().max()),
-        12.0 / len(cfg.run.months))
+    write_parquet(smg, RunDir(run_dir).output("segment_month.parquet"))
+    hours_per_bus = annual.service_hours_per_bus(float(trip["seconds"].sum()), _n_buses(trip),
+                                                 12.0 / len(cfg.run.months))
     segments = annual.segment_year(segments.merge(shape_route, on="shape_id", how="left"), geo, sm,
                                    cfg.pv_system().kwp, hours_per_bus)
-    write_parquet(segments, run_dir / "segments.parquet")
+    write_parquet(segments, RunDir(run_dir).output("segments.parquet"))
+    return smg, segments, sm
 
-    # --- route-direction-month
-    agg = {c: "sum" for c in kwh_cols + ["consumption_kwh"]}
+
+def _route_month(trip: pd.DataFrame) -> pd.DataFrame:
+    """Per route, direction and month: trips, time, kWh, consumption, coverage, shading loss."""
+    kwh_cols = [c for c in trip.columns if c.startswith("pv_kwh")] + ["seconds"]
     rm = (trip.groupby(["route_id", "route_short_name", "direction_id", "month"], sort=True)
-          .agg(trips=("trip_id", "size"), **{c: (c, "sum") for c in agg}).reset_index())
+          .agg(trips=("trip_id", "size"), **{c: (c, "sum") for c in kwh_cols + ["consumption_kwh"]})
+          .reset_index())
     rm["coverage"] = rm["pv_kwh"] / rm["consumption_kwh"]
     rm["shading_loss"] = shading_loss(rm["pv_kwh_direct"], rm["pv_kwh_diffuse"], rm["pv_kwh_unshaded"])
-    write_parquet(rm, run_dir / "route_month.parquet")
+    return rm
 
-    # --- vehicle block per day
-    write_parquet(bd, run_dir / "block_day.parquet")
 
-    # --- daily pattern by hour and month
-    hourly = _read_parts(run_dir, "hourly")
+def _hourly_pattern(hourly: pd.DataFrame) -> pd.DataFrame:
+    """The daily pattern by month and local hour: irradiation sums and the mean irradiance
+    ``g_*`` (W/m2) while buses are on the road at that hour."""
     h_cols = [c for c in hourly.columns if c.startswith("h_")]
     hp = hourly.groupby(["month", "hour"], sort=True)[h_cols + ["seconds"]].sum().reset_index()
-    for c in h_cols:  # mean irradiance while buses are on the road at that hour (W/m2)
+    for c in h_cols:
         hp["g_" + c[2:]] = hp[c] * 3600.0 / hp["seconds"].where(hp["seconds"] > 0)
-    write_parquet(hp, run_dir / "hourly_pattern.parquet")
+    return hp
 
-    # --- fleet-year
-    pv = cfg.pv_system()
-    n_buses = int(trip.groupby("service_date")["block_id"].nunique().max())
-    # a run over some months states annual figures scaled by 12 / months (flagged in the summary)
-    annualise = 12.0 / len(cfg.run.months)
-    pv_year = float(bd["pv_kwh_usable"].sum()) * annualise
-    demand_year = float(bd["demand_kwh"].sum()) * annualise
-    window = cfg.economics.soc_window
-    kwp_fleet = pv.kwp * n_buses
+
+def _harvest(cfg: Config, bd: pd.DataFrame, idle: pd.DataFrame, kwp_fleet: float, annualise: float) -> dict:
+    """The summary's split of the PV by when it is harvested (driving, layover, parked) and
+    what the battery takes."""
     parts = {"driving": float(bd["pv_kwh_driving"].sum()), "layover": float(bd["pv_kwh_layover"].sum()),
              "parked": float(bd["pv_kwh_parked"].sum() + idle["pv_kwh"].sum())}
-    harvest = {
+    return {
         "harvest": cfg.fleet.harvest, "depot_shading": cfg.fleet.depot_shading,
         **{f"pv_kwh_{k}": v for k, v in parts.items()},
         "pv_kwh_in_service": parts["driving"] + parts["layover"],
@@ -356,7 +501,16 @@ def reduce_run(cfg: Config, year: int, run_dir: Path, say=print) -> dict:
         "parked_hours": float((bd["seconds_parked"].sum() + idle["seconds"].sum()) / 3600.0),
         "layover_aux_kwh": float(bd["layover_aux_kwh"].sum()),
     }
-    eco = {
+
+
+def _economics(cfg: Config, bd: pd.DataFrame, n_buses: int, annualise: float) -> dict:
+    """The fleet's demand, coverage, avoided charging cycles and payback over a year."""
+    from .. import economics
+
+    pv, vehicle, window = cfg.pv_system(), cfg.vehicle_params(), cfg.economics.soc_window
+    pv_year = float(bd["pv_kwh_usable"].sum()) * annualise
+    demand_year = float(bd["demand_kwh"].sum()) * annualise
+    return {
         "fleet_demand_mwh": demand_year / 1000.0,
         "coverage": float(economics.coverage(pv_year, demand_year)),
         "avoided_charging_cycles_fleet": float(economics.avoided_cycles(pv_year, vehicle.battery_kwh, window)),
@@ -366,7 +520,14 @@ def reduce_run(cfg: Config, year: int, run_dir: Path, say=print) -> dict:
         "payback_years": float(economics.simple_payback_years(
             pv.kwp, pv_year / n_buses, cfg.economics.cost_eur_per_wp, cfg.economics.tariff_eur_per_kwh)),
     }
-    tot = sm[[c for c in sm.columns if c.startswith("h_")]].sum()
+
+
+def _monthly(cfg: Config, trip: pd.DataFrame, bd: pd.DataFrame, idle: pd.DataFrame, n_buses: int) -> pd.DataFrame:
+    """The fleet per month: trips, kWh, consumption, shading loss, the harvest split, avoided
+    charging cycles and yields."""
+    from .. import economics
+
+    pv, vehicle = cfg.pv_system(), cfg.vehicle_params()
     monthly = (trip.groupby("month", sort=True)
                .agg(trips=("trip_id", "size"), pv_kwh=("pv_kwh", "sum"), pv_kwh_clear=("pv_kwh_clear", "sum"),
                     pv_kwh_unshaded=("pv_kwh_unshaded", "sum"),
@@ -385,11 +546,23 @@ def reduce_run(cfg: Config, year: int, run_dir: Path, say=print) -> dict:
     split["pv_kwh_whole_day"] = split[["pv_kwh_driving", "pv_kwh_layover", "pv_kwh_parked"]].sum(axis=1)
     monthly = monthly.merge(split.reset_index(), on="month", how="left")
     monthly["avoided_charging_cycles"] = economics.avoided_cycles(
-        monthly["pv_kwh_usable"].to_numpy(), vehicle.battery_kwh, window)
+        monthly["pv_kwh_usable"].to_numpy(), vehicle.battery_kwh, cfg.economics.soc_window)
     monthly["kwh_per_kwp_allsky"] = monthly["pv_kwh"] / (pv.kwp * n_buses)
     monthly["kwh_per_kwp_clearsky"] = monthly["pv_kwh_clear"] / (pv.kwp * n_buses)
-    write_parquet(monthly, run_dir / "monthly.parquet")
+    return monthly
 
+
+def _fleet_year(cfg: Config, year: int, run_dir: Path, trip, bd, idle, sm, segments) -> tuple[pd.DataFrame, dict]:
+    """The fleet per month and the fleet-year summary (checked: :func:`_check_totals`)."""
+    from . import annual
+
+    data_dir = Path(cfg.data_dir)
+    pv = cfg.pv_system()
+    n_buses = _n_buses(trip)
+    # a run over some months states annual figures scaled by 12 / months (flagged in the summary)
+    annualise = 12.0 / len(cfg.run.months)
+    hours_per_bus = annual.service_hours_per_bus(float(trip["seconds"].sum()), n_buses, annualise)
+    tot = sm[[c for c in sm.columns if c.startswith("h_")]].sum()
     summary = {
         "scenario": cfg.scenario, "year": year, "months": cfg.run.months, "pv_mode": cfg.pv.mode,
         "diffuse_model": cfg.irradiance.diffuse_model,
@@ -411,12 +584,10 @@ def reduce_run(cfg: Config, year: int, run_dir: Path, say=print) -> dict:
         "unshaded_to_ghi_allsky": float(tot["h_total_unshaded"] / tot["h_ghi"]),
         "unshaded_to_ghi_clearsky": float(tot["h_total_clear_unshaded"] / tot["h_ghi_clear"]),
         "reflected_share": float(tot["h_reflected"] / tot["h_total"]),
-        **harvest,
-        **eco,
+        **_harvest(cfg, bd, idle, pv.kwp * n_buses, annualise),
+        **_economics(cfg, bd, n_buses, annualise),
         **annual.per_bus_figures(tot, n_buses, annualise, hours_per_bus, data_dir, year),
     }
     summary.update(_radiation_gaps(data_dir, year, cfg.run.months))
     _check_totals(summary, run_dir)
-    write_json(summary, run_dir / "summary.json")
-    write_report(run_dir, summary, monthly, smg, hp, rm, cfg=cfg, segments=segments)
-    return summary
+    return _monthly(cfg, trip, bd, idle, n_buses), summary

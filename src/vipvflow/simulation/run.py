@@ -207,6 +207,7 @@ def run_simulation(cfg: Config, year: int, scheduler: str | None = None,
                             name="sun-positions")
     warm.start()
     client, cluster = make_client(cfg, scheduler, n_workers)
+    closer = threading.Thread(target=_close, args=(client, cluster), name="close-cluster")
     try:
         n_workers_now = len(client.scheduler_info()["workers"])
         # a LocalCluster's workers share the machine's cores for ray casting
@@ -226,23 +227,23 @@ def run_simulation(cfg: Config, year: int, scheduler: str | None = None,
         results = _map(client, ctx, todo, standing_todo)
         timings["map_s"] = time.perf_counter() - t_map
         builds = client.run(worker_bvh_builds)
-    except BaseException:
-        _close(client, cluster)
-        raise
-    # the cluster shuts down while this process reduces
-    closer = threading.Thread(target=_close, args=(client, cluster), name="close-cluster")
-    closer.start()
-    try:
         if not (all(partition_done(run_dir, t, m) for t in tiles for m in _months(cfg, year))
                 and all(standing_done(run_dir, t) for t in standing)):
             say("stopped before all partitions were computed; run the same command again to resume")
             return run_dir
+        # the partitions are read and summed by tasks on the cluster; the joins and the
+        # outputs are made here
         t_red = time.perf_counter()
         with FolderProgress("reduce", run_dir):
-            summary = reduce_run(cfg, year, run_dir, say=say)
+            # the cluster shuts down once the partitions are read, while this process writes
+            summary = reduce_run(cfg, year, run_dir, say=say, client=client,
+                                 read=lambda: closer.start())
         timings["reduce_s"] = time.perf_counter() - t_red
     finally:
-        closer.join()
+        if closer.ident is not None:         # started by the reduce
+            closer.join()
+        else:
+            _close(client, cluster)
     timings["total_s"] = time.perf_counter() - t_start
     _write_manifest(cfg, year, run_dir, checksums, timings, results, builds)
     say(_summary_line(summary))
