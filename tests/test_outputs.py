@@ -87,8 +87,9 @@ def test_segments_hold_public_factors_and_their_year(small_run):
     row = seg.iloc[len(seg) // 2]
     assert row["g_total_in_service"] == pytest.approx(row["h_total"] / (row["seconds"] / 3600.0))
     # the fleet's specific yield is the segments' yearly yield weighted by the time spent on them
+    # (the summary sums the trips' kWh, stored per partition in float32: 1e-7 relative)
     assert np.average(seg["kwh_per_kwp_year"], weights=seg["seconds"]) == pytest.approx(
-        summary["kwh_per_kwp_allsky"], rel=1e-9)
+        summary["kwh_per_kwp_allsky"], rel=1e-7)
     assert summary["segments"] == len(seg)
 
 

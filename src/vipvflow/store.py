@@ -187,19 +187,20 @@ class PartKind:
     rows: str
     """what one row holds"""
     key: dict
-    """columns that identify a row, with their Arrow types (the other columns: the
-    measures of :mod:`vipvflow.simulation.partition`, named as in the data dictionary)"""
+    """columns that identify a row within its file, with their Arrow types (the tile and the
+    month are named by the path, not stored; the other columns: the measures of
+    :mod:`vipvflow.simulation.partition`, named as in the data dictionary)"""
 
 
 #: every kind of file under a run's ``parts/``; a partition (tile, month) is complete when its
 #: :data:`PARTITION_KINDS` files exist (``segment_month`` is written last)
 PARTS = {
     "hourly": PartKind("tile/month", "one local hour of the day: irradiation sums and pass time",
-                       {"hour": "int8", "tile": "string", "month": "string"}),
+                       {"hour": "int8"}),
     "trip": PartKind("tile/month", "one trip on one service date: PV kWh by sky and component",
-                     {"trip_id": "string", "service_date": "timestamp[ns]", "tile": "string"}),
+                     {"trip_id": "string", "service_date": "timestamp[ns]"}),
     "segment_month": PartKind("tile/month", "one segment: passes, irradiation sums, kWh",
-                              {"segment_id": "int64", "tile": "string", "month": "string"}),
+                              {"segment_id": "int64"}),
     "standing": PartKind("tile/month", "one layover or parked interval of a block at a stop "
                          "(month=all: the whole year)",
                          {"block_id": "string", "service_date": "timestamp[ns]",
