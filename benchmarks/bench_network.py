@@ -20,6 +20,7 @@ Periods (``VIPVFLOW_BENCH_NETWORK`` or ``--week``/``--month`` on the module's co
 cores), ``month`` (June 2024) and ``week`` (Monday 10 to Sunday 16 June 2024; long days:
 more daytime passes than an average week), the last two with the year extrapolated from
 them.  ``tiny``: the small demo's street, 4 lines, one weekday.
+"""
 
 from __future__ import annotations
 
