@@ -253,6 +253,28 @@ def test_reflector_attribution_is_a_share_of_the_reflected_energy(small_run):
     assert refl["building_id"].notna().all()
 
 
+def test_reflector_attribution_reads_the_surfaces_the_run_found(small_run):
+    """The export credits each group's stored dominant surface (``r{g}_surface``): no ray is
+    cast again, so every attributed surface is one of the run's, and a segment's credited
+    share never exceeds its groups' weight on surfaces."""
+    import re
+
+    from vipvflow.mesh import TileMesh
+    from vipvflow.store import DataDir, RunDir
+
+    run = dz.load_run(small_run)
+    refl = reflector_contributions(run)
+    stored = set()
+    for f in RunDir(small_run).part_files("geometry"):
+        geo = pd.read_parquet(f)
+        groups = [int(c[1:-2]) for c in geo.columns if re.fullmatch(r"r\d+_w", c)]
+        mesh = TileMesh.load(DataDir(run.data_dir).city.mesh(f.stem.split("=", 1)[1]))
+        for g in groups:
+            idx = geo.loc[(geo[f"r{g}_w"] > 0) & (geo[f"r{g}_surface"] >= 0), f"r{g}_surface"]
+            stored |= set(mesh.surface_ids[idx.to_numpy()])
+    assert len(refl) and set(refl["surface_id"]) <= stored
+
+
 # ----------------------------------------------------------------------------- embedding, CLI
 def test_embed_refuses_citygml2(small_run, shared_data, tmp_path):
     with pytest.raises(InputError, match="CityGML 3.0"):

@@ -716,14 +716,13 @@ def reflector_contributions(run: RunData, sel: Selection | None = None) -> pd.Da
     """Reflected PV energy attributed to the building surfaces that reflect onto the routes.
 
     Each segment's reflector groups (``parts/geometry``: weight ``r{g}_w`` = albedo x view
-    factor, representative hit point ``r{g}_x, r{g}_y, r{g}_z``) are attributed to the
-    surface hit by a ray from the segment's roof point to the group's representative point
-    (the tile mesh of the ingested city, ``data_dir/city/meshes``).  A segment's monthly
+    factor, ``r{g}_surface`` = the tile mesh's surface holding most of the group's weight, as
+    the run's rays found it) are read, not traced again.  A segment's monthly
     ``pv_kwh_reflected`` (``parts/segment_month``) is shared among its groups in proportion to
     their weights; a group merges every surface of one orientation class seen from the
-    segment, so the whole group is credited to the surface of its representative point.
-    Groups on terrain, or whose ray does not come back to the representative point, stay
-    unattributed.  Read tile by tile.
+    segment, so the whole group is credited to its dominant surface.  Groups on terrain or the
+    ground, and groups without a surface (-1), stay unattributed.  Read tile by tile; the
+    tile meshes (``data_dir/city/meshes``) give the surfaces' ids and types.
 
     Parameters
     ----------
@@ -738,46 +737,42 @@ def reflector_contributions(run: RunData, sel: Selection | None = None) -> pd.Da
     run's geometry parts or the city meshes are absent.
     """
     from ..mesh import SURFACE_TYPES, TileMesh
-    from ..shading import Scene
 
     cols = ["surface_id", "building_id", "surface_type", "month", "pv_kwh_reflected", "segments"]
     months = sel.months if sel is not None else run.months
-    files = RunDir(run.run_dir).part_files("geometry")
     pieces = []
-    for f in files:
+    for f in RunDir(run.run_dir).part_files("geometry"):
         tile = f.stem.split("=", 1)[1]
         mesh_path = DataDir(run.data_dir).city.mesh(tile)
         if not mesh_path.exists():
             log.warning("no city mesh for tile %s (%s): its reflectors are not attributed", tile, mesh_path)
             continue
-        geo = pd.read_parquet(f)
+        names = pq.read_schema(f).names
+        groups = sorted(int(c[1:-2]) for c in names if re.fullmatch(r"r\d+_w", c))
+        if not groups or f"r{groups[0]}_surface" not in names:
+            continue
+        geo = pd.read_parquet(f, columns=["segment_id", *(f"r{g}_{k}" for g in groups for k in ("w", "surface"))])
         if sel is not None:
             geo = geo[sel.contains(geo["segment_id"].to_numpy(np.int64))]
-        groups = sorted(int(c[1:-2]) for c in geo.columns if re.fullmatch(r"r\d+_w", c))
         sm = _tile_reflected(run, tile, months)
         geo = geo[geo["segment_id"].isin(sm["segment_id"])]
-        if geo.empty or not groups:
+        if geo.empty:
             continue
         w = np.stack([geo[f"r{g}_w"].to_numpy(np.float64) for g in groups], 1)          # (n, G)
-        rep = np.stack([geo[[f"r{g}_x", f"r{g}_y", f"r{g}_z"]].to_numpy(np.float64) for g in groups], 1)
-        origin = geo[["px", "py", "pz"]].to_numpy(np.float64)
+        surf = np.stack([geo[f"r{g}_surface"].to_numpy(np.int64) for g in groups], 1)   # (n, G)
         share = w / np.where(w.sum(1, keepdims=True) > 0, w.sum(1, keepdims=True), 1.0)
-        seg_idx, g_idx = np.nonzero(w > 0)
+        seg_idx, g_idx = np.nonzero((w > 0) & (surf >= 0))
         if not len(seg_idx):
             continue
-        o = origin[seg_idx]
-        vec = rep[seg_idx, g_idx] - o
-        dist = np.linalg.norm(vec, axis=1)
-        ok = dist > 1e-6
         mesh = TileMesh.load(mesh_path)
-        tri, t = Scene(mesh).first_hit(o[ok], vec[ok] / dist[ok, None], dist[ok] + 0.5)
-        tri_all = np.full(len(seg_idx), -1)
-        tri_all[np.flatnonzero(ok)] = np.where(np.abs(t - dist[ok]) < 0.25, tri, -1)
-        hit = tri_all >= 0
-        att = pd.DataFrame({"segment_id": geo["segment_id"].to_numpy()[seg_idx[hit]],
-                            "surface_id": mesh.surface_ids[mesh.surface_index[tri_all[hit]]],
-                            "surface_type": np.asarray(SURFACE_TYPES)[mesh.surface_type[tri_all[hit]]],
-                            "share": share[seg_idx[hit], g_idx[hit]]})
+        # each surface's type: that of its triangles
+        surface_type = np.full(len(mesh.surface_ids), -1, np.int64)
+        surface_type[np.asarray(mesh.surface_index)] = np.asarray(mesh.surface_type)
+        hit = surf[seg_idx, g_idx]
+        att = pd.DataFrame({"segment_id": geo["segment_id"].to_numpy()[seg_idx],
+                            "surface_id": np.asarray(mesh.surface_ids)[hit],
+                            "surface_type": np.asarray(SURFACE_TYPES)[surface_type[hit]],
+                            "share": share[seg_idx, g_idx]})
         att = att[~att["surface_type"].isin(["terrain", "ground", "vegetation"])]
         if att.empty:
             continue
