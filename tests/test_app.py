@@ -2,6 +2,8 @@
 Bokeh app driven in a real headless Chromium."""
 from __future__ import annotations
 
+import json
+
 import socket
 import subprocess
 import sys
@@ -275,6 +277,12 @@ def test_app_in_browser(chromium, app_url, trip_model, tmp_path):
             assert (first["route"], int(first["direction"]), first["date"], first["requested"]) == \
                 (start["route_id"], start["direction_id"], start["date"], "12:00")
             assert float(first["pv_kwh"]) > 0
+            # the run's three fleet yields in the header, as summary.json has them
+            sm = json.loads((Path(trip_model.run_dir) / "summary.json").read_text())
+            yields = page.locator(".run-yields").inner_text()
+            for label, key in (("driving", "kwh_per_kwp_allsky"), ("in service", "kwh_per_kwp_in_service"),
+                               ("whole day", "kwh_per_kwp_whole_day")):
+                assert f"{label} {sm[key]:,.0f}" in yields, yields
             exp = _expected(trip_model, first)
             assert {k: first[k] for k in exp} == exp
 

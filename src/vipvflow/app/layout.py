@@ -8,8 +8,10 @@ formatting.  The trip's numbers are in a ``Div`` with stable ids (``#trip-number
 from __future__ import annotations
 
 import html
+import json
 import logging
 from functools import lru_cache
+from types import SimpleNamespace
 
 import numpy as np
 import pandas as pd
@@ -21,7 +23,7 @@ from bokeh.palettes import Category10_5, Viridis256
 from bokeh.plotting import figure
 from bokeh.transform import dodge
 
-from ..store import DataDir
+from ..store import DataDir, RunDir
 from .model import TECHNOLOGIES, PVChoice, TripModel
 
 log = logging.getLogger(__name__)
@@ -140,15 +142,33 @@ def numbers_html(res, fleet: dict | None = None) -> str:
 
 def build_document(model: TripModel, doc) -> None:
     """Fill a Bokeh document with the app for *model* (a FunctionHandler target)."""
+    start = default_view(model)
+    c = _controls(model, start)
+    v = _views(model)
+    v.f_mon = _monthly_figure(v.src_mon)
+    refresh = _wire(model, c, v)
+    refresh()
+    w = _WIDTH
+    controls = column(c.tech, c.mode, c.size_by, c.kwp, c.area, c.pr, c.losses, c.route, c.date,
+                      c.depart, c.aux, c.soc, width=w + 20)
+    doc.add_root(column(_header(model), row(controls, column(c.numbers, c.error, v.f_map),
+                                            column(v.f_irr, v.f_cyc, v.f_soc)),
+                        row(Div(width=w + 20), v.f_mon)))
+    doc.title = "vipvflow app"
+
+
+#: width of the control column (px)
+_WIDTH = 300
+
+
+def _controls(model: TripModel, start: dict) -> SimpleNamespace:
+    """The PV, route, date and vehicle controls and the text panes, opened on *start*."""
     routes = model.routes()
     route_opts = [(f"{r.route_id}|{r.direction_id}",
                    f"{r.route_short_name} direction {r.direction_id} ({r.trips} trips)")
                   for r in routes.itertuples()]
-    start = default_view(model)
     run_pv = model.run_pv_choice
-
-    # ------------------------------------------------------------------ controls
-    w = 300
+    w = _WIDTH
     tech = Select(title="PV technology", value=run_pv.technology, options=list(TECHNOLOGIES),
                   width=w, css_classes=["pv-tech"])
     mode = Select(title="PV model", value=run_pv.mode, width=w, css_classes=["pv-mode"],
@@ -181,7 +201,11 @@ def build_document(model: TripModel, doc) -> None:
                                ":host .compute, :host .fleet { color: #555; margin-top: 4px; }"])
     error = Div(text="", width=560, css_classes=["app-error"])
 
-    # ------------------------------------------------------------------ views
+    return SimpleNamespace(tech=tech, mode=mode, size_by=size_by, kwp=kwp, area=area, pr=pr, losses=losses, route=route, date=date, depart=depart, aux=aux, soc=soc, numbers=numbers, error=error)
+
+
+def _views(model: TripModel) -> SimpleNamespace:
+    """The data sources and the irradiance, map, driving-cycle and SoC figures."""
     src_seg = ColumnDataSource(data={k: [] for k in ("time", "direct", "diffuse", "reflected",
                                                      "total", "unshaded", "x", "y", "x_end",
                                                      "y_end", "energy_wh")})
@@ -228,6 +252,11 @@ def build_document(model: TripModel, doc) -> None:
     f_soc.add_layout(soc_min_line)
     f_soc.legend.location = "bottom_left"
 
+    return SimpleNamespace(src_seg=src_seg, src_cyc=src_cyc, src_mon=src_mon, f_irr=f_irr, f_map=f_map, mapper=mapper, f_cyc=f_cyc, f_soc=f_soc, soc_min_line=soc_min_line)
+
+
+def _monthly_figure(src_mon: ColumnDataSource):
+    """Monthly PV energy of the route-direction: all-sky and clear-sky bars, unshaded marks."""
     f_mon = figure(title="Monthly PV energy of the route-direction (run, rescaled to this PV)",
                    x_range=FactorRange(), height=330, width=560, y_axis_label="kWh",
                    tools="save,reset")
@@ -248,7 +277,17 @@ def build_document(model: TripModel, doc) -> None:
     f_mon.xaxis.major_label_text_font_size = "11pt"
     f_mon.y_range.start = 0
 
-    # ------------------------------------------------------------------ callbacks
+    return f_mon
+
+
+def _wire(model: TripModel, c: SimpleNamespace, v: SimpleNamespace):
+    """Connect the controls to the model; returns the function that recomputes the views."""
+    run_pv = model.run_pv_choice
+    tech, mode, size_by, kwp, area, pr, losses = c.tech, c.mode, c.size_by, c.kwp, c.area, c.pr, c.losses
+    route, date, depart, aux, soc, numbers, error = c.route, c.date, c.depart, c.aux, c.soc, c.numbers, c.error
+    src_seg, src_cyc, src_mon, mapper, soc_min_line = v.src_seg, v.src_cyc, v.src_mon, v.mapper, v.soc_min_line
+    f_mon = v.f_mon
+
     def pv_choice() -> PVChoice:
         return PVChoice(technology=tech.value, mode=mode.value, kwp=float(kwp.value),
                         area_m2=float(area.value) if size_by.active == 1 else None,
@@ -316,14 +355,23 @@ def build_document(model: TripModel, doc) -> None:
     for widget in (kwp, area, pr, losses, depart, soc):
         widget.on_change("value_throttled", recompute)
     size_by.on_change("active", on_size)
-    refresh()
+    return refresh
 
-    header = Div(text=(f"<h2 style='margin:4px 0'>vipvflow: bus-roof PV along a trip</h2>"
-                       f"<div style='color:#555'>run <code>{html.escape(str(model.run_dir))}</code>, "
-                       f"scenario {html.escape(model.cfg.scenario)} {model.year}, "
-                       f"diffuse model {model.cfg.irradiance.diffuse_model}</div>"), width=1200)
-    controls = column(tech, mode, size_by, kwp, area, pr, losses, route, date, depart, aux, soc,
-                      width=w + 20)
-    doc.add_root(column(header, row(controls, column(numbers, error, f_map), column(f_irr, f_cyc, f_soc)),
-                        row(Div(width=w + 20), f_mon)))
-    doc.title = "vipvflow app"
+
+def _header(model: TripModel) -> Div:
+    """Title, run, diffuse model and the run's three yields (driving, in service, whole day)."""
+    yields = ""
+    summary_path = RunDir(model.run_dir).output("summary.json")
+    if summary_path.exists():
+        sm = json.loads(summary_path.read_text())
+        parts = [(label, sm.get(key)) for label, key in (("driving", "kwh_per_kwp_allsky"),
+                                                         ("in service", "kwh_per_kwp_in_service"),
+                                                         ("whole day", "kwh_per_kwp_whole_day"))]
+        shown = [f"{label} {value:,.0f}" for label, value in parts if isinstance(value, (int, float))]
+        if shown:
+            yields = (f"<div class='run-yields' style='color:#555'>the run's fleet yield, kWh/kWp per year: "
+                      f"{', '.join(shown)}</div>")
+    return Div(text=(f"<h2 style='margin:4px 0'>vipvflow: bus-roof PV along a trip</h2>"
+                     f"<div style='color:#555'>run <code>{html.escape(str(model.run_dir))}</code>, "
+                     f"scenario {html.escape(model.cfg.scenario)} {model.year}, "
+                     f"diffuse model {model.cfg.irradiance.diffuse_model}</div>{yields}"), width=1200)

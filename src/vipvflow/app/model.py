@@ -405,6 +405,45 @@ class TripModel:
                             temp_air_c=self.cfg.climate.monthly_mean_temperature_c[month - 1],
                             vehicle_speed_mps=speed_mps, wind_mps=self.cfg.climate.wind_speed_mps)
 
+    def _vehicle_run(self, pid: int, month: int, origin: float, off, dt, energy, aux_kw, soc_start,
+                     soc_min):
+        """The vehicle along the trip's driving cycle, with and without the PV *energy* (kWh per
+        segment pass): (parameters, SoC at departure, consumption, the per-second cycle with SoC
+        and cumulative kWh)."""
+        from ..vehicle import simulate_cycle
+
+        tz = self.timezone
+        params = self.vehicle
+        upd = {}
+        if aux_kw is not None:
+            upd["aux_base_kw"] = float(aux_kw)
+        if soc_min is not None:
+            upd["soc_min"] = float(soc_min)
+        if soc_start is not None:
+            upd["soc_max"] = max(float(soc_start), params.soc_min if soc_min is None else float(soc_min) + 1e-6)
+        if upd:
+            params = params.model_copy(update=upd)
+        soc0 = params.soc_max if soc_start is None else float(soc_start)
+        cycle = self._cycle(pid)
+        cons = simulate_cycle(cycle, params, self.cfg.climate.monthly_mean_temperature_c[month - 1],
+                              detail=True)
+        iv = cons["intervals"]
+        t_s = cycle["t_s"].to_numpy(np.float64)
+        e_batt = np.r_[0.0, np.cumsum(iv["p_battery"] * iv["dt_s"]) / 3.6e6]      # kWh
+        seg_end = np.r_[0.0, off + dt]
+        e_pv = np.interp(t_s - t_s[0], seg_end, np.r_[0.0, np.cumsum(energy)])
+        cap = params.battery_kwh
+        soc = soc0 - e_batt / cap
+        # with PV: charging stops at soc_max (one-sided reflection of the running sum)
+        free = soc0 + (e_pv - e_batt) / cap
+        soc_pv = free - np.maximum(np.maximum.accumulate(free - params.soc_max), 0.0)
+        cyc = pd.DataFrame({
+            "t_s": t_s,
+            "time": pd.to_datetime(origin + t_s - t_s[0], unit="s", utc=True).tz_convert(tz).tz_localize(None),
+            "speed_kmh": cycle["speed_mps"].to_numpy(np.float64) * 3.6,
+            "soc": soc, "soc_pv": soc_pv, "pv_kwh_cum": e_pv, "battery_kwh_cum": e_batt})
+        return params, soc0, cons, cyc
+
     def trip(self, route_id, direction_id, date, depart="08:00", pv: PVChoice | None = None,
              aux_kw: float | None = None, soc_start: float | None = None,
              soc_min: float | None = None) -> TripResult:
@@ -421,7 +460,7 @@ class TripModel:
         soc_start, soc_min : SoC at the trip's start and the lower limit (0..1; defaults:
             the vehicle's ``soc_max`` and ``soc_min``)
         """
-        from ..vehicle import simulate_cycle, soc_trace
+        from ..vehicle import soc_trace
 
         t0 = time.perf_counter()
         pv = pv or self.run_pv_choice
@@ -455,36 +494,8 @@ class TripModel:
             "x": g["x"].to_numpy(), "y": g["y"].to_numpy(),
             "x_end": g["x_end"].to_numpy(), "y_end": g["y_end"].to_numpy()})
 
-        # vehicle
-        params = self.vehicle
-        upd = {}
-        if aux_kw is not None:
-            upd["aux_base_kw"] = float(aux_kw)
-        if soc_min is not None:
-            upd["soc_min"] = float(soc_min)
-        if soc_start is not None:
-            upd["soc_max"] = max(float(soc_start), params.soc_min if soc_min is None else float(soc_min) + 1e-6)
-        if upd:
-            params = params.model_copy(update=upd)
-        soc0 = params.soc_max if soc_start is None else float(soc_start)
-        cycle = self._cycle(pid)
-        cons = simulate_cycle(cycle, params, self.cfg.climate.monthly_mean_temperature_c[month - 1],
-                              detail=True)
-        iv = cons["intervals"]
-        t_s = cycle["t_s"].to_numpy(np.float64)
-        e_batt = np.r_[0.0, np.cumsum(iv["p_battery"] * iv["dt_s"]) / 3.6e6]      # kWh
-        seg_end = np.r_[0.0, off + dt]
-        e_pv = np.interp(t_s - t_s[0], seg_end, np.r_[0.0, np.cumsum(energy)])
-        cap = params.battery_kwh
-        soc = soc0 - e_batt / cap
-        # with PV: charging stops at soc_max (one-sided reflection of the running sum)
-        free = soc0 + (e_pv - e_batt) / cap
-        soc_pv = free - np.maximum(np.maximum.accumulate(free - params.soc_max), 0.0)
-        cyc = pd.DataFrame({
-            "t_s": t_s,
-            "time": pd.to_datetime(origin + t_s - t_s[0], unit="s", utc=True).tz_convert(tz).tz_localize(None),
-            "speed_kmh": cycle["speed_mps"].to_numpy(np.float64) * 3.6,
-            "soc": soc, "soc_pv": soc_pv, "pv_kwh_cum": e_pv, "battery_kwh_cum": e_batt})
+        params, soc0, cons, cyc = self._vehicle_run(pid, month, origin, off, dt, energy,
+                                                    aux_kw, soc_start, soc_min)
         pv_kwh = float(energy.sum())
         use = float(cons["battery_kwh"])
         end = soc_trace(pd.DataFrame({"battery_kwh": [use]}), [pv_kwh], params, soc_start=soc0)
