@@ -16,7 +16,7 @@ from pathlib import Path
 
 PROBE = textwrap.dedent("""
     import json, resource, sys, time
-    from vipvflow.city import ingest_city
+    from vipvflow.inputs.city import ingest_city
     from vipvflow.config import CityCfg
     t0 = time.perf_counter()
     r = ingest_city(sys.argv[1], sys.argv[2], CityCfg(tile_size_m=500, buffer_m=300))
@@ -33,8 +33,8 @@ def _ingest(path: Path, out: Path) -> dict:
 
 
 def run(tiny: bool = False) -> dict:
-    from vipvflow.city.citygml import CityGMLReader
-    from vipvflow.city.synthetic import write_synthetic_city
+    from vipvflow.inputs.city.citygml import CityGMLReader
+    from vipvflow.inputs.city.synthetic import write_synthetic_city
 
     n = 300 if tiny else 6000
     with tempfile.TemporaryDirectory() as tmp:

@@ -33,8 +33,8 @@ def hwm_mb():
 
 
 t0 = time.perf_counter()
-from vipvflow.export import write_dynamizers
-import vipvflow.export.dynamizer, shapely, pyarrow.parquet, vipvflow.shading, vipvflow.mesh
+from vipvflow.outputs import write_dynamizers
+import vipvflow.outputs.dynamizer, shapely, pyarrow.parquet, vipvflow.models.shading, vipvflow.models.mesh
 import_rss = hwm_mb()
 t1 = time.perf_counter()
 kw = json.loads(sys.argv[3])

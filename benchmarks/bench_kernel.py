@@ -3,7 +3,7 @@
 The same passes as ``line_year`` (the demo's line ``L1``, every month of 2024, every tile it
 crosses), through the least work that still gives PV energy per trip:
 
-* the passes of a (tile, month) from the timetable (:func:`vipvflow.trajectory.iter_passes`,
+* the passes of a (tile, month) from the timetable (:func:`vipvflow.inputs.gtfs.iter_passes`,
   timed apart as ``passes_s``);
 * radiation and sun at each daytime pass from a per-minute table (nearest minute, one gather);
 * one Embree occlusion ray per daytime pass from the segment's roof point towards the sun;
@@ -44,7 +44,7 @@ def _tiles_of_route(data_dir: str, route: str) -> list[str]:
 
 def _minute_table(data_dir: str):
     """(t0, per-minute float32 columns dni, dhi, ghi, sun_x, sun_y, sun_z) for the year."""
-    from vipvflow.radiation import RadiationTable
+    from vipvflow.models.sun_sky import RadiationTable
 
     rad = RadiationTable.load(data_dir, YEAR)
     t = rad.t0 + np.arange(rad.n, dtype=np.float64) * rad.step_s
@@ -54,9 +54,9 @@ def _minute_table(data_dir: str):
 
 def _tile_work(data_dir: str, tiles: list[str], route: str, months: list[int]) -> dict:
     """Every pass of *tiles* x *months*: passes, lookup, rays, energy per trip."""
-    from vipvflow.shading import get_scene
+    from vipvflow.inputs.gtfs import iter_passes
+    from vipvflow.models.shading import get_scene
     from vipvflow.simulation.partition import _segments, tune_malloc
-    from vipvflow.trajectory import iter_passes
 
     tune_malloc()
     t_load = time.perf_counter()

@@ -8,7 +8,7 @@ Figures: wall time of the run (cluster start, per-tile geometry, 12 months x til
 partitions, reduce, report, manifest), segment passes and passes per second, peak RSS of
 the whole process tree (this process + nanny + workers), BVH builds, and where the
 workers' time goes: the per-partition timings of the manifest, with the irradiance time
-split by the stages of the fused kernel (:mod:`vipvflow.passkernel`: ``ray_setup`` is the
+split by the stages of the fused kernel (:mod:`vipvflow.models.passkernel`: ``ray_setup`` is the
 compiled loop that looks up the radiation and builds the ray batch, so ``lookup`` and
 ``pack`` are 0; ``rays`` the Embree query; ``components`` the compiled loop that sums the
 components into the partition's bins) next to pass generation, the per-trip/segment/hour

@@ -10,7 +10,7 @@ along the roof normal, as the pipeline does) towards the sun at random daytime m
 2024 (sun vector from the run's radiation table), 300 m long (``ray_length_m``).  In the
 database each ray is a ``LINESTRING Z`` and a ray is blocked when
 ``EXISTS (surface s: s.geom &&& ray AND ST_3DIntersects(s.geom, ray))``; the same rays go to
-:meth:`vipvflow.shading.Scene.occluded`.
+:meth:`vipvflow.models.shading.Scene.occluded`.
 
 Figures: rays per second of each (PostGIS: the query alone, rays already in a table; and
 with loading them), the ratio, and the agreement.  Every ray on which they disagree is
@@ -68,8 +68,8 @@ def ray_wkt(o: np.ndarray, d: np.ndarray) -> list[str]:
 
 def sun_rays(data_dir: Path, tile: str, n: int, seed: int = 7):
     """*n* rays (origins, unit directions) from the tile's roof points to the daytime sun."""
-    from vipvflow.irradiance import plane_normal, roof_plane
-    from vipvflow.radiation import RadiationTable
+    from vipvflow.models.sun_sky import RadiationTable
+    from vipvflow.models.view_factors import plane_normal, roof_plane
 
     seg = pd.read_parquet(data_dir / "gtfs" / "segments.parquet")
     seg = seg[seg["tile"] == tile]
@@ -160,8 +160,8 @@ def _largest_tile(data_dir: Path) -> str:
 
 
 def run(tiny: bool = False) -> dict:
-    from vipvflow.mesh import TileMesh
-    from vipvflow.shading import Scene, available_cores, occluded_reference
+    from vipvflow.models.mesh import TileMesh
+    from vipvflow.models.shading import Scene, available_cores, occluded_reference
 
     size = "small" if tiny else "full"
     prepare_demo(size)

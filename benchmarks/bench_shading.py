@@ -3,10 +3,10 @@
 Figures (all measured in one run, same process, same rays):
 - ``raw_embreex_rays_per_s``: ``EmbreeScene.run(..., query='OCCLUDED')`` on ready float32
   arrays, one thread;
-- ``kernel_rays_per_s_1thread``: :meth:`vipvflow.shading.Scene.occluded` on float64 world
+- ``kernel_rays_per_s_1thread``: :meth:`vipvflow.models.shading.Scene.occluded` on float64 world
   coordinates (origin shift, float32 conversion), one thread; ``kernel_vs_raw`` the ratio;
 - ``kernel_rays_per_s``: the same with the thread pool (all available cores);
-- ``passes_per_s`` / ``passes_per_s_per_core``: :func:`vipvflow.irradiance.evaluate_passes`
+- ``passes_per_s`` / ``passes_per_s_per_core``: :func:`vipvflow.models.irradiance.evaluate_passes`
   (radiation lookup, sun position, direct ray, diffuse, reflected with one ray per sample
   point of every sunlit reflector group, all-sky + clear-sky + unshaded) on a grid city of box
   buildings, default configuration (``reflector_points`` = 4, ``reflector_sampling`` =
@@ -28,7 +28,7 @@ import pandas as pd
 
 def grid_city(n_blocks: int, seed: int = 0, x0: float = 77_000.0, y0: float = 75_000.0):
     """Blocks of 2 x 2 box buildings (8-30 m high) between 20 m streets; returns mesh, streets."""
-    from vipvflow.shading import box_mesh
+    from vipvflow.models.shading import box_mesh
 
     rng = np.random.default_rng(seed)
     pitch, block, street = 80.0, 60.0, 20.0
@@ -68,9 +68,11 @@ def _best(fn, repeat: int) -> float:
 
 def run(tiny: bool = False) -> dict:
     from vipvflow.config import IrradianceCfg
-    from vipvflow.irradiance import evaluate_passes, segment_geometry
-    from vipvflow.radiation import COLUMNS, RadiationTable
-    from vipvflow.shading import Scene, available_cores
+    from vipvflow.inputs.cams import COLUMNS
+    from vipvflow.models.irradiance import evaluate_passes
+    from vipvflow.models.shading import Scene, available_cores
+    from vipvflow.models.sun_sky import RadiationTable
+    from vipvflow.models.view_factors import segment_geometry
 
     n_blocks = 4 if tiny else 28
     n_rays = 20_000 if tiny else 2_000_000
@@ -127,7 +129,7 @@ def run(tiny: bool = False) -> dict:
     # passes with any light (the rest, at night, are skipped by the engine)
     daylight = float(table.has_light(passes["t_utc"].to_numpy() + 0.75).mean())
     # --- the number of sample points per reflector group: cost and effect
-    from vipvflow.shading import Scene as _Scene
+    from vipvflow.models.shading import Scene as _Scene
 
     n_p = n_pass // 4
     per_p = {}

@@ -5,8 +5,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from vipvflow import pv
 from vipvflow.config import IrradianceCfg, PVSystem, load_config
+from vipvflow.models import pv
 from vipvflow.simulation.partition import COMPONENTS, RunContext, aggregate_partition
 
 

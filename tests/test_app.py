@@ -15,8 +15,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from vipvflow.horizon import horizon_at, horizon_profile
-from vipvflow.shading import Scene, box_mesh
+from vipvflow.models.horizon import horizon_at, horizon_profile
+from vipvflow.models.shading import Scene, box_mesh
 
 X0, Y0 = 77_000.0, 75_000.0        # LUREF-like coordinates: float32 precision must hold
 CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
@@ -104,7 +104,7 @@ def test_trip_model_agrees_with_ray_cast_run(trip_model, small_run):
     """The same scheduled trip, recomputed from horizons (rays where they cannot tell), against the
     simulation's result: unshaded energy equal, sun visibility from horizons equal to
     Embree's (but at the sampled azimuths' interpolation), total PV close."""
-    from vipvflow.shading import get_scene
+    from vipvflow.models.shading import get_scene
 
     res, date = _midday_trip(trip_model)
     te = pd.read_parquet(Path(small_run) / "trip_energy.parquet")

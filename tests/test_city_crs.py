@@ -14,9 +14,9 @@ import pytest
 from lxml import etree
 from pyproj import CRS, Transformer
 
-from vipvflow.city import ingest_city, load_tile_mesh
-from vipvflow.city.crs import SourceCRS, horizontal, local_utm, north_first, parse_srs_name
-from vipvflow.shading import Scene
+from vipvflow.inputs.city import ingest_city, load_tile_mesh
+from vipvflow.inputs.city.crs import SourceCRS, horizontal, local_utm, north_first, parse_srs_name
+from vipvflow.models.shading import Scene
 
 PLATEAU = ("citygml", "plateau_osaka", "52350301_bldg_6697_op.gml")
 TYPES = {"roof": "RoofSurface", "wall": "WallSurface", "ground": "GroundSurface"}
@@ -254,8 +254,8 @@ def test_axis_order_option_for_northing_first_files(tmp_path, capsys):
     """EPSG:2169 (LUREF) is northing first in EPSG, but Luxembourg fits its area of use either way
     round: `auto` reads easting first (as producers write); a file really written northing first
     is read right with --axis-order epsg."""
-    from vipvflow.city.synthetic import HEADER, building_xml, house_polygons
     from vipvflow.cli import main
+    from vipvflow.inputs.city.synthetic import HEADER, building_xml, house_polygons
 
     polys = house_polygons(77000.0, 75000.0, 300.0, 12, 10, 6, 3)
     swapped = {t: [r[:, [1, 0, 2]] for r in rings] for t, rings in polys.items()}

@@ -8,10 +8,10 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from vipvflow.city import TerrainModel, ingest_city, load_tile_mesh, parse_srs_name, prepare_polygon
-from vipvflow.city.geometry import Skip
 from vipvflow.config import CityCfg
 from vipvflow.errors import InputError
+from vipvflow.inputs.city import TerrainModel, ingest_city, load_tile_mesh, parse_srs_name, prepare_polygon
+from vipvflow.inputs.city.geometry import Skip
 
 NS1 = ('xmlns="http://www.opengis.net/citygml/1.0" xmlns:bldg="http://www.opengis.net/citygml/building/1.0" '
        'xmlns:gml="http://www.opengis.net/gml"')

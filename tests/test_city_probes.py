@@ -19,10 +19,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from vipvflow.city import ingest_city
-from vipvflow.city.ingest import remove_stale_ingests
-from vipvflow.city.synthetic import HEADER, building_xml, house_polygons, write_synthetic_city
 from vipvflow.cli import main
+from vipvflow.inputs.city import ingest_city
+from vipvflow.inputs.city.ingest import remove_stale_ingests
+from vipvflow.inputs.city.synthetic import HEADER, building_xml, house_polygons, write_synthetic_city
 
 SRS = "EPSG:2169"
 X0, Y0 = 77000.0, 75000.0
@@ -236,7 +236,7 @@ def test_repaired_probe_counted_in_summary(probe, tmp_path, capsys):
 # -- interruption ------------------------------------------------------------------------------
 KILL_SCRIPT = """
 import sys
-from vipvflow.city import ingest_city
+from vipvflow.inputs.city import ingest_city
 from vipvflow.config import CityCfg
 ingest_city(sys.argv[1], sys.argv[2], CityCfg(tile_size_m=100, buffer_m=20), chunk_surfaces=200)
 """

@@ -11,8 +11,8 @@ import pytest
 import shapely
 from lxml import etree
 
-from vipvflow.city import TerrainModel, ingest_city, load_tile_mesh
 from vipvflow.errors import InputError
+from vipvflow.inputs.city import TerrainModel, ingest_city, load_tile_mesh
 
 TYPES = {"roof": "RoofSurface", "wall": "WallSurface", "ground": "GroundSurface"}
 

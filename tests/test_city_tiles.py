@@ -13,12 +13,12 @@ import pytest
 from embreex import rtcore_scene
 from embreex.mesh_construction import TriangleMesh
 
-from vipvflow.city import SURFACE_TYPES, ingest_city, load_tile_mesh
-from vipvflow.city.synthetic import write_synthetic_city
 from vipvflow.cli import main
 from vipvflow.config import CityCfg
 from vipvflow.errors import InputError
-from vipvflow.tiles import tile_bounds, tile_names
+from vipvflow.inputs.city import SURFACE_TYPES, ingest_city, load_tile_mesh
+from vipvflow.inputs.city.synthetic import write_synthetic_city
+from vipvflow.inputs.tiles import tile_bounds, tile_names
 
 
 @pytest.fixture(scope="module")
@@ -114,7 +114,7 @@ PROBE = textwrap.dedent("""
     import gc, json, resource, sys, threading
     import psutil
     import geopandas, numpy, pyproj, shapely  # the baseline every run pays
-    from vipvflow.city import ingest_city
+    from vipvflow.inputs.city import ingest_city
     from vipvflow.config import CityCfg
     proc = psutil.Process()
     gc.collect()

@@ -79,7 +79,7 @@ def test_cams_fetch_writes_the_service_csv(cams_service, tmp_path, monkeypatch, 
                       "summarization": "PT01M", "username": "someone%40example.org", "verbose": "true"}
     assert "Identifier=get_cams_radiation" in path and "RawDataOutput=irradiation" in path
     # and what it wrote is what the ingest reads
-    from vipvflow.radiation import read_cams_file
+    from vipvflow.inputs.cams import read_cams_file
 
     frame, meta = read_cams_file(target)
     assert len(frame) > 0

@@ -7,7 +7,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from vipvflow import cli, economics
+from vipvflow import cli
+from vipvflow.models import economics
 
 
 def _number(text: str, label: str) -> float:

@@ -13,9 +13,9 @@ from lxml import etree
 
 from vipvflow.cli import main
 from vipvflow.errors import InputError
-from vipvflow.export import read_dynamizers, reflector_contributions, validate, write_dynamizers
-from vipvflow.export import dynamizer as dz
-from vipvflow.export.citygml3 import NSMAP, SCHEMA_LOCATIONS, srs_name, vertical_epsg
+from vipvflow.outputs import read_dynamizers, reflector_contributions, validate, write_dynamizers
+from vipvflow.outputs import dynamizer as dz
+from vipvflow.outputs.citygml3 import NSMAP, SCHEMA_LOCATIONS, srs_name, vertical_epsg
 
 SAMPLE_V3 = ("citygml", "samples", "citygml4j_lod2_buildings_v3.gml")
 NS = {k: v for k, v in NSMAP.items() if k != "xsi"}
@@ -259,7 +259,7 @@ def test_reflector_attribution_reads_the_surfaces_the_run_found(small_run):
     share never exceeds its groups' weight on surfaces."""
     import re
 
-    from vipvflow.mesh import TileMesh
+    from vipvflow.models.mesh import TileMesh
     from vipvflow.store import DataDir, RunDir
 
     run = dz.load_run(small_run)

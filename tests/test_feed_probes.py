@@ -151,7 +151,7 @@ def test_shapeless_vbb_like_feed_segments(tmp_path):
 
     from gtfs_probe_feeds import STOPS
     from vipvflow.config import TrajectoryCfg
-    from vipvflow.trajectory import ingest_gtfs
+    from vipvflow.inputs.gtfs import ingest_gtfs
 
     feed = write_feed(tmp_path / "vbb.zip", vbb_like_tables())
     report = ingest_gtfs(feed, tmp_path / "data", TrajectoryCfg())
@@ -186,7 +186,7 @@ def test_frequencies_exact_times(tmp_path):
     """exact_times 1: departures 08:00, 08:10, ... 08:50 (6); exact_times 0: every 20 min
     from 10:00 before 11:00 (3); the headway-based rows are named."""
     from vipvflow.config import TrajectoryCfg
-    from vipvflow.trajectory import ingest_gtfs
+    from vipvflow.inputs.gtfs import ingest_gtfs
 
     t = vbb_like_tables()
     t["frequencies.txt"] = ("trip_id,start_time,end_time,headway_secs,exact_times\n"

@@ -9,10 +9,11 @@ import pvlib
 import pytest
 
 from vipvflow.config import IrradianceCfg
-from vipvflow.irradiance import (evaluate_passes, roof_irradiance, roof_plane, segment_geometry,
-                                 sun_vector)
-from vipvflow.radiation import COLUMNS, RadiationTable
-from vipvflow.shading import Scene, box_mesh
+from vipvflow.models.irradiance import evaluate_passes, roof_irradiance
+from vipvflow.models.view_factors import roof_plane, segment_geometry, sun_vector
+from vipvflow.inputs.cams import COLUMNS
+from vipvflow.models.sun_sky import RadiationTable
+from vipvflow.models.shading import Scene, box_mesh
 
 LONG = 3000.0     # half length of "infinite" walls (m)
 
@@ -218,7 +219,7 @@ def test_sky_view_factor_diffuse_mode():
 
 def _canyon(H, W, rho_wall=0.35, rho_road=0.15):
     """Infinite canyon (walls along y) with its road as ground triangles in the mesh."""
-    from vipvflow.mesh import SURFACE_CODE, TileMesh
+    from vipvflow.models.mesh import SURFACE_CODE, TileMesh
 
     walls = box_mesh([[-W / 2 - 20, -LONG, 0, -W / 2, LONG, H],
                       [W / 2, -LONG, 0, W / 2 + 20, LONG, H]], albedo_wall=rho_wall)
@@ -351,7 +352,7 @@ def test_exchange_weights_are_the_radiosity_solution():
     m_B = (w_B + w_A f_A) / (1 - f_A f_B).  One facade and its street (f_s of the street
     from the facade, f_w of the facade from the street): m = w / (1 - f_s f_w) for the
     facade and w f_s / (1 - f_s f_w) for the street."""
-    from vipvflow.irradiance import _exchange_weights
+    from vipvflow.models.view_factors import _exchange_weights
 
     wA, wB, fA, fB = 0.06, 0.04, 0.12, 0.09
     m = _exchange_weights(np.array([[wA, wB]]), np.zeros((1, 2)), np.array([[fA, fB]]),

@@ -128,8 +128,8 @@ def test_site_ghi_is_the_year_of_minutes(tmp_path):
 def test_footprints_are_the_city_ground_surfaces(small_config):
     """One footprint per building of the small demo city (its ground surfaces), in metres of
     EPSG:2169 around the routes."""
-    from vipvflow.city.footprints import building_footprints
     from vipvflow.config import load_config
+    from vipvflow.inputs.city.footprints import building_footprints
     from vipvflow.simulation.prepare import ensure_ingested
 
     cfg = load_config(small_config)
@@ -157,7 +157,7 @@ def test_monthly_chart_stacks_driving_in_service_and_whole_day(small_run):
     """The monthly chart's bars: driving, then terminals on top (in service), then parked
     time (whole day), each month's stack summing to the monthly table's whole-day yield, in
     the proportions of the summary's three yields (kWh/kWp)."""
-    from vipvflow.simulation.report import fig_monthly
+    from vipvflow.outputs.report import fig_monthly
 
     monthly = pd.read_parquet(small_run / "monthly.parquet")
     s = json.loads((small_run / "summary.json").read_text())
@@ -179,7 +179,7 @@ def test_monthly_chart_stacks_driving_in_service_and_whole_day(small_run):
 
 def test_close_up_is_on_the_canyons(small_run):
     """The map's close-up window holds the segment whose roof sees the least sky."""
-    from vipvflow.simulation.report import CLOSE_UP_M, close_up_window
+    from vipvflow.outputs.report import CLOSE_UP_M, close_up_window
 
     seg = gpd.read_parquet(small_run / "segments.parquet")
     xmin, ymin, xmax, ymax = close_up_window(seg)
@@ -195,7 +195,7 @@ def test_app_map_draws_the_same_footprints(small_run):
 
     from vipvflow.app.layout import build_document
     from vipvflow.app.model import TripModel
-    from vipvflow.city.footprints import building_footprints
+    from vipvflow.inputs.city.footprints import building_footprints
 
     model = TripModel(small_run)
     doc = Document()

@@ -5,11 +5,13 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from vipvflow import passkernel
 from vipvflow.config import IrradianceCfg
-from vipvflow.irradiance import COMPONENTS, evaluate_passes, pack_geometry, segment_geometry
-from vipvflow.radiation import COLUMNS, RadiationTable
-from vipvflow.shading import Scene, box_mesh
+from vipvflow.inputs.cams import COLUMNS
+from vipvflow.models import passkernel
+from vipvflow.models.irradiance import evaluate_passes
+from vipvflow.models.shading import Scene, box_mesh
+from vipvflow.models.sun_sky import RadiationTable
+from vipvflow.models.view_factors import COMPONENTS, pack_geometry, segment_geometry
 
 LAT, LON, ALT = 49.61, 6.13, 300.0
 
@@ -46,7 +48,7 @@ def _clear_day_table(day: str):
 def _canyon_scene(H=16.0, W=18.0, L=400.0):
     """A street canyon along y (facades of two blocks) over a road in the mesh, and a
     tower at its end."""
-    from vipvflow.mesh import SURFACE_CODE, TileMesh
+    from vipvflow.models.mesh import SURFACE_CODE, TileMesh
 
     walls = box_mesh([[-W / 2 - 20, -L, 0, -W / 2, L, H], [W / 2, -L, 0, W / 2 + 20, L, H],
                       [-30, L + 10, 0, 30, L + 40, 60]], albedo_wall=0.35)
@@ -102,8 +104,8 @@ def test_fused_equals_numpy_on_the_demo_passes(small_run, small_config):
     the numpy reference's, and so do the partition sums it accumulates without per-pass
     outputs (trip, segment and hourly tables of :func:`aggregate_partition`)."""
     from vipvflow.config import load_config
+    from vipvflow.inputs.gtfs import iter_passes
     from vipvflow.simulation import partition as part
-    from vipvflow.trajectory import iter_passes
 
     cfg = load_config(small_config)
     data_dir = str(cfg.data_dir)

@@ -82,7 +82,7 @@ def test_citygml_bytes_and_positions(tmp_path, test_data):
 
 
 def test_ingest_reports_bytes_read(demo_small, tmp_path, capsys):
-    from vipvflow.city import ingest_city
+    from vipvflow.inputs.city import ingest_city
 
     gml = demo_small / "demo_city.gml"
     ingest_city([gml], tmp_path / "data")
@@ -92,7 +92,7 @@ def test_ingest_reports_bytes_read(demo_small, tmp_path, capsys):
 
 
 def test_dashboard_on_8787_when_free_else_any_port():
-    from vipvflow.simulation.run import dashboard_address
+    from vipvflow.simulation.cluster import dashboard_address
 
     with socket.socket() as s:
         s.bind(("", 0))

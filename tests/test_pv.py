@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from vipvflow.config import PVSystem
-from vipvflow.pv import energy, energy_paper, power_pvlib
+from vipvflow.models.pv import energy, energy_paper, power_pvlib
 
 SYSTEM = PVSystem(name="t", kwp=3.5, roof_area_m2=30.0, area_share=0.6, performance_ratio=0.75)
 

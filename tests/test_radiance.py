@@ -55,9 +55,10 @@ pr = pytest.importorskip(
 import pvlib  # noqa: E402
 
 from vipvflow.config import IrradianceCfg  # noqa: E402
-from vipvflow.irradiance import roof_irradiance, segment_geometry, sun_vector  # noqa: E402
-from vipvflow.mesh import SURFACE_CODE, TileMesh  # noqa: E402
-from vipvflow.shading import Scene  # noqa: E402
+from vipvflow.models.irradiance import roof_irradiance
+from vipvflow.models.mesh import SURFACE_CODE, TileMesh  # noqa: E402
+from vipvflow.models.shading import Scene  # noqa: E402
+from vipvflow.models.view_factors import segment_geometry, sun_vector  # noqa: E402
 
 GROUND_HALF = 1000.0                           # half side of the road plane (m)
 ROOF_Z = 3.2                                   # bus roof height (m)

@@ -9,8 +9,8 @@ import pvlib
 import pytest
 
 from vipvflow.errors import InputError
-from vipvflow.radiation import (FLAG_GAP, FLAG_NEGATIVE, FLAG_NO_ALLSKY, RadiationTable,
-                                ingest_cams, read_cams_file)
+from vipvflow.inputs.cams import FLAG_GAP, FLAG_NEGATIVE, FLAG_NO_ALLSKY, ingest_cams, read_cams_file
+from vipvflow.models.sun_sky import RadiationTable
 
 
 @pytest.fixture(scope="module")

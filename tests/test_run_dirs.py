@@ -74,7 +74,7 @@ def test_app_model_from_root_on_a_copied_run(copied_run, monkeypatch):
 
 def test_dynamizer_export_of_a_copied_run_from_root_equals_the_original(small_run, copied_run,
                                                                           tmp_path, monkeypatch):
-    from vipvflow.export import write_dynamizers
+    from vipvflow.outputs import write_dynamizers
 
     monkeypatch.chdir("/")
     original = write_dynamizers(small_run, tmp_path / "original.gml")

@@ -4,8 +4,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from vipvflow import shading
-from vipvflow.shading import Scene, box_mesh, get_scene, occluded_reference
+from vipvflow.models import shading
+from vipvflow.models.shading import Scene, box_mesh, get_scene, occluded_reference
 
 X0, Y0 = 77_000.0, 75_000.0       # LUREF-like coordinates: precision must survive float32
 

@@ -178,7 +178,7 @@ def test_physics_sanity(small_run, demo_small):
 def test_vecto_cycles_written_and_vmod_replaces_consumption(small_run, small_config, tmp_path, test_data):
     import shutil
 
-    from vipvflow import vecto
+    from vipvflow.outputs import vecto
     from vipvflow.simulation.reduce import trip_consumption
 
     cfg = load_config(small_config)
@@ -242,7 +242,7 @@ def _busy(seconds: float) -> int:
 def test_local_cluster_profiles_workers_only_when_asked(small_config, tmp_path, profile):
     import dask
 
-    from vipvflow.simulation.run import LOCAL_CLUSTER_DASK_CONFIG, make_client
+    from vipvflow.simulation.cluster import LOCAL_CLUSTER_DASK_CONFIG, make_client
 
     cfg = _cfg(small_config, tmp_path, worker_profile=profile)
     client, cluster = make_client(cfg, None, 1)

@@ -8,8 +8,8 @@ import pandas as pd
 import pytest
 
 from vipvflow.cli import main
-from vipvflow.shading import box_mesh
-from vipvflow.track import fit_stats, headings
+from vipvflow.models.shading import box_mesh
+from vipvflow.simulation.track import fit_stats, headings
 
 X0, Y0 = 77_000.0, 75_000.0
 

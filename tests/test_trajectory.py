@@ -14,9 +14,9 @@ import shapely
 from pyproj import Transformer
 
 from vipvflow.config import CycleCfg, TrajectoryCfg
-from vipvflow.trajectory import (driving_cycle, ingest_gtfs, iter_passes, passes_for_trip,
-                                 pattern_cycle, service_dates)
-from vipvflow.trajectory.segments import build_segments
+from vipvflow.models.driving_cycle import driving_cycle, pattern_cycle
+from vipvflow.inputs.gtfs import ingest_gtfs, iter_passes, passes_for_trip, service_dates
+from vipvflow.inputs.gtfs.segments import build_segments
 
 HERE = Path(__file__).resolve().parent
 ISRAEL = HERE / "data" / "gtfs" / "israel_route_2126"

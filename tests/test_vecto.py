@@ -9,7 +9,8 @@ import pandas as pd
 import pytest
 
 from test_vehicle import trapezoid_cycle
-from vipvflow import cli, vecto
+from vipvflow import cli
+from vipvflow.outputs import vecto
 from vipvflow.config import load_config
 from vipvflow.errors import InputError
 

@@ -7,7 +7,7 @@ import pytest
 from pydantic import ValidationError
 
 from vipvflow.config import load_config
-from vipvflow.vehicle import G, VehicleParams, infer_blocks, simulate_cycle, soc_trace
+from vipvflow.models.vehicle import G, VehicleParams, infer_blocks, simulate_cycle, soc_trace
 
 
 def trapezoid_cycle(legs: int, spacing_m: float, vmax: float, accel: float, decel: float,

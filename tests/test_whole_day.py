@@ -8,11 +8,12 @@ import pvlib
 import pytest
 
 from vipvflow.config import IrradianceCfg, TrajectoryCfg
-from vipvflow.radiation import COLUMNS, RadiationTable
-from vipvflow.shading import Scene, box_mesh
+from vipvflow.inputs.cams import COLUMNS
+from vipvflow.inputs.gtfs import ingest_gtfs, passes_for_trip
+from vipvflow.inputs.gtfs.schedule import block_timeline, service_day_origin_utc
+from vipvflow.models.shading import Scene, box_mesh
+from vipvflow.models.sun_sky import RadiationTable
 from vipvflow.simulation.standing import interval_integrals, open_scene, point_geometry
-from vipvflow.trajectory import ingest_gtfs, passes_for_trip
-from vipvflow.trajectory.schedule import block_timeline, service_day_origin_utc
 
 LAT, LON, ALT = 49.61, 6.13, 300.0
 LONG = 3000.0        # half length of an "infinite" wall (m)
@@ -193,7 +194,7 @@ def test_timeline_partitions_every_block_day(small_feed):
 
 
 def test_block_day_balance_by_hand():
-    from vipvflow.vehicle import VehicleParams, block_day_balance
+    from vipvflow.models.vehicle import VehicleParams, block_day_balance
 
     params = VehicleParams(curb_mass_kg=12000, cda_m2=6.0, crr=0.007, motor_power_kw=250,
                            motor_torque_nm=2000, battery_kwh=100.0, soc_min=0.2, soc_max=0.9)
@@ -327,7 +328,7 @@ def test_open_depot_run_parks_under_the_open_sky(small_run, small_config, tmp_pa
     """A configured depot in the open: every parked interval of the run holds the flat roof's
     open-sky irradiation, DNI cos(zenith) + DHI, of the radiation table minute by minute."""
     from vipvflow.config import load_config
-    from vipvflow.radiation import RadiationTable
+    from vipvflow.models.sun_sky import RadiationTable
     from vipvflow.simulation import run_simulation
 
     cfg = load_config(small_config, overrides={

@@ -277,8 +277,8 @@ class Config(_Model):
                               CONF_DIR / "pv_systems.yaml", "pv.system")
 
     def vehicle_params(self):
-        """The vehicle chosen by ``vehicle.model`` (a :class:`vipvflow.vehicle.VehicleParams`)."""
-        from .vehicle import VehicleParams
+        """The vehicle chosen by ``vehicle.model`` (a :class:`vipvflow.models.vehicle.VehicleParams`)."""
+        from .models.vehicle import VehicleParams
 
         catalog = _read_yaml(CONF_DIR / "vehicles.yaml")
         return _catalog_entry(catalog, self.vehicle.model, self.vehicle.overrides,

@@ -137,7 +137,7 @@ class RadiationDir:
 
     def sun_cache(self, first_s: int, n: int) -> Path:
         """Sun vectors of the table's grid from *first_s* (Unix s), *n* steps, kept for the
-        workers of a run (:func:`vipvflow.radiation._cached_sun`)."""
+        workers of a run (:func:`vipvflow.models.sun_sky._cached_sun`)."""
         return self.root / f"sun_{first_s}_{n}.npz"
 
 

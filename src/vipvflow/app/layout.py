@@ -79,7 +79,7 @@ def month_labels(months) -> list[str]:
 
 @lru_cache(maxsize=4)
 def _footprints(data_dir: str, tiles: tuple, bounds: tuple) -> tuple[list, list]:
-    from ..city.footprints import building_footprints
+    from ..inputs.city.footprints import building_footprints
 
     rings = building_footprints(data_dir, tiles=tiles, bounds=bounds)
     return [r[:, 0].tolist() for r in rings], [r[:, 1].tolist() for r in rings]

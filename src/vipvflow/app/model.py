@@ -11,24 +11,24 @@ casting:
   requested time on the chosen date (the last one of the day when none leaves later; a
   trip of another service day, placed on the date, when the route does not run that day);
 * per segment, at the middle of the time the bus spends on it (as the simulation does):
-  sun and CAMS radiation from :class:`vipvflow.radiation.RadiationTable`, and the run's
-  components summed by the simulation's own :func:`vipvflow.irradiance.roof_components`:
+  sun and CAMS radiation from :class:`vipvflow.models.sun_sky.RadiationTable`, and the run's
+  components summed by the simulation's own :func:`vipvflow.models.irradiance.roof_components`:
   direct ``DNI max(cos AOI, 0)`` when the sun's elevation exceeds the segment's horizon
-  profile interpolated at the sun's azimuth (:mod:`vipvflow.horizon`), the simulation's own
+  profile interpolated at the sun's azimuth (:mod:`vipvflow.models.horizon`), the simulation's own
   occlusion ray deciding where the profile cannot (within 1 deg of it, or at a building's
   edge between two azimuth bins); diffuse with the
   run's model (``DHI x SVF`` or the paper's isotropic ``DHI (1 + cos tilt) / 2``); reflected
-  from the stored reflectors (:func:`vipvflow.irradiance.pack_geometry`: the facade groups and
+  from the stored reflectors (:func:`vipvflow.models.view_factors.pack_geometry`: the facade groups and
   the street, their exchange folded in), each lit in the fraction of its stored sample points
   that see the sun: one occlusion query per trip against the tile meshes of the run's data
   directory (about 1e5 rays, milliseconds), the expectation of the simulation's one point
   per pass, whose per-pass standard deviation is given as ``reflected_sd``; the unshaded
   reference ``DNI max(cos AOI, 0) + DHI (1 + cos tilt) / 2``;
-* PV: the simulation's dispatcher :func:`vipvflow.pv.energy` (paper mode ``kWp x POA / 1000
+* PV: the simulation's dispatcher :func:`vipvflow.models.pv.energy` (paper mode ``kWp x POA / 1000
   x PR x dt / 3600`` or pvlib mode, PVWatts at a SAPM cell temperature cooled by the bus's
   speed);
-* consumption: the pattern's 2 s driving cycle (:func:`vipvflow.trajectory.pattern_cycle`)
-  through :func:`vipvflow.vehicle.simulate_cycle` with the chosen auxiliary base load
+* consumption: the pattern's 2 s driving cycle (:func:`vipvflow.models.driving_cycle.pattern_cycle`)
+  through :func:`vipvflow.models.vehicle.simulate_cycle` with the chosen auxiliary base load
   (HVAC at the month's mean temperature on top), and the state of charge over the trip
   with and without PV.
 """
@@ -43,7 +43,7 @@ import numpy as np
 import pandas as pd
 
 from ..config import Config, PVSystem
-from ..irradiance import shading_loss
+from ..models.irradiance import shading_loss
 from ..store import DataDir, RunDir
 
 #: PV technologies offered: PVWatts temperature coefficient of power (1/K, typical datasheet
@@ -105,7 +105,7 @@ class PVChoice:
         """kW per kW/m2 of POA, for rescaling stored energies (paper: kWp x PR; pvlib:
         kWp x (1 - losses) x inverter efficiency, temperature effects not rescaled)."""
         if self.mode == "paper":
-            from ..pv import paper_kw_per_wm2
+            from ..models.pv import paper_kw_per_wm2
 
             return 1000.0 * paper_kw_per_wm2(self.peak_kw, self.performance_ratio)
         return self.peak_kw * (1 - self.losses_percent / 100.0) * self.inverter_efficiency
@@ -161,10 +161,10 @@ class TripModel:
     """
 
     def __init__(self, run_dir):
-        from ..horizon import horizon_columns, load_horizons
-        from ..irradiance import pack_geometry
-        from ..radiation import RadiationTable
-        from ..trajectory import service_dates
+        from ..models.horizon import horizon_columns, load_horizons
+        from ..models.view_factors import pack_geometry
+        from ..models.sun_sky import RadiationTable
+        from ..inputs.gtfs import service_dates
 
         from ..simulation.rundir import open_run
 
@@ -264,17 +264,17 @@ class TripModel:
     # ------------------------------------------------------------------ compute
     @lru_cache(maxsize=64)
     def _cycle(self, pattern_id: int) -> pd.DataFrame:
-        from ..trajectory import pattern_cycle
+        from ..models.driving_cycle import pattern_cycle
 
         return pattern_cycle(self.data_dir, pattern_id, self.cfg.trajectory.cycle)
 
     def _origin_utc(self, date) -> float:
-        from ..trajectory import service_day_origin_utc
+        from ..inputs.gtfs import service_day_origin_utc
 
         return float(service_day_origin_utc([pd.Timestamp(date)], self.timezone)[0])
 
     def _scene(self, tile: str):
-        from ..shading import get_scene
+        from ..models.shading import get_scene
 
         return get_scene(self.data_dir, tile, cache_size=64)
 
@@ -310,7 +310,7 @@ class TripModel:
 
     def sun_visible(self, rows, sun, elevation_deg, azimuth_deg, in_front) -> np.ndarray:
         """Whether the sun reaches the roof point, (n,) bool: from the stored horizon profile
-        (:func:`vipvflow.horizon.sun_visible`), and where the profile cannot tell (the sun
+        (:func:`vipvflow.models.horizon.sun_visible`), and where the profile cannot tell (the sun
         within ``HORIZON_BAND_DEG`` of it, or in an azimuth bin where it jumps by more than
         that: a building's edge) from the simulation's own occlusion ray, so the app's direct
         light is the run's.
@@ -323,7 +323,7 @@ class TripModel:
         in_front : (n,) bool, passes with the sun up and in front of the roof (the others
             get no direct light whatever the answer)
         """
-        from ..horizon import horizon_at
+        from ..models.horizon import horizon_at
 
         prof = self._horizon[rows]
         h = horizon_at(prof, azimuth_deg)
@@ -356,7 +356,8 @@ class TripModel:
         estimate of the reflected beam for that pass), ``sun_visible`` (bool),
         ``elevation, azimuth`` (deg), ``ghi, dni, dhi`` (W/m2).
         """
-        from ..irradiance import ROULETTE_WEIGHT, isotropic_sky_view, roof_components
+        from ..models.irradiance import ROULETTE_WEIGHT, roof_components
+        from ..models.view_factors import isotropic_sky_view
 
         f32 = np.float32
         rows = self._row[np.asarray(segment_ids, np.int64)]
@@ -398,8 +399,8 @@ class TripModel:
 
     def pv_energy(self, poa, dt_s, speed_mps, month: int, pv: PVChoice) -> np.ndarray:
         """PV energy (kWh) of each pass at POA irradiance *poa* (W/m2) for *dt_s* (s), with
-        the simulation's dispatcher :func:`vipvflow.pv.energy`."""
-        from .. import pv as pvmod
+        the simulation's dispatcher :func:`vipvflow.models.pv.energy`."""
+        from ..models import pv as pvmod
 
         return pvmod.energy(poa, dt_s, pv.system(), pv.mode,
                             temp_air_c=self.cfg.climate.monthly_mean_temperature_c[month - 1],
@@ -410,7 +411,7 @@ class TripModel:
         """The vehicle along the trip's driving cycle, with and without the PV *energy* (kWh per
         segment pass): (parameters, SoC at departure, consumption, the per-second cycle with SoC
         and cumulative kWh)."""
-        from ..vehicle import simulate_cycle
+        from ..models.vehicle import simulate_cycle
 
         tz = self.timezone
         params = self.vehicle
@@ -460,7 +461,7 @@ class TripModel:
         soc_start, soc_min : SoC at the trip's start and the lower limit (0..1; defaults:
             the vehicle's ``soc_max`` and ``soc_min``)
         """
-        from ..vehicle import soc_trace
+        from ..models.vehicle import soc_trace
 
         t0 = time.perf_counter()
         pv = pv or self.run_pv_choice

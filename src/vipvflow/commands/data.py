@@ -100,7 +100,7 @@ def fetch_cams(entry: dict, year: int, email: str, target: Path, timeout: float 
     """Download a CAMS year into *target* as the service's CSV (what ``ingest cams`` reads);
     returns its number of data lines. One-line :class:`InputError` on a service or network error or an
     answer that is not a CAMS CSV, and then *target* is left as it was."""
-    from ..radiation import read_cams_file
+    from ..inputs.cams import read_cams_file
 
     url = cams_request_url(entry, year, email)
     host = urllib.parse.urlsplit(url).netloc

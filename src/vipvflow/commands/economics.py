@@ -14,9 +14,9 @@ from pathlib import Path
 
 import pandas as pd
 
-from .. import economics
 from ..config import load_config
 from ..errors import InputError
+from ..models import economics
 from . import add_config
 
 

@@ -43,7 +43,7 @@ def register(sub):
 
 
 def run(args):
-    from ..export import write_dynamizers
+    from ..outputs import write_dynamizers
     from ..simulation.rundir import open_run
 
     open_run(args.run_dir)      # the run and its data dir, or one line saying what is missing

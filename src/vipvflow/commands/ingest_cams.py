@@ -23,7 +23,7 @@ def register(sub):
 
 
 def run(args):
-    from ..radiation import ingest_cams
+    from ..inputs.cams import ingest_cams
 
     cfg = load_config(args.config)
     files = list(args.files) or list(cfg.inputs.cams)

@@ -35,7 +35,7 @@ def register(sub):
 
 def run(args):
     set_quiet(args.quiet)
-    from ..city import ingest_city
+    from ..inputs.city import ingest_city
 
     cfg = load_config(args.config)
     files = list(args.files) or list(cfg.inputs.citygml)

@@ -27,7 +27,7 @@ def register(sub):
 
 def run(args) -> int:
     from ..config import load_config
-    from ..trajectory import ingest_gtfs
+    from ..inputs.gtfs import ingest_gtfs
 
     cfg = load_config(args.config)
     report = ingest_gtfs(Path(args.feed), Path(args.data_dir), cfg.trajectory, crs=args.crs,

@@ -27,8 +27,8 @@ def register(sub):
 
 
 def run(args):
-    from ..radiation import RadiationTable
-    from ..track import fit_stats, model_track, read_track
+    from ..models.sun_sky import RadiationTable
+    from ..simulation.track import fit_stats, model_track, read_track
 
     cfg = load_config(args.config)
     if (args.city / "manifest.json").is_file():      # a run folder: the city of its data dir

@@ -3,9 +3,9 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from .. import vecto
 from ..config import load_config
-from ..vehicle import simulate_cycle
+from ..models.vehicle import simulate_cycle
+from ..outputs import vecto
 from . import add_config
 
 

@@ -60,13 +60,13 @@ def _segments(data_dir: str) -> pd.DataFrame:
 
 @lru_cache(maxsize=2)
 def _radiation(data_dir: str, year: int):
-    from ..radiation import RadiationTable
+    from ..models.sun_sky import RadiationTable
 
     return RadiationTable.load(data_dir, year)
 
 
 def _scene(ctx: RunContext, tile: str):
-    from ..shading import get_scene
+    from ..models.shading import get_scene
 
     return get_scene(ctx.data_dir, tile, cache_size=ctx.bvh_cache_size, n_threads=ctx.ray_threads)
 
@@ -103,7 +103,7 @@ def tune_malloc(mmap_threshold: int = 32 << 20, trim_threshold: int = 128 << 20)
 def _packed_geometry(ctx: RunContext, tile: str, geometry: pd.DataFrame, scene) -> dict:
     """The tile's geometry packed for the hot path, once per worker while the same geometry
     table and scene stay in memory (a bounded cache, like the scenes')."""
-    from ..irradiance import pack_geometry
+    from ..models.view_factors import pack_geometry
 
     key = (ctx.run_dir, tile)
     hit = _PACKED.get(key)
@@ -120,10 +120,10 @@ def _packed_geometry(ctx: RunContext, tile: str, geometry: pd.DataFrame, scene) 
 def tile_geometry(ctx: RunContext, tile: str) -> pd.DataFrame:
     """Per-segment geometry factors of a tile (sky view factor, reflector groups), computed
     once per run and stored in ``parts/geometry/tile=<TILE>.parquet``, and the segments'
-    horizon profiles (:func:`vipvflow.horizon.horizon_profile` from the roof ray origins)
+    horizon profiles (:func:`vipvflow.models.horizon.horizon_profile` from the roof ray origins)
     in ``parts/horizon/tile=<TILE>.parquet``, so a trip can be recomputed without rays."""
-    from ..horizon import horizon_frame, horizon_profile
-    from ..irradiance import segment_geometry
+    from ..models.horizon import horizon_frame, horizon_profile
+    from ..models.view_factors import segment_geometry
 
     path = RunDir(ctx.run_dir).tile_part("geometry", tile)
     if path.exists():
@@ -146,7 +146,7 @@ def tile_geometry(ctx: RunContext, tile: str) -> pd.DataFrame:
 
 def pv_energy_kwh(poa_wm2: np.ndarray, dt_s: np.ndarray, speed_mps: np.ndarray, month: int,
                   ctx: RunContext) -> np.ndarray:
-    """PV energy per pass in the run's PV mode (:func:`vipvflow.pv.energy`), at the month's
+    """PV energy per pass in the run's PV mode (:func:`vipvflow.models.pv.energy`), at the month's
     mean air temperature and the run's wind.
 
     Parameters
@@ -166,7 +166,7 @@ def pv_energy_kwh(poa_wm2: np.ndarray, dt_s: np.ndarray, speed_mps: np.ndarray, 
     Paper section 3.3 (``kWp x POA / 1000 x PR x dt``); pvlib ``pvsystem.pvwatts_dc``,
     ``temperature.sapm_cell`` (``pvlib`` mode).
     """
-    from .. import pv
+    from ..models import pv
 
     return pv.energy(poa_wm2, dt_s, PVSystem(**ctx.pv_system), ctx.pv_mode,
                      temp_air_c=ctx.monthly_temperature_c[month - 1],
@@ -205,13 +205,13 @@ def _dense_positions(ids: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 def partition_groups(passes: pd.DataFrame, ctx: RunContext) -> dict:
     """Each pass's (trip, service date) run, segment position and local hour, and the
-    seconds per run, segment and hour (:func:`vipvflow.passkernel.pass_groups`).
+    seconds per run, segment and hour (:func:`vipvflow.models.passkernel.pass_groups`).
 
     Returns its dict with ``trip_code``, ``trip_uniques``, ``day`` (days since 1970) and
     ``dt`` (n,) s on the segment.  The runs come from the pass order (sorted by service
-    date, trip and time, as :func:`vipvflow.trajectory.iter_passes` gives them).
+    date, trip and time, as :func:`vipvflow.inputs.gtfs.iter_passes` gives them).
     """
-    from ..passkernel import pass_groups
+    from ..models.passkernel import pass_groups
 
     # trip codes in the order of the trip names (categories are sorted by iter_passes)
     trip_col = passes["trip_id"]
@@ -264,20 +264,20 @@ def aggregate_partition(passes: pd.DataFrame, irr: pd.DataFrame | None, month: i
     Parameters
     ----------
     passes : DataFrame of the partition's passes (``trip_id, service_date, segment_id,
-        t_utc, dt_s, speed_mps``), in :func:`vipvflow.trajectory.iter_passes` order
-    irr : DataFrame of per-pass irradiance (W/m2, :func:`vipvflow.irradiance.evaluate_passes`),
+        t_utc, dt_s, speed_mps``), in :func:`vipvflow.inputs.gtfs.iter_passes` order
+    irr : DataFrame of per-pass irradiance (W/m2, :func:`vipvflow.models.irradiance.evaluate_passes`),
         or None with *bins*
     month : int, 1..12 (the month's air temperature in ``pvlib`` mode)
     ctx : RunContext
     groups : dict, optional, :func:`partition_groups` of *passes* when the caller has it
     bins : (seg_bins, run_bins), optional, irradiation (Wh/m2) already summed per (segment x
         24 + local hour) bin and per run, columns ``COMPONENTS`` (the fused kernel,
-        :func:`vipvflow.passkernel.accumulate`); only in the linear ``paper`` PV mode
+        :func:`vipvflow.models.passkernel.accumulate`); only in the linear ``paper`` PV mode
 
     Notes
     -----
     Irradiation ``H = sum E dt / 3600`` (Wh/m2); in ``paper`` mode the energy is linear in
-    it, ``kWh = kWp x PR x H / 1000`` (:func:`vipvflow.pv.energy_paper`); in ``pvlib`` mode
+    it, ``kWh = kWp x PR x H / 1000`` (:func:`vipvflow.models.pv.energy_paper`); in ``pvlib`` mode
     it is summed per pass (:func:`pv_energy_kwh`).  Without *bins*: one ``bincount`` per
     component over (segment, local hour) bins and one ``reduceat`` over the (trip, date)
     runs, over the passes that received any light only (a (trip, date) split over several
@@ -307,7 +307,7 @@ def aggregate_partition(passes: pd.DataFrame, irr: pd.DataFrame | None, month: i
         sums["trip"][f"h_{c}"] = per_run[:, j]
     if linear:
         # paper mode is linear in the irradiation: kWh = kWp x PR x H / 1000 (H in Wh/m2)
-        from ..pv import paper_kw_per_wm2
+        from ..models.pv import paper_kw_per_wm2
 
         k = paper_kw_per_wm2(system.kwp, system.performance_ratio)
         for grp in ("trip", "seg"):
@@ -348,12 +348,12 @@ def aggregate_partition(passes: pd.DataFrame, irr: pd.DataFrame | None, month: i
 
 def _fused_sums(ctx: RunContext, tile: str, passes: pd.DataFrame, geometry: pd.DataFrame,
                 timings: dict):
-    """The partition's irradiation summed by the fused kernel (:mod:`vipvflow.passkernel`)
+    """The partition's irradiation summed by the fused kernel (:mod:`vipvflow.models.passkernel`)
     into (segment, local hour) and (trip, date) bins, without per-pass outputs; None where
     the kernel cannot run (geometry not in the scene's frame).  Adds its stages to
-    *timings* (``irradiance_*`` like :func:`vipvflow.irradiance.evaluate_passes`; the pass
+    *timings* (``irradiance_*`` like :func:`vipvflow.models.irradiance.evaluate_passes`; the pass
     grouping to ``reduce_s``)."""
-    from .. import passkernel
+    from ..models import passkernel
 
     t0 = time.perf_counter()
     scene = _scene(ctx, tile)
@@ -394,8 +394,8 @@ def run_partition(ctx: RunContext, tile: str, month: str, geometry: pd.DataFrame
     ``parts/hourly/...`` (per local hour: irradiation and pass time, for the daily pattern).
     Returns a small summary for the progress view.
     """
-    from ..irradiance import evaluate_passes
-    from ..trajectory import iter_passes
+    from ..inputs.gtfs import iter_passes
+    from ..models.irradiance import evaluate_passes
 
     tune_malloc()
     t0 = time.perf_counter()
@@ -470,6 +470,6 @@ def partition_done(run_dir: Path, tile: str, month: str) -> bool:
 
 def worker_bvh_builds() -> dict:
     """BVH builds per tile in this process (collected from every worker after a run)."""
-    from .. import shading
+    from ..models import shading
 
     return {tile: n for (_, tile), n in shading.BVH_BUILDS.items()}

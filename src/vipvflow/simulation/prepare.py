@@ -76,9 +76,9 @@ def ensure_demo(cfg: Config, year: int, say=print) -> None:
 def ensure_ingested(cfg: Config, say=print) -> dict:
     """Ingest city, GTFS and CAMS inputs into ``cfg.data_dir`` unless already done for the same
     files and settings. Returns the inputs' checksums for the run manifest."""
-    from ..city import ingest_city
-    from ..radiation import ingest_cams
-    from ..trajectory import ingest_gtfs
+    from ..inputs.cams import ingest_cams
+    from ..inputs.city import ingest_city
+    from ..inputs.gtfs import ingest_gtfs
 
     data_dir = Path(cfg.data_dir)
     city_files = [Path(p) for p in cfg.inputs.citygml]
@@ -232,7 +232,7 @@ def _run_trips(cfg: Config, trips):
 def _run_service_dates(data_dir: Path, trips, year: int, months: set):
     """The service dates of *trips* in the run's months; none is an error naming the
     calendar's range."""
-    from ..trajectory.schedule import service_dates
+    from ..inputs.gtfs.schedule import service_dates
 
     gdir = DataDir(data_dir).gtfs.root
     sd = service_dates(data_dir, year)
@@ -272,7 +272,7 @@ def _hours_on_the_road(gdir: Path, trips, sd, timezone: str):
     """(service days, their first departure and last arrival in Unix s UTC)."""
     import pandas as pd
 
-    from ..trajectory.schedule import service_day_origin_utc
+    from ..inputs.gtfs.schedule import service_day_origin_utc
 
     pat = pd.read_parquet(GtfsDir(gdir).patterns, columns=["pattern_id", "t_offset_s", "dt_s"])
     dur = (pat["t_offset_s"] + pat["dt_s"]).groupby(pat["pattern_id"]).max()

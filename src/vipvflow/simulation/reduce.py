@@ -20,7 +20,7 @@ import pyarrow.parquet as pq
 
 from ..config import Config
 from ..errors import InputError
-from ..irradiance import shading_loss
+from ..models.irradiance import shading_loss
 from ..store import DataDir, RunDir, write_json, write_parquet
 
 log = logging.getLogger(__name__)
@@ -198,9 +198,9 @@ def trip_consumption(cfg: Config, data_dir: Path, year: int, pattern_ids, vecto_
     with ``vehicle.vmod_dir`` the VECTO modal results ``pattern_<id>.vmod`` found there
     replace the built-in consumption of those patterns (for every month).
     """
-    from .. import vecto
-    from ..trajectory import pattern_cycle
-    from ..vehicle import simulate_cycle
+    from ..models.driving_cycle import pattern_cycle
+    from ..models.vehicle import simulate_cycle
+    from ..outputs import vecto
 
     params = cfg.vehicle_params()
     temps = cfg.climate.monthly_mean_temperature_c
@@ -285,12 +285,12 @@ def block_day_table(cfg: Config, run_dir: Path, trip: pd.DataFrame, vehicle):
     temperature through the battery's discharge efficiency.  Balance: the bus leaves the
     depot at ``soc_max``; PV offsets each trip and layover, a surplus charges up to
     ``soc_max`` (the rest is curtailed); PV parked at the depot replaces depot charging up to
-    what the block-day used (:func:`vipvflow.vehicle.block_day_balance`).  An idle bus's
+    what the block-day used (:func:`vipvflow.models.vehicle.block_day_balance`).  An idle bus's
     battery is full: its PV is all curtailed.  With ``harvest: driving`` (the paper's
     accounting) all the driving PV counts and nothing is curtailed.
     """
-    from ..trajectory.schedule import IDLE_BLOCK
-    from ..vehicle import block_day_balance
+    from ..inputs.gtfs.schedule import IDLE_BLOCK
+    from ..models.vehicle import block_day_balance
 
     run = RunDir(run_dir)
     tl = pd.read_parquet(run.timeline_table("block_days"))
@@ -380,7 +380,7 @@ def reduce_run(cfg: Config, year: int, run_dir: Path, say=print, client=None, re
     *run_dir* at the same path), or in this process without one (:func:`partial_sums`);
     the joins, the vehicles' balance and the outputs are computed here.  *read* is called
     once the cluster's part is done (the run shuts its cluster down then)."""
-    from .report import write_report
+    from ..outputs.report import write_report
 
     parts = partial_sums(run_dir, client)
     if read is not None:
@@ -505,7 +505,7 @@ def _harvest(cfg: Config, bd: pd.DataFrame, idle: pd.DataFrame, kwp_fleet: float
 
 def _economics(cfg: Config, bd: pd.DataFrame, n_buses: int, annualise: float) -> dict:
     """The fleet's demand, coverage, avoided charging cycles and payback over a year."""
-    from .. import economics
+    from ..models import economics
 
     pv, vehicle, window = cfg.pv_system(), cfg.vehicle_params(), cfg.economics.soc_window
     pv_year = float(bd["pv_kwh_usable"].sum()) * annualise
@@ -525,7 +525,7 @@ def _economics(cfg: Config, bd: pd.DataFrame, n_buses: int, annualise: float) ->
 def _monthly(cfg: Config, trip: pd.DataFrame, bd: pd.DataFrame, idle: pd.DataFrame, n_buses: int) -> pd.DataFrame:
     """The fleet per month: trips, kWh, consumption, shading loss, the harvest split, avoided
     charging cycles and yields."""
-    from .. import economics
+    from ..models import economics
 
     pv, vehicle = cfg.pv_system(), cfg.vehicle_params()
     monthly = (trip.groupby("month", sort=True)

@@ -2,8 +2,8 @@
 
 A standing roof is a fixed point, so it goes through the same irradiance kernel as a road
 segment: its geometry factors (sky view factor, reflector groups) once per point with
-:func:`vipvflow.irradiance.segment_geometry` (a flat roof: no gradient), then
-:func:`vipvflow.irradiance.evaluate_passes` at the middle of every minute the point's
+:func:`vipvflow.models.view_factors.segment_geometry` (a flat roof: no gradient), then
+:func:`vipvflow.models.irradiance.evaluate_passes` at the middle of every minute the point's
 intervals span (the radiation table's own grid: CAMS minute means at minute centres).  The
 minute values are summed into a running total per point, and an interval ``[t0, t1)`` takes
 the difference of that total at its ends, interpolated within a minute: the exact integral
@@ -41,14 +41,14 @@ def timeline_dir(run_dir) -> Path:
 
 def open_scene():
     """A scene without any surface: an open field."""
-    from ..shading import Scene, box_mesh
+    from ..models.shading import Scene, box_mesh
 
     return Scene(box_mesh([]))
 
 
 def point_geometry(scene, points: pd.DataFrame, cfg: IrradianceCfg) -> pd.DataFrame:
     """Geometry factors of standing roof points (``point_id, x, y, z``, m): a flat roof."""
-    from ..irradiance import segment_geometry
+    from ..models.view_factors import segment_geometry
 
     seg = pd.DataFrame({"segment_id": points["point_id"].to_numpy(np.int64),
                         "x": points["x"].to_numpy(float), "y": points["y"].to_numpy(float),
@@ -65,8 +65,8 @@ def interval_integrals(intervals: pd.DataFrame, geometry: pd.DataFrame, radiatio
     ----------
     intervals : DataFrame with ``point_id`` and ``t0_utc, t1_utc`` (Unix s)
     geometry : :func:`point_geometry` of the points (``segment_id`` = ``point_id``)
-    radiation : vipvflow.radiation.RadiationTable
-    scene : vipvflow.shading.Scene
+    radiation : vipvflow.models.sun_sky.RadiationTable
+    scene : vipvflow.models.shading.Scene
     cfg : IrradianceCfg
     energy_kwh : callable ``(poa_wm2, dt_s) -> kWh`` per minute (the run's PV model, still)
     ground_albedo : float
@@ -77,7 +77,7 @@ def interval_integrals(intervals: pd.DataFrame, geometry: pd.DataFrame, radiatio
     DataFrame indexed like *intervals*: ``seconds``, :data:`PV_SOURCE` columns (kWh) and
     ``h_<component>`` (Wh/m2) for :data:`H_COMPONENTS`.
     """
-    from ..irradiance import evaluate_passes
+    from ..models.irradiance import evaluate_passes
 
     n = len(intervals)
     out = {"seconds": (intervals["t1_utc"] - intervals["t0_utc"]).to_numpy(float)}
@@ -190,7 +190,7 @@ def depot_point(cfg, data_dir) -> tuple | None:
     from pyproj import Transformer
 
     from ..errors import InputError
-    from ..tiles import tile_names
+    from ..inputs.tiles import tile_names
 
     depot = cfg.fleet.depot
     if depot is None:
@@ -210,10 +210,10 @@ def depot_point(cfg, data_dir) -> tuple | None:
 
 def write_timeline(cfg, year: int, run_dir, routes=None) -> list[tuple[str, str]]:
     """Cut the run's block-days into driving, layover and parked time
-    (:func:`vipvflow.trajectory.schedule.block_timeline`), keep the kinds ``fleet.harvest``
+    (:func:`vipvflow.inputs.gtfs.schedule.block_timeline`), keep the kinds ``fleet.harvest``
     counts, write ``parts/timeline/{block_days,intervals,points,trip_runs}.parquet`` once per
     run and return the tiles that have standing intervals (one ``standing`` task each)."""
-    from ..trajectory.schedule import block_timeline
+    from ..inputs.gtfs.schedule import block_timeline
 
     run = RunDir(run_dir)
     if not run.timeline_table("points").exists():

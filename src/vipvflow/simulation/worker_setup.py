@@ -7,7 +7,7 @@ line (a :class:`vipvflow.errors.VipvError`) or with its traceback (a bug): the w
 "Compute Failed ... Traceback" log of the same failure is left out unless the command runs
 with ``-v`` (Dask setting ``vipvflow.worker-failure-log``).
 
-Each worker loads the fused per-pass kernel (:func:`vipvflow.passkernel.warm`: compiled once
+Each worker loads the fused per-pass kernel (:func:`vipvflow.models.passkernel.warm`: compiled once
 and cached on disk, loaded here) before its first task, so no task pays for the compilation.
 """
 from __future__ import annotations
@@ -34,6 +34,6 @@ def dask_setup(worker) -> None:
             pass
     if not dask.config.get("vipvflow.worker-failure-log", False):
         logging.getLogger("distributed.worker").addFilter(_not_compute_failed)
-    from .. import passkernel
+    from ..models import passkernel
 
     passkernel.warm()

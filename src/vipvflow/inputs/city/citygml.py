@@ -33,7 +33,7 @@ from typing import Iterator
 import numpy as np
 from lxml import etree
 
-from ..errors import InputError
+from ...errors import InputError
 
 XLINK_HREF = "{http://www.w3.org/1999/xlink}href"
 GML_IDS = ("{http://www.opengis.net/gml}id", "{http://www.opengis.net/gml/3.2}id")

@@ -36,7 +36,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ..store import DataDir, GtfsDir
+from ...store import DataDir, GtfsDir
 import pyarrow.parquet as pq
 
 WEEKDAYS = ["monday", "tuesday", "wednesday", "thursday", "friday", "saturday", "sunday"]
@@ -313,7 +313,7 @@ def iter_passes(data_dir, tile: str, month, year: int | None = None,
     data_dir : path
         Scenario data directory (``gtfs/`` from :func:`ingest_gtfs`).
     tile : str
-        Tile name (:mod:`vipvflow.tiles`).
+        Tile name (:mod:`vipvflow.inputs.tiles`).
     month : str or int
         ``"2024-06"``, or 6 together with *year*.
     year : int, optional
@@ -549,7 +549,7 @@ _BLOCK_DAY = ["block_id", "date"]
 
 def _block_trips(data_dir, routes):
     """(trips with their pattern's end stops, end time and block, the patterns' ends)."""
-    from ..vehicle import infer_blocks
+    from ...models.vehicle import infer_blocks
 
     trips = _read(data_dir, "trips", columns=["trip_id", "route_id", "service_id", "block_id",
                                                       "shape_id", "pattern_id", "start_s"])

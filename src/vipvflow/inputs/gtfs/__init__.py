@@ -5,14 +5,11 @@
   ``feed.json`` under a data directory.
 - :func:`service_dates`, :func:`iter_passes`, :func:`passes_for_trip` turn them into the
   passes of a (tile, month) partition or of one trip, in UTC.
-- :func:`driving_cycle`, :func:`pattern_cycle` give 2 s speed / stop / gradient cycles.
 """
-from .cycle import cycle_phases, driving_cycle, pattern_cycle
 from .feed import Feed, read_feed, time_to_seconds
 from .ingest import ingest_gtfs
 from .schedule import (iter_passes, passes_for_trip, reach_time, service_dates,
                        service_day_origin_utc)
 
 __all__ = ["ingest_gtfs", "read_feed", "Feed", "time_to_seconds", "service_dates",
-           "service_day_origin_utc", "iter_passes", "passes_for_trip", "reach_time",
-           "driving_cycle", "pattern_cycle", "cycle_phases"]
+           "service_day_origin_utc", "iter_passes", "passes_for_trip", "reach_time"]

@@ -1,6 +1,6 @@
 """Ground elevation from the city model: the TIN relief, else building ground surfaces.
 
-``city/terrain.npz`` (written by :func:`vipvflow.city.ingest_city`) holds
+``city/terrain.npz`` (written by :func:`vipvflow.inputs.city.ingest_city`) holds
 
 - ``tin_vertices`` (n, 3) float64 and ``tin_triangles`` (m, 3) int32: the
   ``dem:TINRelief`` triangles (and any relief polygons, triangulated);
@@ -18,8 +18,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import InputError
-from ..store import DataDir
+from ...errors import InputError
+from ...store import DataDir
 
 
 class TerrainModel:

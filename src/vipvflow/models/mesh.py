@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .store import write_npz
+from ..store import write_npz
 
 #: surface type codes used in ``TileMesh.surface_type``
 SURFACE_TYPES = ("roof", "wall", "ground", "closure", "terrain", "vegetation", "other")

@@ -2,7 +2,7 @@
 (PNG, also in ``figures/``).
 
 The maps show each segment's year (:mod:`vipvflow.simulation.annual`) over the building
-footprints of the city model (:func:`vipvflow.city.footprints.building_footprints`): the
+footprints of the city model (:func:`vipvflow.inputs.city.footprints.building_footprints`): the
 whole network, and a close-up of the street canyons (where the roofs see least sky).
 """
 from __future__ import annotations
@@ -21,9 +21,9 @@ import pandas as pd  # noqa: E402
 from matplotlib.collections import LineCollection, PolyCollection  # noqa: E402
 from matplotlib.patches import Rectangle  # noqa: E402
 
-from ..irradiance import shading_loss  # noqa: E402
+from ..models.irradiance import shading_loss  # noqa: E402
+from ..simulation.dictionary import SUMMARY  # noqa: E402
 from ..store import RunDir, write_bytes, write_text  # noqa: E402
-from .dictionary import SUMMARY  # noqa: E402
 
 #: colour limits of the maps: these percentiles of the segments' values (a few segments with
 #: a stop or a tunnel-like canyon would otherwise flatten the rest)
@@ -344,7 +344,7 @@ def write_report(run_dir: Path, summary: dict, monthly, smg, hp, rm, cfg=None, s
     the building footprints)."""
     import geopandas as gpd
 
-    from ..city.footprints import building_footprints
+    from ..inputs.city.footprints import building_footprints
 
     if segments is None:
         segments = gpd.read_parquet(run_dir / "segments.parquet")

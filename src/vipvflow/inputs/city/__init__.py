@@ -3,11 +3,11 @@
 Public API
 ----------
 ingest_city(paths, data_dir, city_cfg, crs=None) -> IngestReport
-load_tile_mesh(data_dir, tile) -> vipvflow.mesh.TileMesh
+load_tile_mesh(data_dir, tile) -> vipvflow.models.mesh.TileMesh
 TerrainModel.load(data_dir).elevation(x, y)
 SURFACE_TYPES : surface type names, index = code in ``TileMesh.surface_type``
 """
-from ..mesh import SURFACE_CODE, SURFACE_TYPES, TileMesh
+from ...models.mesh import SURFACE_CODE, SURFACE_TYPES, TileMesh
 from .citygml import CityGMLReader
 from .crs import parse_srs_name
 from .geometry import prepare_polygon

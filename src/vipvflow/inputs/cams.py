@@ -25,39 +25,53 @@ https://ads.atmosphere.copernicus.eu/datasets/cams-solar-radiation-timeseries
 """
 from __future__ import annotations
 
-import json
-import logging
 import os
 import re
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
-from .errors import InputError
-from .store import DataDir, RadiationDir, staging_dir, swap_dir, write_json, write_npz
-
-log = logging.getLogger(__name__)
+from ..errors import InputError
+from ..store import DataDir, RadiationDir, staging_dir, swap_dir, write_json
 
 #: irradiance columns kept (W/m2): all-sky and clear-sky global horizontal, direct normal,
 #: diffuse horizontal
 COLUMNS = ("ghi", "dni", "dhi", "ghi_clear", "dni_clear", "dhi_clear")
 
+
 FLAG_GAP = 1            # missing period or nan in the file
+
+
 FLAG_NEGATIVE = 2       # negative irradiance
+
+
 FLAG_GHI_TOA = 4        # GHI > 1.1 x top-of-atmosphere horizontal irradiance
+
+
 FLAG_GHI_CLEAR = 8      # GHI > clear-sky GHI x factor + offset
+
+
 FLAG_DNI_EXTRA = 16     # DNI > extraterrestrial normal irradiance
+
+
 FLAG_NO_ALLSKY = 32     # McClear only: all-sky columns are the clear-sky values
+
 
 #: GHI is flagged when above ``factor x ghi_clear + offset_wm2`` (cloud enhancement can
 #: exceed clear sky by tens of per cent for minutes)
 CLEAR_SKY_MARGIN = (1.5, 50.0)
 
+
 _REQUIRED = ("Clear sky GHI", "Clear sky DHI", "Clear sky BNI")
+
+
 _ALLSKY = ("GHI", "DHI", "BNI")
+
+
 _STEPS_S = {"1min": 60, "15min": 900, "1h": 3600}
+
+
 _GRID_S = 60
 
 
@@ -490,268 +504,3 @@ def ingest_cams(paths, data_dir, clear_sky_margin=CLEAR_SKY_MARGIN) -> dict:
     write_json(report, out_dir.report)
     swap_dir(out_dir.root, final)
     return report
-
-
-# --------------------------------------------------------------------------- sun
-def sun_vectors(t_utc, lat, lon, altitude, step_s: float = 300.0) -> np.ndarray:
-    """Unit vectors towards the sun (east, north, up) on a time grid, (3, K, N) float32.
-
-    pvlib's solar position (SPA, apparent zenith) every *step_s* seconds, its unit vector
-    interpolated linearly to the grid *t_utc* (Unix s) and normalised.
-
-    Parameters
-    ----------
-    t_utc : (N,) float, Unix s;  lat, lon : (K,) degrees;  altitude : (K,) m
-    """
-    import pvlib
-
-    t = np.asarray(t_utc, np.float64)
-    lat, lon = np.atleast_1d(lat), np.atleast_1d(lon)
-    alt = np.broadcast_to(np.asarray(altitude, np.float64), lat.shape)
-    sun = np.empty((3, len(lat), len(t)), np.float32)
-    coarse = np.arange(t[0] - step_s, t[-1] + 2 * step_s, step_s)
-    times = pd.to_datetime(np.round(coarse * 1e3).astype(np.int64), unit="ms", utc=True)
-    for i in range(len(lat)):
-        sp = pvlib.solarposition.get_solarposition(times, lat[i], lon[i], altitude=alt[i])
-        z, a = np.radians(sp["apparent_zenith"].to_numpy()), np.radians(sp["azimuth"].to_numpy())
-        for j, comp in enumerate((np.sin(z) * np.sin(a), np.sin(z) * np.cos(a), np.cos(z))):
-            sun[j, i] = np.interp(t, coarse, comp)
-    return sun / np.sqrt((sun ** 2).sum(axis=0))
-
-
-def _cached_sun(path: Path, grid, lat, lon, alt) -> np.ndarray:
-    """:func:`sun_vectors` for a radiation file's grid, kept beside the file
-    (``sun_<first>_<n>.npz``) so each worker of a run loads it instead of running SPA; the
-    cache names the radiation file's size and time, the grid and the locations it is for,
-    and is rewritten when any differ (or ignored where the folder is read-only)."""
-    st = path.stat()
-    key = json.dumps([st.st_size, st.st_mtime_ns, float(grid[0]), float(grid[-1]), len(grid),
-                      np.round(lat, 8).tolist(), np.round(lon, 8).tolist(), np.round(alt, 3).tolist()])
-    cache = RadiationDir(path.parent).sun_cache(int(grid[0]), len(grid))
-    try:
-        with np.load(cache) as z:
-            if str(z["key"]) == key:
-                return z["sun"]
-    except (OSError, KeyError, ValueError):
-        pass
-    sun = sun_vectors(grid, lat, lon, alt)
-    try:
-        write_npz(cache, sun=sun, key=np.array(key))
-    except OSError:
-        pass
-    return sun
-
-
-# --------------------------------------------------------------------------- lookup
-@dataclass
-class RadiationTable:
-    """Radiation and sun position on a regular time grid, for K locations.
-
-    Attributes
-    ----------
-    t0 : float, Unix s of grid point 0
-    step_s : float, grid step (s)
-    data : dict name -> (K, N) float32; ``ghi ... dhi_clear`` (W/m2) and the sun unit vector
-        ``sun_x, sun_y, sun_z`` (east, north, up; from pvlib apparent zenith and azimuth)
-    lat, lon : (K,) float64, degrees
-    """
-
-    t0: float
-    step_s: float
-    data: dict
-    lat: np.ndarray
-    lon: np.ndarray
-
-    def _packed(self):
-        """All series as one (K, N, C) float32 array: one gather per pass instead of C."""
-        cache = self.__dict__.get("_pack")
-        if cache is None or cache[0] != tuple(self.data) or any(
-                cache[2][c] is not self.data[c] for c in self.data):
-            names = tuple(self.data)
-            packed = np.ascontiguousarray(np.stack([self.data[c] for c in names], axis=-1),
-                                          dtype=np.float32)
-            cache = (names, packed, dict(self.data))
-            self.__dict__["_pack"] = cache
-        return cache[0], cache[1]
-
-    def _light(self) -> np.ndarray:
-        """(K, N) bool: grid intervals [i, i + 1] in which any radiation value is non-zero or
-        missing (NaN) at either end; outside them every interpolated value is exactly 0."""
-        cache = self.__dict__.get("_light_cache")
-        arrays = tuple(self.data[c] for c in COLUMNS)
-        if cache is None or any(a is not b for a, b in zip(cache[0], arrays)):
-            lit = np.zeros(self.data["ghi"].shape, bool)
-            for a in arrays:
-                lit |= (a != 0) | np.isnan(a)
-            lit[:, :-1] |= lit[:, 1:]
-            cache = (arrays, lit)
-            self.__dict__["_light_cache"] = cache
-        return cache[1]
-
-    def has_light(self, t_utc, location=None) -> np.ndarray:
-        """Whether radiation may be non-zero at each time (bool array).
-
-        ``False`` means every value :meth:`lookup` would return at that time is exactly 0
-        (night, in CAMS), so callers may skip the pass; times outside the grid are ``True``
-        (their lookup is NaN, handled by the caller).
-
-        Parameters
-        ----------
-        t_utc : array of float, Unix seconds
-        location : None, int or int array, as in :meth:`lookup`
-        """
-        t = np.asarray(t_utc, dtype=np.float64)
-        f = (t - self.t0) / self.step_s
-        inside = (f >= 0) & (f <= self.n - 1)
-        i = np.clip(np.nan_to_num(f), 0, self.n - 1).astype(np.int64)
-        lit = self._light()
-        loc = 0 if location is None else np.asarray(location, np.int64)
-        return lit[loc, i] | ~inside
-
-    @property
-    def n(self) -> int:
-        return self.data["ghi"].shape[1]
-
-    @property
-    def t_end(self) -> float:
-        return self.t0 + (self.n - 1) * self.step_s
-
-    @classmethod
-    def from_grid(cls, t_utc, values: dict, lat, lon, altitude=0.0, sun_step_s: float = 300.0,
-                  sun: np.ndarray | None = None):
-        """Build from arrays on a regular grid; computes the sun position once.
-
-        Parameters
-        ----------
-        t_utc : (N,) Unix seconds, regular
-        values : dict of (N,) or (K, N) arrays, W/m2, keys :data:`COLUMNS`
-        lat, lon, altitude : float or (K,), degrees, m
-        sun_step_s : float
-            pvlib's solar position is evaluated every ``sun_step_s`` and the unit vector
-            interpolated (chord error below 1e-4 degrees for 5 min).
-        sun : (3, K, N) float32, optional
-            The unit sun vectors of an earlier call on the same grid (see :meth:`load`).
-        """
-        t = np.asarray(t_utc, dtype=np.float64)
-        lat = np.atleast_1d(np.asarray(lat, np.float64))
-        lon = np.atleast_1d(np.asarray(lon, np.float64))
-        alt = np.broadcast_to(np.asarray(altitude, np.float64), lat.shape)
-        step = float(t[1] - t[0]) if len(t) > 1 else 60.0
-        if len(t) > 2 and np.abs(np.diff(t) - step).max() > 1e-6:
-            raise ValueError("time grid is not regular")
-        data = {c: np.atleast_2d(np.asarray(values[c], np.float32)) for c in COLUMNS}
-        k = len(lat)
-        for c in COLUMNS:
-            if data[c].shape[0] != k:
-                data[c] = np.broadcast_to(data[c], (k, len(t))).copy()
-        if sun is None:
-            sun = sun_vectors(t, lat, lon, alt, sun_step_s)
-        for j, name in enumerate(("sun_x", "sun_y", "sun_z")):
-            data[name] = sun[j]
-        return cls(t0=float(t[0]), step_s=step, data=data, lat=lat, lon=lon)
-
-    @classmethod
-    def load(cls, data_dir, year: int, pad_days: float = 1.0) -> "RadiationTable":
-        """Load ``radiation/radiation.parquet`` for *year* (UTC, padded by *pad_days*).
-
-        Raises
-        ------
-        InputError
-            When the file is missing or does not cover any of the year.
-        """
-        path = DataDir(data_dir).radiation.table
-        if not path.is_file():
-            raise InputError(f"{path}: not found; run 'vipvflow ingest cams' first")
-        lo = pd.Timestamp(f"{year}-01-01", tz="UTC").timestamp() - pad_days * 86400
-        hi = pd.Timestamp(f"{year + 1}-01-01", tz="UTC").timestamp() + pad_days * 86400
-        table = pd.read_parquet(path, filters=[("t_utc", ">=", int(lo)), ("t_utc", "<", int(hi))])
-        if table.empty:
-            raise InputError(f"{path}: holds no radiation for {year} (re-ingest CAMS data "
-                             f"covering {year})")
-        locs = table[["lat", "lon"]].drop_duplicates().to_numpy()
-        t_all = table["t_utc"].to_numpy()
-        grid = np.arange(t_all.min(), t_all.max() + 1, _GRID_S, dtype=np.float64)
-        values = {c: np.full((len(locs), len(grid)), np.nan, np.float32) for c in COLUMNS}
-        alts = []
-        for i, (la, lo_) in enumerate(locs):
-            part = table[(table["lat"] == la) & (table["lon"] == lo_)]
-            idx = ((part["t_utc"].to_numpy() - grid[0]) // _GRID_S).astype(np.int64)
-            for c in COLUMNS:
-                values[c][i, idx] = part[c].to_numpy(np.float32)
-            alts.append(float(part["altitude"].iloc[0]) if "altitude" in part else 0.0)
-        covered = np.isfinite(values["ghi"]).mean()
-        if covered < 1.0:
-            log.warning("%s: %.1f %% of %d's minute grid has no radiation (NaN)", path,
-                        100 * (1 - covered), year)
-        alts = np.array(alts)
-        sun = _cached_sun(path, grid, locs[:, 0], locs[:, 1], alts)
-        return cls.from_grid(grid, values, locs[:, 0], locs[:, 1], alts, sun=sun)
-
-    @classmethod
-    def from_cams(cls, paths) -> "RadiationTable":
-        """Read CAMS files straight into a table (no data dir), for single runs and tracks."""
-        import tempfile
-
-        with tempfile.TemporaryDirectory() as tmp:
-            ingest_cams(paths, tmp)
-            table = pd.read_parquet(DataDir(tmp).radiation.table)
-        locs = table[["lat", "lon", "altitude"]].drop_duplicates().to_numpy()
-        grid = np.arange(table["t_utc"].min(), table["t_utc"].max() + 1, _GRID_S, dtype=np.float64)
-        values = {c: np.full((len(locs), len(grid)), np.nan, np.float32) for c in COLUMNS}
-        for i, (la, lo_, _) in enumerate(locs):
-            part = table[(table["lat"] == la) & (table["lon"] == lo_)]
-            idx = ((part["t_utc"].to_numpy() - grid[0]) // _GRID_S).astype(np.int64)
-            for c in COLUMNS:
-                values[c][i, idx] = part[c].to_numpy(np.float32)
-        return cls.from_grid(grid, values, locs[:, 0], locs[:, 1], locs[:, 2])
-
-    def nearest_location(self, lat, lon) -> np.ndarray:
-        """Index of the nearest table location for each point (degrees; great-circle)."""
-        lat = np.radians(np.atleast_1d(np.asarray(lat, np.float64)))[:, None]
-        lon = np.radians(np.atleast_1d(np.asarray(lon, np.float64)))[:, None]
-        la, lo = np.radians(self.lat)[None], np.radians(self.lon)[None]
-        h = (np.sin((la - lat) / 2) ** 2
-             + np.cos(lat) * np.cos(la) * np.sin((lo - lon) / 2) ** 2)
-        return np.argmin(h, axis=1).astype(np.int32)
-
-    def lookup(self, t_utc, location=None, angles: bool = True) -> dict:
-        """Interpolate radiation and sun position to times (linear, by index arithmetic).
-
-        Parameters
-        ----------
-        t_utc : array of float, Unix seconds
-        location : None, int or int array (index into ``lat``/``lon``; see
-            :meth:`nearest_location`); ``None`` means location 0
-        angles : bool, also return ``zenith`` and ``azimuth`` (degrees)
-
-        Returns
-        -------
-        dict of float32 arrays
-            ``ghi, dni, dhi, ghi_clear, dni_clear, dhi_clear`` (W/m2), ``sun_x, sun_y, sun_z``
-            (unit vector east/north/up), ``zenith`` (apparent, deg), ``azimuth`` (deg from
-            north, clockwise).  NaN outside the grid.
-        """
-        t = np.asarray(t_utc, dtype=np.float64)
-        f = (t - self.t0) / self.step_s
-        outside = ~((f >= 0) & (f <= self.n - 1))
-        f = np.clip(np.nan_to_num(f), 0, self.n - 1)
-        i = np.minimum(f.astype(np.int64), self.n - 2) if self.n > 1 else np.zeros(f.shape, np.int64)
-        w = (f - i).astype(np.float32)[:, None]
-        names, packed = self._packed()
-        if location is None or np.ndim(location) == 0:
-            rows = packed[0 if location is None else int(location)]
-            a, b = rows[i], rows[i + 1] if self.n > 1 else rows[i]
-        else:
-            loc = np.asarray(location, np.int64)
-            a = packed[loc, i]
-            b = packed[loc, i + 1] if self.n > 1 else a
-        v = a + w * (b - a)
-        if outside.any():
-            v[outside] = np.nan
-        vt = np.ascontiguousarray(v.T)          # contiguous columns for the callers' arithmetic
-        out = {name: vt[j] for j, name in enumerate(names)}
-        if angles:
-            sz = np.clip(out["sun_z"], -1, 1)
-            out["zenith"] = np.degrees(np.arccos(sz)).astype(np.float32)
-            out["azimuth"] = (np.degrees(np.arctan2(out["sun_x"], out["sun_y"])) % 360).astype(np.float32)
-        return out

@@ -736,7 +736,7 @@ def reflector_contributions(run: RunData, sel: Selection | None = None) -> pd.Da
     ``segments`` (number of selected segments the surface reflects onto); empty when the
     run's geometry parts or the city meshes are absent.
     """
-    from ..mesh import SURFACE_TYPES, TileMesh
+    from ..models.mesh import SURFACE_TYPES, TileMesh
 
     cols = ["surface_id", "building_id", "surface_type", "month", "pv_kwh_reflected", "segments"]
     months = sel.months if sel is not None else run.months

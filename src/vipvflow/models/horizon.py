@@ -3,7 +3,7 @@
 A segment's horizon profile ``h(a)`` is the elevation angle (degrees) above which the sky
 is free of buildings in azimuth ``a`` (clockwise from north), seen from the roof point.
 It is found once per segment at simulation time by bisection on the elevation with
-occlusion rays (:meth:`vipvflow.shading.Scene.occluded`), vectorised over every segment and
+occlusion rays (:meth:`vipvflow.models.shading.Scene.occluded`), vectorised over every segment and
 azimuth bin at once, and stored per tile in ``parts/horizon/tile=<TILE>.parquet``
 (``segment_id`` and ``h000 .. h355``, degrees).  With it, direct sunlight on the roof can
 be decided without ray casting: the sun is visible when its elevation exceeds the horizon
@@ -23,7 +23,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from .store import RunDir
+from ..store import RunDir
 
 #: azimuth bins of a stored profile (degrees from north, clockwise)
 N_AZIMUTH = 72
@@ -40,7 +40,7 @@ def horizon_profile(scene, origins, n_azimuth: int = N_AZIMUTH, tol_deg: float =
 
     Parameters
     ----------
-    scene : vipvflow.shading.Scene
+    scene : vipvflow.models.shading.Scene
     origins : (n, 3) float, m, projected CRS (the roof points, lifted off the roof)
     n_azimuth : int, number of azimuth directions ``k * 360 / n_azimuth`` (deg from north)
     tol_deg : float, the bisection stops when the bracket is narrower than this (deg)

@@ -9,11 +9,11 @@
   runs).
 - Vehicle: :func:`write_vecto_job` writes an engineering-mode battery-electric job (``.vecto``,
   ``.vveh``, ``.vem`` + motor curves, ``.vbat``, ``.vacc``) from a
-  :class:`vipvflow.vehicle.VehicleParams`, as far as the formats allow (its docstring lists what
+  :class:`vipvflow.models.vehicle.VehicleParams`, as far as the formats allow (its docstring lists what
   maps and what does not).
 - Results: :func:`read_vmod` reads VECTO's modal results (``.vmod``: time-resolved, units in
   brackets, UTF-8 BOM) and :func:`vmod_energy` integrates their power columns into the same
-  per-trip energies :func:`vipvflow.vehicle.simulate_cycle` gives, so a user who runs VECTO can
+  per-trip energies :func:`vipvflow.models.vehicle.simulate_cycle` gives, so a user who runs VECTO can
   replace the built-in consumption.
 
 VECTO files seen in the wild start with a UTF-8 BOM or not, are sometimes Windows-1252 (``m/s²``
@@ -30,8 +30,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .errors import InputError
-from .store import write_bytes, write_text
+from ..errors import InputError
+from ..store import write_bytes, write_text
 
 VDRI_NAMES = {"s": "s_m", "v": "v_kmh", "grad": "grad_pct", "stop": "stop_s"}
 VDRI_HEADER = {v: f"<{k}>" for k, v in VDRI_NAMES.items()}

@@ -15,12 +15,13 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .config import IrradianceCfg
-from .errors import InputError
-from .store import DataDir
-from .irradiance import evaluate_passes, segment_geometry
-from .shading import get_scene
-from .tiles import tile_names
+from ..config import IrradianceCfg
+from ..errors import InputError
+from ..store import DataDir
+from ..models.irradiance import evaluate_passes
+from ..models.view_factors import segment_geometry
+from ..models.shading import get_scene
+from ..inputs.tiles import tile_names
 
 log = logging.getLogger(__name__)
 
@@ -108,7 +109,7 @@ def model_track(track: pd.DataFrame, data_dir, radiation_table, cfg: IrradianceC
     if np.isnan(z).any():
         ground = np.full(len(tr), np.nan)
         try:
-            from .city import TerrainModel
+            from ..inputs.city import TerrainModel
 
             ground = TerrainModel.load(data_dir).elevation(x, y)
         except Exception as exc:  # no terrain stored: the mesh's lowest point below

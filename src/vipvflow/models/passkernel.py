@@ -1,17 +1,17 @@
 """The fused per-pass kernel: pass time -> radiation -> rays -> components -> sums.
 
-The same physics as :func:`vipvflow.irradiance.roof_irradiance` (eqs. 1-3 of the paper, the
+The same physics as :func:`vipvflow.models.irradiance.roof_irradiance` (eqs. 1-3 of the paper, the
 street reflectors, the rotating reflector sample point and its Russian roulette), compiled
 with numba into two loops over the passes around the one Embree occlusion query numba cannot
 call:
 
 1. :func:`_setup` looks up the radiation and the sun at each pass's time (linear in time,
-   the :meth:`vipvflow.radiation.RadiationTable.lookup` arithmetic), skips dark passes, and
+   the :meth:`vipvflow.models.sun_sky.RadiationTable.lookup` arithmetic), skips dark passes, and
    writes the pass's rays (the roof point towards the sun, one per reflector facing it)
    straight into the ray batch;
-2. Embree answers the batch (:meth:`vipvflow.shading.Scene.occluded_local`);
+2. Embree answers the batch (:meth:`vipvflow.models.shading.Scene.occluded_local`);
 3. :func:`_finish_block` sums the components per pass into the output block of
-   :func:`vipvflow.irradiance.evaluate_passes`, or :func:`_finish_bins` adds their
+   :func:`vipvflow.models.irradiance.evaluate_passes`, or :func:`_finish_bins` adds their
    irradiation (Wh/m2) straight into the (segment, local hour) and (trip, date) bins of a
    partition (:func:`vipvflow.simulation.partition.aggregate_partition`).
 
@@ -55,7 +55,7 @@ _C1, _C2, _C3 = np.uint64(0x9E3779B97F4A7C15), np.uint64(0xBF58476D1CE4E5B9), np
 
 @njit(cache=True, nogil=True)
 def _sample_key(segment_id, t_utc):
-    """:func:`vipvflow.irradiance.pass_sample_key` of one pass (splitmix64 finaliser)."""
+    """:func:`vipvflow.models.irradiance.pass_sample_key` of one pass (splitmix64 finaliser)."""
     x = np.uint64(segment_id) * _C1 + np.uint64(np.int64(np.rint(t_utc * 1000.0)))
     x = (x ^ (x >> _M30)) * _C2
     x = (x ^ (x >> _M27)) * _C3
@@ -155,7 +155,7 @@ def _setup(lo, hi, seg, t_start, dt, mid, row, loc_of_row, packed, cols, t0, ste
 @njit(cache=True, nogil=True, inline="always")
 def _components(c, r, rad, cos_aoi, visible, beam_sum, sky, iso, refl_sky, refl_ghi, out):
     """The 12 :data:`BLOCK_COLUMNS` of one pass into *out* (float32, as
-    :func:`vipvflow.irradiance.roof_components` sums them)."""
+    :func:`vipvflow.models.irradiance.roof_components` sums them)."""
     ca = cos_aoi[c]
     vis = np.float32(1.0) if visible else np.float32(0.0)
     for s in range(2):
@@ -414,7 +414,7 @@ def _run(seg, t_start, dt, mid, row, geo, cfg, radiation_table, scene, loc_of_ro
 
 def evaluate_block(seg, t_start, dt, mid, row, geo, cfg, radiation_table, scene,
                    loc_of_row=None, timings: dict | None = None):
-    """Per-pass components of the fused kernel (:func:`vipvflow.irradiance.evaluate_passes`).
+    """Per-pass components of the fused kernel (:func:`vipvflow.models.irradiance.evaluate_passes`).
 
     Parameters
     ----------
@@ -423,10 +423,10 @@ def evaluate_block(seg, t_start, dt, mid, row, geo, cfg, radiation_table, scene,
     dt : (n,) float64, s on the segment (used when *mid*: radiation at ``t_start + dt / 2``)
     mid : bool
     row : (n,) int64, row of each pass's segment in the packed geometry *geo*
-    geo : dict from :func:`vipvflow.irradiance.pack_geometry` with a scene (local frame)
+    geo : dict from :func:`vipvflow.models.view_factors.pack_geometry` with a scene (local frame)
     cfg : IrradianceCfg
-    radiation_table : vipvflow.radiation.RadiationTable
-    scene : vipvflow.shading.Scene
+    radiation_table : vipvflow.models.sun_sky.RadiationTable
+    scene : vipvflow.models.shading.Scene
     loc_of_row : (segments,) int64, optional, radiation location of each geometry row
     timings : dict, optional, seconds added to ``ray_setup_s`` (includes the radiation
         lookup), ``rays_s`` and ``components_s``

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..store import DataDir
+from ...store import DataDir
 
 
 def building_footprints(data_dir, tiles=None, bounds=None) -> list[np.ndarray]:

@@ -190,8 +190,8 @@ def reach_times_from_phases(phases: pd.DataFrame, s) -> np.ndarray:
 
 def cycle_reach_times(stop_d, arr, dep, seg_start, seg_len, cfg):
     """Per-segment timing of a pattern from its driving cycle (as
-    :func:`vipvflow.trajectory.schedule.pattern_segment_times`, plus the cycle report)."""
-    from .schedule import pattern_segment_times
+    :func:`vipvflow.inputs.gtfs.schedule.pattern_segment_times`, plus the cycle report)."""
+    from ..inputs.gtfs.schedule import pattern_segment_times
 
     idx, _, _, cov = pattern_segment_times(stop_d, arr, dep, seg_start, seg_len)
     phases, legs = cycle_phases(stop_d, arr, dep, cfg)

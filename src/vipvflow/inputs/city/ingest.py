@@ -2,8 +2,8 @@
 
 Two passes with bounded memory:
 
-1. Stream every file (:class:`~vipvflow.city.citygml.CityGMLReader`), clean and
-   triangulate each polygon (:mod:`~vipvflow.city.geometry`), and keep the results in
+1. Stream every file (:class:`~vipvflow.inputs.city.citygml.CityGMLReader`), clean and
+   triangulate each polygon (:mod:`~vipvflow.inputs.city.geometry`), and keep the results in
    compact numpy chunks.  A full chunk is routed to spool files, one per tile it touches:
    the tile of each surface's area centroid ("own") and every tile whose buffer-expanded
    bounds its bounding box overlaps ("buffer").
@@ -19,7 +19,7 @@ ingest (``.city-ingest-<pid>``, the older ``city/.ingest-spool-<pid>``) are remo
 next ingest once their process is gone.
 
 Coordinates: each file's axis order and CRS are settled on its first building
-(:class:`~vipvflow.city.crs.SourceCRS`); without ``--crs`` a projected file keeps its CRS and a
+(:class:`~vipvflow.inputs.city.crs.SourceCRS`); without ``--crs`` a projected file keeps its CRS and a
 geographic one (PLATEAU's EPSG:6697) is put into its local UTM zone.  Polygons with a
 non-finite coordinate, a vertex outside the CRS's area of use or an absurd area are skipped and
 counted by reason.
@@ -37,12 +37,11 @@ from pathlib import Path
 
 import numpy as np
 
-from ..config import CityCfg
-from ..errors import InputError
-from ..store import (CityDir, DataDir, atomic_path, pid_alive, remove_stale, staging_dir, swap_dir,
-                     write_json, write_npz)
-from ..mesh import SURFACE_CODE, SURFACE_TYPES, TileMesh
-from ..progress import Progress, citygml_bytes, file_position
+from ...config import CityCfg
+from ...errors import InputError
+from ...store import CityDir, DataDir, atomic_path, pid_alive, remove_stale, staging_dir, swap_dir, write_json, write_npz
+from ...models.mesh import SURFACE_CODE, SURFACE_TYPES, TileMesh
+from ...progress import Progress, citygml_bytes, file_position
 from ..tiles import tile_bounds, tile_index, tile_name
 from .citygml import CityGMLReader, open_sources
 from .crs import (SourceCRS, horizontal, inside, is_projected, local_utm, normalise_crs,

@@ -22,8 +22,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ..errors import InputError
-from ..store import TILE_SIZE_M, DataDir, GtfsDir, staging_dir, swap_dir, write_parquet, write_text
+from ...errors import InputError
+from ...store import TILE_SIZE_M, DataDir, GtfsDir, staging_dir, swap_dir, write_parquet, write_text
 from .feed import read_feed
 from .schedule import pattern_segment_times, project_stops_monotone
 from .segments import build_segments, cumulative_distance, project_shapes
@@ -52,7 +52,7 @@ def _terrain(data_dir: Path, problems: list[str]):
     try:
         from ..city import TerrainModel
     except ImportError:
-        problems.append("city/terrain.npz present but vipvflow.city.TerrainModel is not "
+        problems.append("city/terrain.npz present but vipvflow.inputs.city.TerrainModel is not "
                         "available; default elevation used")
         return None
     try:
@@ -425,7 +425,7 @@ def _segment_timing(pstops: pd.DataFrame, pattern_shape: list, segs: pd.DataFram
         d, arr, dep = g["dist_m"].to_numpy(), g["arr_s"].to_numpy(), g["dep_s"].to_numpy()
         seg_start, seg_len = sg["cum_dist_m"].to_numpy(), sg["length_m"].to_numpy()
         if timing == "driving_cycle":
-            from .cycle import cycle_reach_times
+            from ...models.driving_cycle import cycle_reach_times
             idx, t0, dtt, cov, rep = cycle_reach_times(d, arr, dep, seg_start, seg_len,
                                                        traj_cfg.cycle)
             if rep["max_delay_s"] > 0:

@@ -20,8 +20,8 @@ import numpy as np
 from embreex import rtcore_scene
 from embreex.mesh_construction import TriangleMesh
 
+from ..store import DataDir
 from .mesh import SURFACE_CODE, TileMesh
-from .store import DataDir
 
 #: number of BVH builds by :func:`get_scene`, per (data_dir, tile)
 BVH_BUILDS: collections.Counter = collections.Counter()

@@ -1,0 +1,70 @@
+"""The Dask client of a run: a LocalCluster sized to the machine, or a running scheduler."""
+from __future__ import annotations
+
+import logging
+import os
+
+from ..config import Config
+
+log = logging.getLogger(__name__)
+
+
+#: Dask settings of a LocalCluster started by a run, whose processes share the machine's
+#: cores with the simulation: event-loop ticks every 1 s instead of 20 ms, system monitors
+#: every 2 s instead of 0.5 s, memory monitors every 0.5 s instead of 0.1 s (the scheduler's
+#: and nannies' event loop took ~15 % of a core at the defaults during the line-year)
+LOCAL_CLUSTER_DASK_CONFIG = {
+    "distributed.admin.tick.interval": "1s",
+    "distributed.admin.system-monitor.interval": "2s",
+    "distributed.worker.memory.monitor-interval": "500ms",
+}
+
+
+def make_client(cfg: Config, scheduler: str | None, n_workers: int | None):
+    """A client of the given scheduler, or of a LocalCluster sized to the machine.
+
+    The LocalCluster's workers run without Dask's statistical profiler unless
+    ``dask.worker_profile`` is set: on a machine whose cores the workers fill, its 100 stack
+    samples a second per worker come out of the simulation's time (the 2-worker line-year
+    spent ~7 % of each worker's CPU on it)."""
+    import dask
+    from distributed import Client, LocalCluster
+
+    scheduler = scheduler or cfg.dask.scheduler
+    if not log.isEnabledFor(logging.INFO):
+        for name in ("distributed", "distributed.scheduler", "distributed.nanny", "distributed.core",
+                     "distributed.worker", "distributed.http.proxy"):
+            logging.getLogger(name).setLevel(logging.WARNING)
+    if scheduler:
+        return Client(scheduler), None
+    n = n_workers or cfg.dask.n_workers or os.cpu_count() or 1
+    settings = {**LOCAL_CLUSTER_DASK_CONFIG, "distributed.worker.profile.enabled": cfg.dask.worker_profile,
+                # workers ignore Ctrl-C and leave a task's failure for this process to report
+                "distributed.worker.preload": ["vipvflow.simulation.worker_setup"],
+                "vipvflow.worker-failure-log": log.isEnabledFor(logging.INFO)}
+    with dask.config.set(settings):     # the nannies hand this configuration to their workers
+        cluster = LocalCluster(n_workers=n, threads_per_worker=cfg.dask.threads_per_worker or 1,
+                               processes=True, memory_limit=cfg.dask.memory_limit,
+                               dashboard_address=dashboard_address(cfg.dask.dashboard_port),
+                               silence_logs=logging.ERROR)
+    return Client(cluster), cluster
+
+
+def dashboard_address(port: int | None) -> str:
+    """``:port`` when that port is free on this machine, else ``:0`` (any free port)."""
+    import socket
+
+    if port is None:
+        return ":0"
+    with socket.socket() as s:
+        try:
+            s.bind(("", port))
+        except OSError:
+            return ":0"
+    return f":{port}"
+
+
+def close_client(client, cluster) -> None:
+    client.close()
+    if cluster is not None:
+        cluster.close()
