@@ -40,25 +40,31 @@ TILE_SIZE_M = 500.0
 
 # --------------------------------------------------------------------------- data dir
 @dataclass(frozen=True)
-class CityDir:
-    """``city/``: tiled surfaces, tile meshes and terrain of the CityGML ingest.
+class _Ingested:
+    """A folder one ingest writes as a whole (``city/``, ``gtfs/``, ``radiation/``).
 
-    *root* is the folder itself (``<data_dir>/city`` or the ingest's staging folder)."""
+    *root* is the folder itself (``<data_dir>/<name>`` or the ingest's staging folder)."""
     root: Path
 
     @property
-    def tiles_json(self) -> Path:
-        """CRS, tile size, buffer and the tiles with their extents."""
-        return self.root / "tiles.json"
-
-    @property
     def report(self) -> Path:
+        """What the ingest found (counts, problems, gaps)."""
         return self.root / "ingest_report.json"
 
     @property
     def stamp(self) -> Path:
         """Digest of the inputs this folder was ingested from (``prepare``)."""
         return self.root / ".inputs.json"
+
+
+@dataclass(frozen=True)
+class CityDir(_Ingested):
+    """``city/``: tiled surfaces, tile meshes and terrain of the CityGML ingest."""
+
+    @property
+    def tiles_json(self) -> Path:
+        """CRS, tile size, buffer and the tiles with their extents."""
+        return self.root / "tiles.json"
 
     @property
     def terrain(self) -> Path:
@@ -86,18 +92,14 @@ GTFS_TABLES = ("segments", "trips", "patterns", "pattern_stops", "calendar", "ca
 
 
 @dataclass(frozen=True)
-class GtfsDir:
-    """``gtfs/``: the timetable cut into segments, by the GTFS ingest."""
-    root: Path
+class GtfsDir(_Ingested):
+    """``gtfs/``: the timetable cut into segments, by the GTFS ingest (its report is
+    :attr:`feed_json`)."""
 
     @property
     def feed_json(self) -> Path:
         """Time zone, CRS, tile size, counts and problems of the ingested feed."""
         return self.root / "feed.json"
-
-    @property
-    def stamp(self) -> Path:
-        return self.root / ".inputs.json"
 
     @property
     def segments(self) -> Path:
@@ -119,21 +121,12 @@ class GtfsDir:
 
 
 @dataclass(frozen=True)
-class RadiationDir:
+class RadiationDir(_Ingested):
     """``radiation/``: the CAMS series of the CAMS ingest (and its sun-position caches)."""
-    root: Path
 
     @property
     def table(self) -> Path:
         return self.root / "radiation.parquet"
-
-    @property
-    def report(self) -> Path:
-        return self.root / "ingest_report.json"
-
-    @property
-    def stamp(self) -> Path:
-        return self.root / ".inputs.json"
 
     def sun_cache(self, first_s: int, n: int) -> Path:
         """Sun vectors of the table's grid from *first_s* (Unix s), *n* steps, kept for the
