@@ -26,7 +26,7 @@ from ..store import DataDir
 
 def _limits(cfg):
     if cfg is None:
-        from ..config import CycleCfg
+        from .params import CycleCfg
         cfg = CycleCfg()
     return (float(cfg.max_accel_mps2), float(cfg.max_decel_mps2),
             float(cfg.speed_limit_kmh) / 3.6, float(cfg.dwell_s), float(cfg.dt_s))

@@ -49,7 +49,7 @@ import time
 import numpy as np
 import pandas as pd
 
-from ..config import IrradianceCfg
+from .params import IrradianceCfg
 from .view_factors import _CHUNK, COMPONENTS, isotropic_sky_view, pack_geometry
 
 

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..config import PVSystem
+from .params import PVSystem
 
 
 def paper_kw_per_wm2(kwp, performance_ratio=0.75):

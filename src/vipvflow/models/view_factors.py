@@ -11,7 +11,7 @@ import math
 import numpy as np
 import pandas as pd
 
-from ..config import IrradianceCfg
+from .params import IrradianceCfg
 from .mesh import SURFACE_CODE
 
 _GOLDEN = (np.sqrt(5.0) - 1.0) / 2.0

@@ -1,0 +1,53 @@
+"""The models' own parameters: what the physics and the vehicle model take, validated.
+
+The configuration (:mod:`vipvflow.config`) reads the scenario files and builds these; the
+models import them from here and never read the configuration themselves.
+"""
+from __future__ import annotations
+
+from typing import Literal
+
+from pydantic import BaseModel, ConfigDict, Field
+
+
+class _Params(BaseModel):
+    model_config = ConfigDict(extra="forbid", validate_assignment=True)
+
+
+class CycleCfg(_Params):
+    dt_s: float = Field(2.0, gt=0)
+    max_accel_mps2: float = Field(1.0, gt=0)
+    max_decel_mps2: float = Field(1.3, gt=0)
+    speed_limit_kmh: float = Field(50.0, gt=0)
+    dwell_s: float = Field(20.0, ge=0)
+
+
+class IrradianceCfg(_Params):
+    # sky_view_factor: DHI x the roof point's cosine-weighted sky view (the default);
+    # isotropic: the paper's DHI (1 + cos tilt) / 2, an upper bound in streets
+    diffuse_model: Literal["isotropic", "sky_view_factor"] = "sky_view_factor"
+    reflection: bool = True
+    reflection_rays: int = Field(256, ge=0, le=65_536)
+    svf_rays: int = Field(512, gt=0, le=65_536)
+    ray_length_m: float = Field(300.0, gt=0, le=100_000)
+    ray_offset_m: float = Field(0.05, ge=0)
+    max_reflector_groups: int = Field(4, ge=0)
+    reflector_points: int = Field(64, ge=1)
+    reflector_sampling: Literal["rotate", "all"] = "rotate"
+    reflector_sky_rays: int = Field(4, ge=1)
+    seed: int = 7
+
+
+class PVSystem(_Params):
+    """A PV system on the bus roof (catalog entry of ``conf/pv_systems.yaml``)."""
+
+    name: str = ""
+    technology: str = "c-Si"
+    kwp: float = Field(gt=0)
+    roof_area_m2: float = Field(gt=0)
+    area_share: float = Field(gt=0, le=1)
+    performance_ratio: float = Field(gt=0, le=1)
+    gamma_pdc_per_k: float = -0.0037
+    inverter_efficiency: float = Field(0.96, gt=0, le=1)
+    system_losses_percent: float = Field(14.0, ge=0, lt=100)
+    temperature_model: str = "sapm_open_rack_glass_polymer"
