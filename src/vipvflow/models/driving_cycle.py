@@ -145,6 +145,12 @@ def driving_cycle(stop_dist_m, arrival_s, departure_s, cfg=None, segments=None) 
         ``dist_m`` along the shape, ``stop`` True while dwelling at a stop or at rest at
         the end. ``attrs["report"]`` holds ``feasible`` (bool), ``max_delay_s``,
         ``final_delay_s`` and ``late_legs`` (list of dicts), and ``attrs["legs"]`` every leg.
+
+    References
+    ----------
+    VECTO's distance-based driving cycle (``.vdri``: target speed, stop time and gradient
+    per distance; European Commission JRC, VECTO user manual), sampled here in time at
+    ``dt_s`` as VECTO's modal results are.
     """
     *_, step = _limits(cfg)
     phases, legs = cycle_phases(stop_dist_m, arrival_s, departure_s, cfg)

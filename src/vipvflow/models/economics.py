@@ -18,7 +18,21 @@ import pandas as pd
 
 
 def coverage(pv_kwh, demand_kwh):
-    """Share of the demand supplied by PV (dimensionless; NaN where the demand is 0)."""
+    """Share of the demand supplied by PV.
+
+    Parameters
+    ----------
+    pv_kwh : array, PV energy over a period (kWh)
+    demand_kwh : array, energy the bus draws from its battery over the same period (kWh)
+
+    Returns
+    -------
+    array, ``pv_kwh / demand_kwh`` (dimensionless; NaN where the demand is 0)
+
+    References
+    ----------
+    The paper's share of demand covered (section 4).
+    """
     pv = np.asarray(pv_kwh, dtype=float)
     demand = np.asarray(demand_kwh, dtype=float)
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -26,23 +40,78 @@ def coverage(pv_kwh, demand_kwh):
 
 
 def cycle_energy_kwh(battery_kwh, soc_window=(0.2, 0.8)):
-    """Energy of one charging cycle (kWh): battery kWh x (high - low) of the SoC window."""
+    """Energy of one charging cycle.
+
+    Parameters
+    ----------
+    battery_kwh : array, usable-capacity reference of the battery (kWh)
+    soc_window : (low, high), state-of-charge window a depot charge restores (0..1)
+
+    Returns
+    -------
+    array, ``battery_kwh x (high - low)`` (kWh)
+
+    References
+    ----------
+    The paper's charging cycle (section 4): one cycle restores the SoC window.
+    """
     lo, hi = _window(soc_window)
     return np.asarray(battery_kwh, dtype=float) * (hi - lo)
 
 
 def avoided_cycles(pv_kwh, battery_kwh, soc_window=(0.2, 0.8)):
-    """Charging cycles the PV energy replaces (cycles over the period of ``pv_kwh``)."""
+    """Charging cycles the PV energy replaces.
+
+    Parameters
+    ----------
+    pv_kwh : array, PV energy the battery takes over a period (kWh)
+    battery_kwh : array, battery capacity (kWh)
+    soc_window : (low, high), state-of-charge window of one cycle (0..1)
+
+    Returns
+    -------
+    array, cycles over the period of ``pv_kwh`` (``pv_kwh / cycle_energy_kwh``)
+
+    References
+    ----------
+    The paper's avoided charging cycles (section 4).
+    """
     return np.asarray(pv_kwh, dtype=float) / cycle_energy_kwh(battery_kwh, soc_window)
 
 
 def system_cost_eur(kwp, cost_eur_per_wp):
-    """Installed cost (EUR) of a PV system of ``kwp`` kWp at ``cost_eur_per_wp`` EUR/Wp."""
+    """Installed cost of a PV system.
+
+    Parameters
+    ----------
+    kwp : array, peak power (kWp)
+    cost_eur_per_wp : float, installed cost per peak watt (EUR/Wp)
+
+    Returns
+    -------
+    array, EUR
+    """
     return np.asarray(kwp, dtype=float) * 1e3 * cost_eur_per_wp
 
 
 def simple_payback_years(kwp, annual_pv_kwh, cost_eur_per_wp, tariff_eur_per_kwh):
-    """Simple payback (years) = (EUR/Wp x Wp) / (annual PV kWh x EUR/kWh); inf without saving."""
+    """Simple (undiscounted) payback time of the PV system.
+
+    Parameters
+    ----------
+    kwp : array, peak power (kWp)
+    annual_pv_kwh : array, PV energy used per year (kWh/year)
+    cost_eur_per_wp : float, installed cost (EUR/Wp)
+    tariff_eur_per_kwh : float, price of the grid energy the PV replaces (EUR/kWh)
+
+    Returns
+    -------
+    array, years: ``cost / (annual_pv_kwh x tariff)``; inf where nothing is saved
+
+    References
+    ----------
+    The paper's payback (section 4), without discounting or degradation.
+    """
     saving = np.asarray(annual_pv_kwh, dtype=float) * tariff_eur_per_kwh
     cost = system_cost_eur(kwp, cost_eur_per_wp)
     with np.errstate(divide="ignore", invalid="ignore"):

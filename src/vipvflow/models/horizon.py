@@ -50,6 +50,12 @@ def horizon_profile(scene, origins, n_azimuth: int = N_AZIMUTH, tol_deg: float =
     -------
     (n, n_azimuth) float32, degrees in [0, 90]: 0 where a horizontal ray escapes, else
     the middle of the last bracket ``[blocked, free]`` (error below ``tol_deg / 2``).
+
+    References
+    ----------
+    The horizon-angle method of urban sky-view studies (Oke, "Canyon geometry and the
+    nocturnal urban heat island", J. Climatol. 1, 1981: the canyon's horizon
+    ``atan(H / D)``, which tests/test_app.py checks against this function).
     """
     o = np.asarray(origins, np.float64).reshape(-1, 3)
     n = len(o)

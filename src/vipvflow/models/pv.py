@@ -37,15 +37,33 @@ def energy_paper(poa_wm2, dt_s, kwp, performance_ratio=0.75):
     Returns
     -------
     array, kWh
+
+    References
+    ----------
+    The paper's PV model (section 3.3); IEC 61724-1 for the performance ratio.
     """
     return (paper_kw_per_wm2(kwp, performance_ratio) * np.asarray(poa_wm2, np.float64)
             * np.asarray(dt_s, np.float64) / 3600.0)
 
 
 def cell_temperature(poa_wm2, temp_air_c, wind_mps, model: str = "sapm_open_rack_glass_polymer"):
-    """Cell temperature (degC) from POA irradiance (W/m2), air temperature (degC) and wind (m/s).
+    """Cell temperature of the roof modules.
 
-    ``model`` is ``sapm_<mounting>`` (a key of pvlib's SAPM parameter table) or ``faiman``.
+    Parameters
+    ----------
+    poa_wm2 : array, plane-of-array irradiance (W/m2)
+    temp_air_c : array, air temperature (degC)
+    wind_mps : array, wind speed over the modules (m/s; the bus's speed adds to it)
+    model : ``sapm_<mounting>`` (a key of pvlib's SAPM parameter table) or ``faiman``
+
+    Returns
+    -------
+    array, cell temperature (degC)
+
+    References
+    ----------
+    pvlib ``temperature.sapm_cell`` (King et al., SAND2004-3535) and ``temperature.faiman``
+    (Faiman, Prog. Photovolt. 16, 2008).
     """
     import pvlib  # here and below imported where used: paper mode never needs it
 
@@ -90,7 +108,23 @@ def power_pvlib(poa_wm2, system: PVSystem, temp_air_c=15.0, vehicle_speed_mps=0.
 
 def energy_pvlib(poa_wm2, dt_s, system: PVSystem, temp_air_c=15.0, vehicle_speed_mps=0.0,
                  wind_mps=0.0):
-    """Energy (kWh) with :func:`power_pvlib` held over each ``dt_s`` (s)."""
+    """Energy of the pvlib PV model.
+
+    Parameters
+    ----------
+    poa_wm2 : array, plane-of-array irradiance (W/m2)
+    dt_s : array, time at that irradiance (s)
+    system : PVSystem
+    temp_air_c, vehicle_speed_mps, wind_mps : air temperature (degC), bus speed and wind (m/s)
+
+    Returns
+    -------
+    array, kWh: :func:`power_pvlib`'s AC power (W) held over each ``dt_s``
+
+    References
+    ----------
+    pvlib ``pvsystem.pvwatts_dc`` and ``inverter.pvwatts`` (Dobos, NREL/TP-6A20-62641, 2014).
+    """
     pac, _ = power_pvlib(poa_wm2, system, temp_air_c, vehicle_speed_mps, wind_mps)
     return pac * np.asarray(dt_s, np.float64) / 3.6e6
 
