@@ -99,7 +99,7 @@ def write_network_gtfs(path: Path, paths: list[np.ndarray], days: list[dt.date],
     """A GTFS zip of one line per polyline, running on *days*; returns counts."""
     from pyproj import Transformer
 
-    from vipvflow.demo.gtfs import _blocks, gtfs_time, stop_offsets, stop_positions
+    from vipvflow.demo.gtfs import _blocks, direction_trips, stop_offsets, stop_positions
     from vipvflow.demo.layout import cumulative_length, densify, point_at
 
     rng = np.random.default_rng(seed)
@@ -131,22 +131,9 @@ def write_network_gtfs(path: Path, paths: list[np.ndarray], days: list[dt.date],
             t0 = np.arange(_hm(start), _hm(end), headway * 60 * factor, dtype=np.int64)
             buses = _blocks(t0, t0, int(arr[-1]))
             for d in (0, 1):
-                ids = [f"{rid}_{sid}_d{d}_{i:03d}" for i in range(len(t0))]
-                trips.append(pd.DataFrame({
-                    "route_id": rid, "service_id": sid, "trip_id": ids, "direction_id": d,
-                    "block_id": [f"{rid}_{sid}_B{b:02d}" for b in buses[d]],
-                    "shape_id": f"{rid}_d{d}"}))
-                idx = np.arange(len(stop_s)) if d == 0 else np.arange(len(stop_s))[::-1]
-                dist = stop_s if d == 0 else length - stop_s[::-1]
-                n = len(stop_s)
-                stop_times.append(pd.DataFrame({
-                    "trip_id": np.repeat(ids, n),
-                    "arrival_time": gtfs_time((t0[:, None] + arr[None, :]).ravel()),
-                    "departure_time": gtfs_time((t0[:, None] + dep[None, :]).ravel()),
-                    "stop_id": np.tile([f"{rid}_S{i:02d}_d{d}" for i in idx], len(t0)),
-                    "stop_sequence": np.tile(np.arange(1, n + 1), len(t0)),
-                    "shape_dist_traveled": np.tile(np.round(np.abs(dist), 2), len(t0)),
-                    "timepoint": 1}))
+                t, st = direction_trips(rid, sid, d, t0, buses[d], stop_s, length, arr, dep)
+                trips.append(t)
+                stop_times.append(st)
     start, end = min(days).strftime("%Y%m%d"), max(days).strftime("%Y%m%d")
     weekdays = {d.weekday() for d in days}
     names = ["monday", "tuesday", "wednesday", "thursday", "friday", "saturday", "sunday"]

@@ -194,23 +194,10 @@ def _line_tables(line: Line, to_wgs84: Transformer):
         t0 = departures(line.name, sid)
         buses = _blocks(t0, t0, duration)
         for d in (0, 1):
-            ids = [f"{rid}_{sid}_d{d}_{k:03d}" for k in range(len(t0))]
-            trips.append(pd.DataFrame({
-                "route_id": rid, "service_id": sid, "trip_id": ids,
-                "trip_headsign": line.long_name.split(" - ")[-1 if d == 0 else 0],
-                "direction_id": d, "block_id": [f"{rid}_{sid}_B{b:02d}" for b in buses[d]],
-                "shape_id": f"{rid}_d{d}"}))
-            stop_idx = np.arange(len(stop_s)) if d == 0 else np.arange(len(stop_s))[::-1]
-            dist = stop_s if d == 0 else length - stop_s[::-1]
-            n = len(stop_s)
-            stop_times.append(pd.DataFrame({
-                "trip_id": np.repeat(ids, n),
-                "arrival_time": gtfs_time((t0[:, None] + arr[None, :]).ravel()),
-                "departure_time": gtfs_time((t0[:, None] + dep[None, :]).ravel()),
-                "stop_id": np.tile([f"{rid}_S{k:02d}_d{d}" for k in stop_idx], len(t0)),
-                "stop_sequence": np.tile(np.arange(1, n + 1), len(t0)),
-                "shape_dist_traveled": np.tile([f"{v:.2f}" for v in np.abs(dist)], len(t0)),
-                "timepoint": 1}))
+            t, st = direction_trips(rid, sid, d, t0, buses[d], stop_s, length, arr, dep)
+            t.insert(3, "trip_headsign", line.long_name.split(" - ")[-1 if d == 0 else 0])
+            trips.append(t)
+            stop_times.append(st)
     return (pd.concat(stops), pd.concat(shapes), pd.concat(trips), pd.concat(stop_times),
             {"stops": len(stop_s), "trip_duration_s": duration})
 
@@ -258,3 +245,37 @@ def write_gtfs(path: Path, layout: Layout, year: int) -> dict:
         "blocks": int(tables["trips.txt"]["block_id"].nunique()),
         "per_line": {line.name: p[4] for line, p in zip(layout.lines, parts)},
     }
+
+
+def direction_trips(rid: str, sid: str, d: int, t0, buses, stop_s, length: float, arr, dep):
+    """trips.txt and stop_times.txt rows of one route, service and direction.
+
+    Parameters
+    ----------
+    rid, sid : route and service ids
+    d : direction (0 along the shape, 1 back)
+    t0 : departures (s after local midnight)
+    buses : the block number of each departure
+    stop_s : stop positions along direction 0's shape (m); *length* the shape's length (m)
+    arr, dep : arrival and departure offsets at each stop from the first departure (s)
+
+    Returns
+    -------
+    (trips, stop_times) DataFrames (times as GTFS ``HH:MM:SS``, distances in m as text)
+    """
+    ids = [f"{rid}_{sid}_d{d}_{k:03d}" for k in range(len(t0))]
+    trips = pd.DataFrame({"route_id": rid, "service_id": sid, "trip_id": ids, "direction_id": d,
+                          "block_id": [f"{rid}_{sid}_B{b:02d}" for b in buses],
+                          "shape_id": f"{rid}_d{d}"})
+    stop_idx = np.arange(len(stop_s)) if d == 0 else np.arange(len(stop_s))[::-1]
+    dist = stop_s if d == 0 else length - stop_s[::-1]
+    n = len(stop_s)
+    stop_times = pd.DataFrame({
+        "trip_id": np.repeat(ids, n),
+        "arrival_time": gtfs_time((t0[:, None] + arr[None, :]).ravel()),
+        "departure_time": gtfs_time((t0[:, None] + dep[None, :]).ravel()),
+        "stop_id": np.tile([f"{rid}_S{k:02d}_d{d}" for k in stop_idx], len(t0)),
+        "stop_sequence": np.tile(np.arange(1, n + 1), len(t0)),
+        "shape_dist_traveled": np.tile([f"{v:.2f}" for v in np.abs(dist)], len(t0)),
+        "timepoint": 1})
+    return trips, stop_times
