@@ -121,6 +121,11 @@ def shading_loss(direct, diffuse, unshaded):
     unshaded`` (sun and sky both count; the light the buildings reflect onto the roof is
     reported apart, as a gain).  Irradiances, irradiations or energies alike (same unit in
     all three); NaN where nothing was received unshaded.  Arrays, pandas Series or floats.
+
+    References
+    ----------
+    The definition in README.md and docs/physics.md: the sun and sky light the buildings
+    take away; their reflections are reported apart.
     """
     shaded = direct + diffuse
     if hasattr(unshaded, "where"):

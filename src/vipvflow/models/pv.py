@@ -93,6 +93,11 @@ def power_pvlib(poa_wm2, system: PVSystem, temp_air_c=15.0, vehicle_speed_mps=0.
     Returns
     -------
     p_ac_w, temp_cell_c : arrays
+
+    References
+    ----------
+    pvlib ``pvsystem.pvwatts_dc`` and ``inverter.pvwatts`` (Dobos, NREL/TP-6A20-62641, 2014);
+    ``temperature.sapm_cell`` (King et al., SAND2004-3535).
     """
     import pvlib
 

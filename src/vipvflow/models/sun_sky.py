@@ -31,6 +31,11 @@ def sun_vectors(t_utc, lat, lon, altitude, step_s: float = 300.0) -> np.ndarray:
     Parameters
     ----------
     t_utc : (N,) float, Unix s;  lat, lon : (K,) degrees;  altitude : (K,) m
+
+    References
+    ----------
+    pvlib ``solarposition.get_solarposition`` (NREL SPA: Reda and Andreas, Solar Energy 76,
+    2004).
     """
     import pvlib
 
@@ -83,6 +88,11 @@ class RadiationTable:
     data : dict name -> (K, N) float32; ``ghi ... dhi_clear`` (W/m2) and the sun unit vector
         ``sun_x, sun_y, sun_z`` (east, north, up; from pvlib apparent zenith and azimuth)
     lat, lon : (K,) float64, degrees
+
+    References
+    ----------
+    CAMS solar radiation time series (Copernicus Atmosphere Monitoring Service; Qu et al.,
+    Meteorol. Z. 26, 2017): GHI, DHI, BNI and their clear-sky values per minute.
     """
 
     t0: float

@@ -193,6 +193,11 @@ def wheel_power(cycle: pd.DataFrame, params: VehicleParams) -> dict[str, np.ndar
     Inertia: m (1+f_rot) a v_mean is the exact mean of m (1+f_rot) a v for constant a, so its
     integral is the kinetic-energy change.  Air: the mean of v^3 over a linear ramp is
     (v0 + v1)(v0^2 + v1^2) / 4.  Gradient: the mean of the two samples' dz/ds.
+
+    References
+    ----------
+    VECTO's longitudinal dynamics (European Commission JRC, VECTO user manual: rolling
+    resistance, air drag, gradient and inertia at the wheel).
     """
     t = np.asarray(cycle["t_s"], dtype=float)
     v = np.asarray(cycle["speed_mps"], dtype=float)
@@ -332,6 +337,11 @@ def soc_trace(trips_energy: pd.DataFrame, pv_kwh: Sequence[float] | np.ndarray |
     stops at ``soc_max``.  The SoC is not clipped at ``soc_min``: a value below it shows how
     far the block overruns the window.  Trips of a block are sequential, so this is a short
     loop over the block's trips.
+
+    References
+    ----------
+    The paper's block-day energy balance (section 4): PV charges the battery up to the SoC
+    ceiling, the rest is curtailed.
     """
     col = "battery_kwh" if "battery_kwh" in trips_energy else "consumption_kwh"
     use = np.asarray(trips_energy[col], dtype=float)
@@ -459,6 +469,10 @@ def block_day_balance(pv_steps: np.ndarray, use_steps: np.ndarray, pv_parked, pa
     A trip and the layover after it are one step: the SoC falls on the trip and rises at
     the layover only when its PV exceeds the auxiliaries, so the step's highest SoC is at its
     end, where the ceiling is applied.
+
+    References
+    ----------
+    The paper's block-day energy balance (section 4); VECTO's auxiliary and HVAC demand.
     """
     pv = np.asarray(pv_steps, float)
     use = np.asarray(use_steps, float)
