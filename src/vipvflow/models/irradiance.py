@@ -193,6 +193,12 @@ def roof_irradiance(geometry, rows, sun: np.ndarray, rad: dict, scene, cfg: Irra
     0 or 1 for that pass, and its mean over passes is the P-point lit fraction, an unbiased
     estimate with P times fewer rays); all in one occlusion query, and the same visibility
     serves all-sky and clear-sky.  The components are summed by :func:`roof_components`.
+
+    References
+    ----------
+    The paper (section 3: direct, isotropic diffuse and reflected light on the roof); the
+    sky view factor of Oke (J. Climatol. 1, 1981) for the default diffuse model; pvlib
+    ``irradiance.get_total_irradiance`` for the unshaded plane of array.
     """
     f32 = np.float32
     t_start = time.perf_counter()
@@ -344,6 +350,12 @@ def evaluate_passes(passes: pd.DataFrame, segments: pd.DataFrame, geometry: pd.D
     DataFrame indexed like *passes*: ``direct, diffuse, reflected, total`` and the
     ``_clear`` variants, ``total_unshaded``, ``total_clear_unshaded``, and the horizontal
     ``ghi``, ``ghi_clear`` at the pass (float32, W/m2), ``sun_visible`` (bool).
+
+    References
+    ----------
+    The paper (section 3: direct, isotropic diffuse and reflected light on the roof); the
+    sky view factor of Oke (J. Climatol. 1, 1981) for the default diffuse model; pvlib
+    ``irradiance.get_total_irradiance`` for the unshaded plane of array.
     """
     cfg = cfg or IrradianceCfg()
     del segments
