@@ -10,8 +10,8 @@ call:
    writes the pass's rays (the roof point towards the sun, one per reflector facing it)
    straight into the ray batch;
 2. Embree answers the batch (:meth:`vipvflow.models.shading.Scene.occluded_local`);
-3. :func:`_finish_block` sums the components per pass into the output block of
-   :func:`vipvflow.models.irradiance.evaluate_passes`, or :func:`_finish_bins` adds their
+3. :func:`_finish` sums the components per pass into the output block of
+   :func:`vipvflow.models.irradiance.evaluate_passes`, or adds their
    irradiation (Wh/m2) straight into the (segment, local hour) and (trip, date) bins of a
    partition (:func:`vipvflow.simulation.partition.aggregate_partition`).
 
@@ -199,29 +199,13 @@ def _visibility(c, pass_ray, pair_w, pair_pass, q, occ, cos_aoi, rotate, P):
 
 
 @njit(cache=True, nogil=True)
-def _finish_block(lo, hi, row, rad, cos_aoi, pass_ray, pair_w, pair_pass, occ, done,
-                  sky, iso, refl_sky, refl_ghi, rotate, P, block, visible_out):
-    """Components of passes ``lo..hi`` into columns of *block* (12, n) and *visible_out*."""
-    out = np.empty(12, np.float32)
-    q = 0
-    for i in range(lo, hi):
-        c = i - lo
-        if not done[c]:
-            continue
-        visible, beam_sum, q = _visibility(c, pass_ray, pair_w, pair_pass, q, occ, cos_aoi,
-                                           rotate, P)
-        r = row[i]
-        _components(c, r, rad, cos_aoi, visible, beam_sum, sky, iso, refl_sky, refl_ghi, out)
-        for j in range(12):
-            block[j, i] = out[j]
-        visible_out[i] = visible
-
-
-@njit(cache=True, nogil=True)
-def _finish_bins(lo, hi, row, rad, cos_aoi, pass_ray, pair_w, pair_pass, occ, done,
-                 sky, iso, refl_sky, refl_ghi, rotate, P, dt, seg_hour, run, seg_bins, run_bins):
-    """Irradiation (Wh/m2) of passes ``lo..hi`` added into ``seg_bins[seg_hour[i]]`` and
-    ``run_bins[run[i]]`` ((bins, 12) float64, :data:`BLOCK_COLUMNS`)."""
+def _finish(lo, hi, row, rad, cos_aoi, pass_ray, pair_w, pair_pass, occ, done,
+            sky, iso, refl_sky, refl_ghi, rotate, P, to_bins, block, visible_out,
+            dt, seg_hour, run, seg_bins, run_bins):
+    """Components of passes ``lo..hi``: into columns of *block* (12, n) and *visible_out*,
+    or, with *to_bins*, as irradiation (Wh/m2) added into ``seg_bins[seg_hour[i]]`` and
+    ``run_bins[run[i]]`` ((bins, 12) float64, :data:`BLOCK_COLUMNS`); the other side's
+    arrays are not touched (empty ones will do)."""
     out = np.empty(12, np.float32)
     q = 0
     for i in range(lo, hi):
@@ -231,12 +215,24 @@ def _finish_bins(lo, hi, row, rad, cos_aoi, pass_ray, pair_w, pair_pass, occ, do
         visible, beam_sum, q = _visibility(c, pass_ray, pair_w, pair_pass, q, occ, cos_aoi,
                                            rotate, P)
         _components(c, row[i], rad, cos_aoi, visible, beam_sum, sky, iso, refl_sky, refl_ghi, out)
-        w = dt[i] / 3600.0
-        b, k = seg_hour[i], run[i]
-        for j in range(12):
-            h = np.float64(out[j]) * w
-            seg_bins[b, j] += h
-            run_bins[k, j] += h
+        if to_bins:
+            w = dt[i] / 3600.0
+            b, k = seg_hour[i], run[i]
+            for j in range(12):
+                h = np.float64(out[j]) * w
+                seg_bins[b, j] += h
+                run_bins[k, j] += h
+        else:
+            for j in range(12):
+                block[j, i] = out[j]
+            visible_out[i] = visible
+
+
+#: empty stand-ins for the side of :func:`_finish` a call does not fill
+_NO_INT = np.zeros(0, np.int64)
+_NO_BINS = np.zeros((0, 12))
+_NO_BLOCK = np.zeros((12, 0), np.float32)
+_NO_VISIBLE = np.zeros(0, np.bool_)
 
 
 @njit(cache=True, nogil=True)
@@ -441,11 +437,7 @@ def evaluate_block(seg, t_start, dt, mid, row, geo, cfg, radiation_table, scene,
     block = np.zeros((len(BLOCK_COLUMNS), n), np.float32)      # one row per column
     visible = np.zeros(n, bool)
 
-    def finish(lo, hi, x, bt, occ, P, rotate):
-        _finish_block(lo, hi, row, bt.rad, bt.cos_aoi, bt.pass_ray, bt.pair_w, bt.pair_pass,
-                      occ, bt.done, x["sky"], x["iso"], x["refl_sky"], x["refl_ghi"],
-                      rotate, P, block, visible)
-
+    finish = _finisher(row, dt, False, block, visible, _NO_INT, _NO_INT, _NO_BINS, _NO_BINS)
     _run(seg, t_start, dt, mid, row, geo, cfg, radiation_table, scene, loc_of_row,
          {} if timings is None else timings, finish)
     return block.T, visible
@@ -471,14 +463,20 @@ def accumulate(seg, t_start, dt, mid, row, geo, cfg, radiation_table, scene, seg
     seg_bins = np.zeros((n_seg_hour, len(BLOCK_COLUMNS)))
     run_bins = np.zeros((n_runs, len(BLOCK_COLUMNS)))
 
-    def finish(lo, hi, x, bt, occ, P, rotate):
-        _finish_bins(lo, hi, row, bt.rad, bt.cos_aoi, bt.pass_ray, bt.pair_w, bt.pair_pass,
-                     occ, bt.done, x["sky"], x["iso"], x["refl_sky"], x["refl_ghi"],
-                     rotate, P, dt, seg_hour, run, seg_bins, run_bins)
-
+    finish = _finisher(row, dt, True, _NO_BLOCK, _NO_VISIBLE, seg_hour, run, seg_bins, run_bins)
     _run(seg, t_start, dt, mid, row, geo, cfg, radiation_table, scene, loc_of_row,
          {} if timings is None else timings, finish)
     return seg_bins, run_bins
+
+
+def _finisher(row, dt, to_bins, block, visible, seg_hour, run, seg_bins, run_bins):
+    """The last step :func:`_run` calls on each chunk: :func:`_finish` into *block* and
+    *visible*, or (*to_bins*) into *seg_bins* and *run_bins*."""
+    def finish(lo, hi, x, bt, occ, P, rotate):
+        _finish(lo, hi, row, bt.rad, bt.cos_aoi, bt.pass_ray, bt.pair_w, bt.pair_pass,
+                occ, bt.done, x["sky"], x["iso"], x["refl_sky"], x["refl_ghi"],
+                rotate, P, to_bins, block, visible, dt, seg_hour, run, seg_bins, run_bins)
+    return finish
 
 
 def warm() -> float:
@@ -494,12 +492,11 @@ def warm() -> float:
         _setup(0, 1, one_i, one_t, one_t, True, one_i, one_i, packed, np.arange(9, dtype=i64),
                0.0, 60.0, o3, np.zeros((1, 1, 3), f32), o3, np.zeros((1, 1, 3), f32), rotate,
                f32(0.02), rad, one_f, pr, one_f, one_i, o3, o3, np.zeros(1, np.bool_))
-        _finish_block(0, 1, one_i, rad, one_f, pr, one_f, one_i, np.zeros(1, bool),
-                      np.zeros(1, np.bool_), one_f, one_f, one_f, one_f, rotate, 1,
-                      np.zeros((12, 1), f32), np.zeros(1, bool))
-        _finish_bins(0, 1, one_i, rad, one_f, pr, one_f, one_i, np.zeros(1, bool),
-                     np.zeros(1, np.bool_), one_f, one_f, one_f, one_f, rotate, 1, one_t,
-                     one_i, one_i, np.zeros((1, 12)), np.zeros((1, 12)))
+        for to_bins in (False, True):
+            _finish(0, 1, one_i, rad, one_f, pr, one_f, one_i, np.zeros(1, bool),
+                    np.zeros(1, np.bool_), one_f, one_f, one_f, one_f, rotate, 1, to_bins,
+                    np.zeros((12, 1), f32), np.zeros(1, bool), one_t, one_i, one_i,
+                    np.zeros((1, 12)), np.zeros((1, 12)))
     _groups(one_i, one_i, one_i, one_t, one_t, 0, one_i, 0, one_t, one_i, one_i, one_i, one_i)
     _seconds(one_i, one_i, one_i, one_t, one_t, one_t, one_t, one_i, one_i)
     return time.perf_counter() - t
