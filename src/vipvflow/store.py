@@ -38,6 +38,28 @@ from .errors import InputError
 TILE_SIZE_M = 500.0
 
 
+# --------------------------------------------------------------------------- folder entries
+class _Entry:
+    """A file or folder of a store folder: as a class attribute ``segments =
+    _Entry("segments.parquet")``, ``folder.segments`` is ``folder.root / "segments.parquet"``
+    (*within*: under that attribute's path instead of ``root``; *kind*: a store class built
+    on the path, e.g. ``DataDir.city`` is a :class:`CityDir`)."""
+
+    def __init__(self, name: str, doc: str = "", *, within: str | None = None, kind=None):
+        self.name, self.within, self.kind = name, within, kind
+        self.__doc__ = doc or f"``{name}``"
+
+    def __set_name__(self, owner, attr: str):
+        self.attr = attr
+
+    def __get__(self, folder, owner=None):
+        if folder is None:
+            return self
+        base = getattr(folder, self.within) if self.within else folder.root
+        path = base / self.name
+        return self.kind(path) if self.kind else path
+
+
 # --------------------------------------------------------------------------- data dir
 @dataclass(frozen=True)
 class _Ingested:
@@ -46,38 +68,19 @@ class _Ingested:
     *root* is the folder itself (``<data_dir>/<name>`` or the ingest's staging folder)."""
     root: Path
 
-    @property
-    def report(self) -> Path:
-        """What the ingest found (counts, problems, gaps)."""
-        return self.root / "ingest_report.json"
-
-    @property
-    def stamp(self) -> Path:
-        """Digest of the inputs this folder was ingested from (``prepare``)."""
-        return self.root / ".inputs.json"
+    report = _Entry('ingest_report.json', 'What the ingest found (counts, problems, gaps).')
+    stamp = _Entry('.inputs.json', 'Digest of the inputs this folder was ingested from (``prepare``).')
 
 
 @dataclass(frozen=True)
 class CityDir(_Ingested):
     """``city/``: tiled surfaces, tile meshes and terrain of the CityGML ingest."""
 
-    @property
-    def tiles_json(self) -> Path:
-        """CRS, tile size, buffer and the tiles with their extents."""
-        return self.root / "tiles.json"
-
-    @property
-    def terrain(self) -> Path:
-        return self.root / "terrain.npz"
-
-    @property
-    def meshes(self) -> Path:
-        return self.root / "meshes"
-
-    @property
-    def surfaces(self) -> Path:
-        """GeoParquet of every tile's own surfaces: ``surfaces/tile=<T>/part-0.parquet``."""
-        return self.root / "surfaces"
+    tiles_json = _Entry('tiles.json', 'CRS, tile size, buffer and the tiles with their extents.')
+    terrain = _Entry('terrain.npz')
+    meshes = _Entry('meshes')
+    surfaces = _Entry('surfaces', "GeoParquet of every tile's own surfaces: "
+                                  "``surfaces/tile=<T>/part-0.parquet``.")
 
     def mesh(self, tile: str) -> Path:
         """Triangle mesh of *tile*, its own surfaces and the buffer around it."""
@@ -96,22 +99,11 @@ class GtfsDir(_Ingested):
     """``gtfs/``: the timetable cut into segments, by the GTFS ingest (its report is
     :attr:`feed_json`)."""
 
-    @property
-    def feed_json(self) -> Path:
-        """Time zone, CRS, tile size, counts and problems of the ingested feed."""
-        return self.root / "feed.json"
-
-    @property
-    def segments(self) -> Path:
-        return self.root / "segments.parquet"
-
-    @property
-    def trips(self) -> Path:
-        return self.root / "trips.parquet"
-
-    @property
-    def patterns(self) -> Path:
-        return self.root / "patterns.parquet"
+    feed_json = _Entry('feed.json', 'Time zone, CRS, tile size, counts and problems of the '
+                                    'ingested feed.')
+    segments = _Entry('segments.parquet')
+    trips = _Entry('trips.parquet')
+    patterns = _Entry('patterns.parquet')
 
     def table(self, name: str) -> Path:
         """``<name>.parquet``, one of :data:`GTFS_TABLES`."""
@@ -124,9 +116,7 @@ class GtfsDir(_Ingested):
 class RadiationDir(_Ingested):
     """``radiation/``: the CAMS series of the CAMS ingest (and its sun-position caches)."""
 
-    @property
-    def table(self) -> Path:
-        return self.root / "radiation.parquet"
+    table = _Entry('radiation.parquet')
 
     def sun_cache(self, first_s: int, n: int) -> Path:
         """Sun vectors of the table's grid from *first_s* (Unix s), *n* steps, kept for the
@@ -142,17 +132,9 @@ class DataDir:
     def __post_init__(self):
         object.__setattr__(self, "root", Path(self.root))
 
-    @property
-    def city(self) -> CityDir:
-        return CityDir(self.root / "city")
-
-    @property
-    def gtfs(self) -> GtfsDir:
-        return GtfsDir(self.root / "gtfs")
-
-    @property
-    def radiation(self) -> RadiationDir:
-        return RadiationDir(self.root / "radiation")
+    city = _Entry('city', kind=CityDir)
+    gtfs = _Entry('gtfs', kind=GtfsDir)
+    radiation = _Entry('radiation', kind=RadiationDir)
 
     def tile_size_m(self) -> float:
         """The tile edge (m) of this data dir's grid: ``tile_size_m`` of ``gtfs/feed.json``
@@ -220,18 +202,10 @@ class RunDir:
     def __post_init__(self):
         object.__setattr__(self, "root", Path(self.root))
 
-    @property
-    def parts(self) -> Path:
-        return self.root / "parts"
-
-    @property
-    def manifest(self) -> Path:
-        return self.root / "manifest.json"
-
-    @property
-    def config_stamp(self) -> Path:
-        """Digest of the configuration the partitions under ``parts/`` were computed with."""
-        return self.parts / "config_digest.txt"
+    parts = _Entry('parts')
+    manifest = _Entry('manifest.json')
+    config_stamp = _Entry('config_digest.txt', 'Digest of the configuration the partitions under '
+                          '``parts/`` were computed with.', within='parts')
 
     @property
     def timeline(self) -> Path:
@@ -268,19 +242,9 @@ class RunDir:
                        "run": "*.parquet"}[PARTS[kind].per]
         return sorted(self.part_dir(kind).glob(pattern))
 
-    @property
-    def figures(self) -> Path:
-        """The report's PNG figures."""
-        return self.root / "figures"
-
-    @property
-    def vecto(self) -> Path:
-        """VECTO driving cycles and job files of the run's patterns."""
-        return self.root / "vecto"
-
-    @property
-    def report(self) -> Path:
-        return self.root / "report.html"
+    figures = _Entry('figures', "The report's PNG figures.")
+    vecto = _Entry('vecto', "VECTO driving cycles and job files of the run's patterns.")
+    report = _Entry('report.html')
 
     def output(self, name: str) -> Path:
         """An output of the reduce beside ``parts/``: ``summary.json``, ``trip_energy.parquet``..."""

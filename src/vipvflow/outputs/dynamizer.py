@@ -55,10 +55,8 @@ SEGMENT_SERIES = {
 }
 #: the same series summed over a route direction's segments (``--aggregate route``)
 ROUTE_SERIES = {
-    "h_direct": ("direct irradiation on the bus roof per month, summed over the segments", "Wh/m2"),
-    "h_diffuse": ("diffuse irradiation on the bus roof per month, summed over the segments", "Wh/m2"),
-    "h_reflected": ("reflected irradiation on the bus roof per month, summed over the segments", "Wh/m2"),
-    "h_total": ("total irradiation on the bus roof per month, summed over the segments", "Wh/m2"),
+    **{name: (f"{prop}, summed over the segments", unit)
+       for name, (prop, unit) in SEGMENT_SERIES.items() if name.startswith("h_")},
     "pv_kwh": ("PV energy harvested on the route direction per month (all passes)", "kWh"),
 }
 #: network series from hourly_pattern.parquet: attribute -> (observed property, unit)

@@ -191,47 +191,68 @@ def fig_routes(rm: pd.DataFrame):
 
 
 # ---------------------------------------------------------------------------- the table
-#: rows of the summary table: (section, key, label, unit, decimals, percent)
-_ROWS = [
-    ("Fleet and network", "routes", "routes", "", 0, False),
-    ("Fleet and network", "buses", "buses (most vehicle blocks on one day)", "", 0, False),
-    ("Fleet and network", "trips", "trips simulated", "", 0, False),
-    ("Fleet and network", "segments", "road segments", "", 0, False),
-    ("Fleet and network", "passes", "segment passes evaluated", "", 0, False),
-    ("Fleet and network", "service_hours_per_bus_year", "service time per bus", "h/year", 0, False),
-    ("PV yield", "kwp_per_bus", "PV installed per bus", "kWp", 2, False),
-    ("PV yield", "kwh_per_kwp_allsky", "specific yield while driving, all-sky", "kWh/kWp per year", 0, False),
-    ("PV yield", "kwh_per_kwp_clearsky", "specific yield while driving, clear-sky", "kWh/kWp per year", 0, False),
-    ("PV yield", "kwh_per_kwp_in_service", "specific yield in service (driving + layovers), all-sky",
-     "kWh/kWp per year", 0, False),
-    ("PV yield", "kwh_per_kwp_whole_day", "specific yield over the whole day (+ parked), all-sky",
-     "kWh/kWp per year", 0, False),
-    ("PV yield", "pv_kwh_layover", "PV energy at terminals between trips", "kWh (simulated months)", 0, False),
-    ("PV yield", "pv_kwh_parked", "PV energy parked at the depot", "kWh (simulated months)", 0, False),
-    ("PV yield", "pv_kwh_curtailed", "PV energy the batteries could not take (curtailed)",
-     "kWh (simulated months)", 0, False),
-    ("PV yield", "pv_kwh_allsky", "PV energy of the fleet, all-sky", "kWh (simulated months)", 0, False),
-    ("PV yield", "pv_kwh_clearsky", "the same under a cloudless sky", "kWh (simulated months)", 0, False),
-    ("PV yield", "pv_kwh_allsky_unshaded", "the same, all-sky, without buildings", "kWh (simulated months)", 0, False),
-    ("Buildings", "shading_loss_allsky", "shading loss, all-sky", "%", 1, True),
-    ("Buildings", "shading_loss_clearsky", "shading loss, clear-sky", "%", 1, True),
-    ("Buildings", "reflection_gain_allsky", "gain from reflections, all-sky", "%", 1, True),
-    ("Buildings", "net_building_effect_allsky", "net effect of the buildings, all-sky", "%", 1, True),
-    ("Light", "site_ghi_kwh_m2_year", "global horizontal irradiation of the site", "kWh/m² per year", 0, False),
-    ("Light", "ghi_in_service_kwh_m2_per_bus", "of which while a bus is in service", "kWh/m² per year", 0, False),
-    ("Light", "roof_irradiation_unshaded_kwh_m2_per_bus", "on a bus roof, without buildings",
-     "kWh/m² per year", 0, False),
-    ("Light", "roof_irradiation_kwh_m2_per_bus", "on a bus roof, with buildings", "kWh/m² per year", 0, False),
-    ("Energy and cost", "fleet_demand_mwh", "battery energy the fleet uses", "MWh per year", 0, False),
-    ("Energy and cost", "coverage", "share of it the roofs supply", "%", 2, True),
-    ("Energy and cost", "avoided_charging_cycles_fleet", "charging cycles avoided, fleet", "per year", 0, False),
-    ("Energy and cost", "avoided_charging_cycles_per_bus", "charging cycles avoided per bus", "per year", 1, False),
-    ("Energy and cost", "system_cost_eur_per_bus", "PV system cost per bus", "EUR", 0, False),
-    ("Energy and cost", "payback_years", "simple payback", "years", 1, False),
-    ("Model", "pv_mode", "PV model", "", 0, False),
-    ("Model", "diffuse_model", "sky diffuse model", "", 0, False),
-    ("Model", "annualised_from_months", "yearly figures scaled from fewer months", "", 0, False),
-]
+#: the summary table: section -> key -> label, in the order shown; the unit and the meaning
+#: (on hover) are the data dictionary's (:data:`SUMMARY`), fractions shown as %
+_SECTIONS = {
+    "Fleet and network": {
+        "routes": "routes",
+        "buses": "buses (most vehicle blocks on one day)",
+        "trips": "trips simulated",
+        "segments": "road segments",
+        "passes": "segment passes evaluated",
+        "service_hours_per_bus_year": "service time per bus",
+    },
+    "PV yield": {
+        "kwp_per_bus": "PV installed per bus",
+        "kwh_per_kwp_allsky": "specific yield while driving, all-sky",
+        "kwh_per_kwp_clearsky": "specific yield while driving, clear-sky",
+        "kwh_per_kwp_in_service": "specific yield in service (driving + layovers), all-sky",
+        "kwh_per_kwp_whole_day": "specific yield over the whole day (+ parked), all-sky",
+        "pv_kwh_layover": "PV energy at terminals between trips",
+        "pv_kwh_parked": "PV energy parked at the depot",
+        "pv_kwh_curtailed": "PV energy the batteries could not take (curtailed)",
+        "pv_kwh_allsky": "PV energy of the fleet, all-sky",
+        "pv_kwh_clearsky": "the same under a cloudless sky",
+        "pv_kwh_allsky_unshaded": "the same, all-sky, without buildings",
+    },
+    "Buildings": {
+        "shading_loss_allsky": "shading loss, all-sky",
+        "shading_loss_clearsky": "shading loss, clear-sky",
+        "reflection_gain_allsky": "gain from reflections, all-sky",
+        "net_building_effect_allsky": "net effect of the buildings, all-sky",
+    },
+    "Light": {
+        "site_ghi_kwh_m2_year": "global horizontal irradiation of the site",
+        "ghi_in_service_kwh_m2_per_bus": "of which while a bus is in service",
+        "roof_irradiation_unshaded_kwh_m2_per_bus": "on a bus roof, without buildings",
+        "roof_irradiation_kwh_m2_per_bus": "on a bus roof, with buildings",
+    },
+    "Energy and cost": {
+        "fleet_demand_mwh": "battery energy the fleet uses",
+        "coverage": "share of it the roofs supply",
+        "avoided_charging_cycles_fleet": "charging cycles avoided, fleet",
+        "avoided_charging_cycles_per_bus": "charging cycles avoided per bus",
+        "system_cost_eur_per_bus": "PV system cost per bus",
+        "payback_years": "simple payback",
+    },
+    "Model": {
+        "pv_mode": "PV model",
+        "diffuse_model": "sky diffuse model",
+        "annualised_from_months": "yearly figures scaled from fewer months",
+    },
+}
+#: decimals of the table's values where the default (0; 1 for a percentage) would hide them
+_DECIMALS = {"kwp_per_bus": 2, "coverage": 2, "avoided_charging_cycles_per_bus": 1,
+             "payback_years": 1}
+#: how a data-dictionary unit reads in the table (sums over the run say so)
+_UNIT_SHOWN = {"count": "", "fraction": "%", "kWh": "kWh (simulated months)",
+               "h": "h (simulated months)"}
+
+
+def _unit(key: str) -> tuple[str, bool]:
+    """The unit *key* is shown in and whether its value is shown as a percentage."""
+    unit = SUMMARY[key].unit if key in SUMMARY else ""
+    return _UNIT_SHOWN.get(unit, unit).replace("m2", "m²"), unit == "fraction"
 
 
 def _fmt(v, decimals: int | None = None, percent: bool = False) -> str:
@@ -258,30 +279,33 @@ def _fmt(v, decimals: int | None = None, percent: bool = False) -> str:
 def summary_table(summary: dict) -> str:
     """The summary as an HTML table by section (value, unit; the meaning on hover); keys
     not in the curated rows are listed under "More" with the data dictionary's unit."""
-    rows, section, shown = [], None, set()
-    for sec, key, label, unit, decimals, percent in _ROWS:
-        if key not in summary:
-            continue
-        shown.add(key)
-        if sec != section:
-            rows.append(f"<tr><th colspan='3' class='sec'>{html.escape(sec)}</th></tr>")
-            section = sec
-        meaning = SUMMARY[key].meaning if key in SUMMARY else ""
-        rows.append(f"<tr title='{html.escape(meaning)}'><td>{html.escape(label)}</td>"
-                    f"<td class='num'>{html.escape(_fmt(summary[key], decimals, percent))}</td>"
-                    f"<td>{html.escape(unit)}</td></tr>")
+    rows, shown = [], set()
+    for section, labels in _SECTIONS.items():
+        keys = [k for k in labels if k in summary]
+        if keys:
+            rows.append(f"<tr><th colspan='3' class='sec'>{html.escape(section)}</th></tr>")
+        rows += [_summary_row(summary, k, html.escape(labels[k]), _DECIMALS.get(k)) for k in keys]
+        shown.update(keys)
     more = [k for k, v in summary.items() if k not in shown and not isinstance(v, (dict, list))
             and k not in ("scenario", "year")]
     if more:
         rows.append("<tr><th colspan='3' class='sec'>More (see docs/outputs.md)</th></tr>")
-        for k in more:
-            entry = SUMMARY.get(k)
-            unit = entry.unit if entry else ""
-            pct = unit == "fraction"
-            rows.append(f"<tr title='{html.escape(entry.meaning if entry else '')}'><td><code>{html.escape(k)}</code></td>"
-                        f"<td class='num'>{html.escape(_fmt(summary[k], None, pct))}</td>"
-                        f"<td>{'%' if pct else html.escape(unit)}</td></tr>")
+        rows += [_summary_row(summary, k, f"<code>{html.escape(k)}</code>", None, auto=True)
+                 for k in more]
     return f"<table class='summary'>{''.join(rows)}</table>"
+
+
+def _summary_row(summary: dict, key: str, label_html: str, decimals: int | None,
+                 auto: bool = False) -> str:
+    """One row of the summary table: label, value (*decimals*, else 1 for a percentage and 0
+    otherwise, or as :func:`_fmt` sees fit with *auto*), unit; the meaning on hover."""
+    unit, percent = _unit(key)
+    if decimals is None and not auto:
+        decimals = 1 if percent else 0
+    meaning = SUMMARY[key].meaning if key in SUMMARY else ""
+    return (f"<tr title='{html.escape(meaning)}'><td>{label_html}</td>"
+            f"<td class='num'>{html.escape(_fmt(summary[key], decimals, percent))}</td>"
+            f"<td>{html.escape(unit)}</td></tr>")
 
 
 def _how_to_read(summary: dict) -> str:
