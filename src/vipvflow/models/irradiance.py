@@ -255,9 +255,7 @@ def roof_irradiance(geometry, rows, sun: np.ndarray, rad: dict, scene, cfg: Irra
         occ = (scene.occluded_local(o, d, cfg.ray_length_m) if local
                else scene.occluded(o, d, cfg.ray_length_m))
         t_done = time.perf_counter()
-        if timings is not None:
-            timings["ray_setup_s"] = timings.get("ray_setup_s", 0.0) + t_rays - t_start
-            timings["rays_s"] = timings.get("rays_s", 0.0) + t_done - t_rays
+        _add_seconds(timings, ray_setup_s=t_rays - t_start, rays_s=t_done - t_rays)
         t_start = t_done
         visible[cand] = ~occ[:nd]
         if len(pi):
@@ -278,9 +276,15 @@ def roof_irradiance(geometry, rows, sun: np.ndarray, rad: dict, scene, cfg: Irra
         out["total" + sfx] = out["direct" + sfx] + out["diffuse" + sfx] + out["reflected" + sfx]
         out[f"total{sfx}_unshaded"] = unshaded
     out["sun_visible"] = visible
-    if timings is not None:
-        timings["components_s"] = timings.get("components_s", 0.0) + time.perf_counter() - t_start
+    _add_seconds(timings, components_s=time.perf_counter() - t_start)
     return out
+
+
+def _add_seconds(timings: dict | None, **seconds: float) -> None:
+    """Add *seconds* to the caller's *timings* (if any) under their names."""
+    if timings is not None:
+        for key, s in seconds.items():
+            timings[key] = timings.get(key, 0.0) + s
 
 
 def pass_sample_key(segment_id, t_utc) -> np.ndarray:
