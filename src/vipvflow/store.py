@@ -68,18 +68,18 @@ class _Ingested:
     *root* is the folder itself (``<data_dir>/<name>`` or the ingest's staging folder)."""
     root: Path
 
-    report = _Entry('ingest_report.json', 'What the ingest found (counts, problems, gaps).')
-    stamp = _Entry('.inputs.json', 'Digest of the inputs this folder was ingested from (``prepare``).')
+    report = _Entry("ingest_report.json", "What the ingest found (counts, problems, gaps).")
+    stamp = _Entry(".inputs.json", "Digest of the inputs this folder was ingested from (``prepare``).")
 
 
 @dataclass(frozen=True)
 class CityDir(_Ingested):
     """``city/``: tiled surfaces, tile meshes and terrain of the CityGML ingest."""
 
-    tiles_json = _Entry('tiles.json', 'CRS, tile size, buffer and the tiles with their extents.')
-    terrain = _Entry('terrain.npz')
-    meshes = _Entry('meshes')
-    surfaces = _Entry('surfaces', "GeoParquet of every tile's own surfaces: "
+    tiles_json = _Entry("tiles.json", "CRS, tile size, buffer and the tiles with their extents.")
+    terrain = _Entry("terrain.npz")
+    meshes = _Entry("meshes")
+    surfaces = _Entry("surfaces", "GeoParquet of every tile's own surfaces: "
                                   "``surfaces/tile=<T>/part-0.parquet``.")
 
     def mesh(self, tile: str) -> Path:
@@ -99,11 +99,11 @@ class GtfsDir(_Ingested):
     """``gtfs/``: the timetable cut into segments, by the GTFS ingest (its report is
     :attr:`feed_json`)."""
 
-    feed_json = _Entry('feed.json', 'Time zone, CRS, tile size, counts and problems of the '
+    feed_json = _Entry("feed.json", 'Time zone, CRS, tile size, counts and problems of the '
                                     'ingested feed.')
-    segments = _Entry('segments.parquet')
-    trips = _Entry('trips.parquet')
-    patterns = _Entry('patterns.parquet')
+    segments = _Entry("segments.parquet")
+    trips = _Entry("trips.parquet")
+    patterns = _Entry("patterns.parquet")
 
     def table(self, name: str) -> Path:
         """``<name>.parquet``, one of :data:`GTFS_TABLES`."""
@@ -116,7 +116,7 @@ class GtfsDir(_Ingested):
 class RadiationDir(_Ingested):
     """``radiation/``: the CAMS series of the CAMS ingest (and its sun-position caches)."""
 
-    table = _Entry('radiation.parquet')
+    table = _Entry("radiation.parquet")
 
     def sun_cache(self, first_s: int, n: int) -> Path:
         """Sun vectors of the table's grid from *first_s* (Unix s), *n* steps, kept for the
@@ -132,9 +132,9 @@ class DataDir:
     def __post_init__(self):
         object.__setattr__(self, "root", Path(self.root))
 
-    city = _Entry('city', kind=CityDir)
-    gtfs = _Entry('gtfs', kind=GtfsDir)
-    radiation = _Entry('radiation', kind=RadiationDir)
+    city = _Entry("city", kind=CityDir)
+    gtfs = _Entry("gtfs", kind=GtfsDir)
+    radiation = _Entry("radiation", kind=RadiationDir)
 
     def tile_size_m(self) -> float:
         """The tile edge (m) of this data dir's grid: ``tile_size_m`` of ``gtfs/feed.json``
@@ -202,10 +202,10 @@ class RunDir:
     def __post_init__(self):
         object.__setattr__(self, "root", Path(self.root))
 
-    parts = _Entry('parts')
-    manifest = _Entry('manifest.json')
-    config_stamp = _Entry('config_digest.txt', 'Digest of the configuration the partitions under '
-                          '``parts/`` were computed with.', within='parts')
+    parts = _Entry("parts")
+    manifest = _Entry("manifest.json")
+    config_stamp = _Entry("config_digest.txt", 'Digest of the configuration the partitions under '
+                          '``parts/`` were computed with.', within="parts")
 
     @property
     def timeline(self) -> Path:
@@ -242,9 +242,9 @@ class RunDir:
                        "run": "*.parquet"}[PARTS[kind].per]
         return sorted(self.part_dir(kind).glob(pattern))
 
-    figures = _Entry('figures', "The report's PNG figures.")
-    vecto = _Entry('vecto', "VECTO driving cycles and job files of the run's patterns.")
-    report = _Entry('report.html')
+    figures = _Entry("figures", "The report's PNG figures.")
+    vecto = _Entry("vecto", "VECTO driving cycles and job files of the run's patterns.")
+    report = _Entry("report.html")
 
     def output(self, name: str) -> Path:
         """An output of the reduce beside ``parts/``: ``summary.json``, ``trip_energy.parquet``..."""

@@ -191,7 +191,7 @@ class TripModel:
                         ignore_index=True)
         hor = load_horizons(self.run_dir)
         if len(hor) == 0:
-            raise FileNotFoundError(f"{self.run_dir / 'parts' / 'horizon'}: no horizon profiles; "
+            raise FileNotFoundError(f"{RunDir(self.run_dir).part_dir('horizon')}: no horizon profiles; "
                                     "re-run the simulation with this version of vipvflow")
         seg = pd.read_parquet(gdir.segments,
                               columns=["segment_id", "shape_id", "x", "y", "x_end", "y_end",

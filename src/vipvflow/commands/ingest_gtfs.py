@@ -3,6 +3,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from ..store import DataDir
 from . import add_config
 
 
@@ -35,7 +36,7 @@ def run(args) -> int:
                          timezone=args.timezone or cfg.inputs.gtfs_timezone,
                          route_types=cfg.run.route_types)
     c = report["counts"]
-    print(f"GTFS {args.feed} -> {Path(args.data_dir) / 'gtfs'}  ({report['seconds']} s)")
+    print(f"GTFS {args.feed} -> {DataDir(args.data_dir).gtfs.root}  ({report['seconds']} s)")
     print(f"  CRS {report['crs']} ({report['crs_source']}), timezone {report['timezone']}, "
           f"timing {report['timing']}")
     print(f"  shapes {c['shapes']}  segments {c['segments']}  tiles {c['tiles']}  "

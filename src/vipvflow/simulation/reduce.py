@@ -183,7 +183,7 @@ def _trip_totals(run_dir: Path, table: pa.Table | None = None) -> pd.DataFrame:
     if table is None:
         table = _join_months(_trip_tree(Path(run_dir), _InProcess()))
     if table is None or not table.num_rows:
-        raise InputError(f"{Path(run_dir) / 'parts' / 'trip'}: no trip partitions with passes: "
+        raise InputError(f"{RunDir(run_dir).part_dir('trip')}: no trip partitions with passes: "
                          "the run's routes never pass its tiles in its months")
     return table.to_pandas()
 

@@ -424,7 +424,7 @@ def passes_for_trip(data_dir, trip_id: str, service_date) -> pd.DataFrame:
                                                       "start_s"])
     trips = trips[trips["trip_id"] == str(trip_id)]
     if trips.empty:
-        raise KeyError(f"trip {trip_id!r} not in {Path(data_dir) / 'gtfs' / 'trips.parquet'}")
+        raise KeyError(f"trip {trip_id!r} not in {DataDir(data_dir).gtfs.trips}")
     pid = int(trips["pattern_id"].iloc[0])
     pat = _read(data_dir, "patterns", filters=[("pattern_id", "==", pid)])
     date = pd.Timestamp(service_date).normalize()
