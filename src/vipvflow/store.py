@@ -273,6 +273,11 @@ def atomic_path(path: str | Path, suffix: str = "") -> Iterator[Path]:
         raise
 
 
+#: a table with more columns than this is written without column statistics or
+#: dictionaries (:func:`write_parquet`)
+WIDE_COLUMNS = 64
+
+
 def write_parquet(df, path: str | Path, pandas_dtypes: bool = False, compact: bool = False) -> Path:
     """Write *df* (DataFrame or GeoDataFrame) to *path* atomically.
 
@@ -298,6 +303,10 @@ def write_parquet(df, path: str | Path, pandas_dtypes: bool = False, compact: bo
             df.to_parquet(tmp, index=False)
         elif compact:
             pq.write_table(table, tmp, **_compact_options(table))
+        elif table.num_columns > WIDE_COLUMNS and output is None:
+            # per-column statistics and dictionaries of a wide table (the geometry
+            # partitions) cost more to write than its values, and made the file larger
+            pq.write_table(table, tmp, write_statistics=False, use_dictionary=False)
         else:
             pq.write_table(annotate(table, output) if output else table, tmp)
     return path
@@ -351,12 +360,14 @@ def _plain_table(df):
 
     if hasattr(df, "geometry") or not df.columns.is_unique:
         return None
-    arrays = []
-    for name in df.columns:
+    arrays = _numpy_columns(df)
+    for i, name in enumerate(df.columns):
+        if i in arrays:
+            continue
         col = df[name]
         kind = col.dtype.kind
         if kind in "biuf" or (kind == "M" and getattr(col.dtype, "tz", None) is None):
-            arrays.append(pa.array(col.to_numpy()))
+            arrays[i] = pa.array(col.to_numpy())
         elif pd.api.types.is_string_dtype(col.dtype) and not isinstance(col.dtype, pd.CategoricalDtype):
             try:        # object columns may hold anything: only real strings take this path
                 arr = pa.array(col.to_numpy(dtype=object), from_pandas=True)
@@ -365,10 +376,29 @@ def _plain_table(df):
             if not (pa.types.is_string(arr.type) or pa.types.is_large_string(arr.type)
                     or (pa.types.is_null(arr.type) and col.dtype != object)):
                 return None
-            arrays.append(arr.cast(pa.string()))
+            arrays[i] = arr.cast(pa.string())
         else:
             return None
+    arrays = [arrays[i] for i in range(len(df.columns))]
     return pa.Table.from_arrays(arrays, names=[str(c) for c in df.columns])
+
+
+def _numpy_columns(df) -> dict:
+    """The plain numpy columns of *df* (numbers, bools, naive datetimes) as Arrow arrays by
+    column position, taken out one 2-D block per dtype: the geometry partitions have about
+    a thousand columns, and one pandas lookup per column cost more than writing them."""
+    import numpy as np
+    import pyarrow as pa
+
+    by_dtype: dict = {}
+    for i, dtype in enumerate(df.dtypes):
+        if isinstance(dtype, np.dtype) and dtype.kind in "biufM":
+            by_dtype.setdefault(dtype, []).append(i)
+    arrays = {}
+    for positions in by_dtype.values():
+        block = np.ascontiguousarray(df.iloc[:, positions].to_numpy().T)
+        arrays.update({i: pa.array(block[j]) for j, i in enumerate(positions)})
+    return arrays
 
 
 def _arrow_table(df):

@@ -562,7 +562,18 @@ def _geometry_frame(seg_ids, origin, tilt, azim, normal, svf, acc: dict, G: int,
                 out[f"st_p{k}_{c}"] = street["pts"][:, k, j]
         out["st_sky"] = street["sky"].astype(f32)
         out["st_wall"] = street["wall"].astype(f32)
-    return pd.DataFrame(out)
+    return _frame_by_dtype(out)
+
+
+def _frame_by_dtype(columns: dict) -> pd.DataFrame:
+    """``pd.DataFrame(columns)``, built from one 2-D block per dtype: the geometry table has
+    about a thousand columns, and a frame built column by column cost more than the rays."""
+    by_dtype: dict = {}
+    for name, values in columns.items():
+        by_dtype.setdefault(np.asarray(values).dtype, []).append(name)
+    frames = [pd.DataFrame(np.column_stack([columns[c] for c in names]), columns=names)
+              for names in by_dtype.values()]
+    return pd.concat(frames, axis=1)[list(columns)]
 
 
 COMPONENTS = ("direct", "diffuse", "reflected", "total", "direct_clear", "diffuse_clear",
@@ -672,14 +683,17 @@ def pack_geometry(geometry: pd.DataFrame, cfg: IrradianceCfg, ground_albedo: flo
     pts = np.zeros((s, J, max(P, 1), 3), np.float64)
     f_s, f_g, f_o, f_w = (np.zeros((s, G)) for _ in range(4))
     beam_len = np.ones((s, J))
+    # the sample points: one (s, P x 3) block per reflector (a thousand columns read one
+    # by one cost more than the rest of the packing)
+    points = lambda prefix: geometry[[f"{prefix}_p{k}_{c}" for k in range(P)  # noqa: E731
+                                      for c in "xyz"]].to_numpy(np.float64).reshape(s, P, 3)
     for g in range(G):
         for j, c in enumerate("xyz"):
             nrm[:, g, j] = col(f"r{g}_n{c}")
-            if P:
-                for k in range(P):
-                    pts[:, g, k, j] = col(f"r{g}_p{k}_{c}")
-            else:
+            if not P:
                 pts[:, g, 0, j] = col(f"r{g}_{c}")
+        if P:
+            pts[:, g] = points(f"r{g}")
         if f"r{g}_sky" in cols:
             f_s[:, g], f_g[:, g], f_o[:, g] = col(f"r{g}_sky"), col(f"r{g}_gnd"), col(f"r{g}_open")
         else:
@@ -692,8 +706,7 @@ def pack_geometry(geometry: pd.DataFrame, cfg: IrradianceCfg, ground_albedo: flo
     if street:
         for j, c in enumerate("xyz"):
             nrm[:, G, j] = col(f"st_n{c}")
-            for k in range(P):
-                pts[:, G, k, j] = col(f"st_p{k}_{c}")
+        pts[:, G] = points("st")
         has = (f_g * w).sum(1) > 0
         m = _exchange_weights(w, f_g, f_w, col("st_wall"), has)
         src_sky = np.concatenate([f_s, col("st_sky")[:, None]], 1)

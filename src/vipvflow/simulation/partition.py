@@ -144,6 +144,26 @@ def tile_geometry(ctx: RunContext, tile: str) -> pd.DataFrame:
     return geom
 
 
+class TileGeometry:
+    """A tile's geometry table as the result of its Dask task (:func:`geometry_task`).
+
+    Dask measures every result it keeps; walking the thousand columns of a geometry table
+    for that cost more than computing the table, so this wrapper gives its size from its
+    shape (8 bytes a value)."""
+    __slots__ = ("frame",)
+
+    def __init__(self, frame: pd.DataFrame):
+        self.frame = frame
+
+    def __sizeof__(self) -> int:
+        return 64 + 8 * self.frame.shape[0] * self.frame.shape[1]
+
+
+def geometry_task(ctx: RunContext, tile: str) -> TileGeometry:
+    """:func:`tile_geometry` as a task of the run's graph."""
+    return TileGeometry(tile_geometry(ctx, tile))
+
+
 def pv_energy_kwh(poa_wm2: np.ndarray, dt_s: np.ndarray, speed_mps: np.ndarray, month: int,
                   ctx: RunContext) -> np.ndarray:
     """PV energy per pass in the run's PV mode (:func:`vipvflow.models.pv.energy`), at the month's
@@ -385,7 +405,8 @@ def _fused_sums(ctx: RunContext, tile: str, passes: pd.DataFrame, geometry: pd.D
     return groups, (seg_bins[:, order], run_bins[:, order])
 
 
-def run_partition(ctx: RunContext, tile: str, month: str, geometry: pd.DataFrame | None = None) -> dict:
+def run_partition(ctx: RunContext, tile: str, month: str,
+                  geometry: "pd.DataFrame | TileGeometry | None" = None) -> dict:
     """Evaluate every pass of *tile* in *month* and write the partition's files.
 
     Writes ``parts/trip/tile=T/month=M.parquet`` (per trip and service date: PV kWh for
@@ -402,6 +423,8 @@ def run_partition(ctx: RunContext, tile: str, month: str, geometry: pd.DataFrame
     run = RunDir(ctx.run_dir)
     if geometry is None:
         geometry = tile_geometry(ctx, tile)
+    elif isinstance(geometry, TileGeometry):
+        geometry = geometry.frame
     passes = iter_passes(ctx.data_dir, tile, month, ctx.year, routes=ctx.routes)
     timings = {"passes_s": time.perf_counter() - t0}
     n = len(passes)

@@ -4,7 +4,7 @@ from __future__ import annotations
 import time
 
 from ..progress import MapProgress
-from .partition import RunContext, run_partition, tile_geometry
+from .partition import RunContext, geometry_task, run_partition
 from .standing import run_standing
 
 
@@ -15,7 +15,7 @@ def map_tasks(client, ctx: RunContext, todo: list[tuple[str, str]], standing: li
     geometry = {}
     futures = []
     for tile in sorted({t for t, _ in todo}):
-        geometry[tile] = client.submit(tile_geometry, ctx, tile, key=f"geometry-{tile}")
+        geometry[tile] = client.submit(geometry_task, ctx, tile, key=f"geometry-{tile}")
     for tile, month in todo:
         futures.append(client.submit(run_partition, ctx, tile, month, geometry[tile],
                                      key=f"irradiance-{tile}-{month}"))
