@@ -360,7 +360,7 @@ def _plain_table(df):
 
     if hasattr(df, "geometry") or not df.columns.is_unique:
         return None
-    arrays = _numpy_columns(df)
+    arrays = _numpy_columns(df) if len(df.columns) > WIDE_COLUMNS else {}
     for i, name in enumerate(df.columns):
         if i in arrays:
             continue
@@ -370,7 +370,8 @@ def _plain_table(df):
             arrays[i] = pa.array(col.to_numpy())
         elif pd.api.types.is_string_dtype(col.dtype) and not isinstance(col.dtype, pd.CategoricalDtype):
             try:        # object columns may hold anything: only real strings take this path
-                arr = pa.array(col.to_numpy(dtype=object), from_pandas=True)
+                arr = (pa.array(col.array) if hasattr(col.array, "__arrow_array__")
+                       else pa.array(col.to_numpy(dtype=object), from_pandas=True))
             except (pa.ArrowInvalid, pa.ArrowTypeError):
                 return None
             if not (pa.types.is_string(arr.type) or pa.types.is_large_string(arr.type)
@@ -384,9 +385,10 @@ def _plain_table(df):
 
 
 def _numpy_columns(df) -> dict:
-    """The plain numpy columns of *df* (numbers, bools, naive datetimes) as Arrow arrays by
-    column position, taken out one 2-D block per dtype: the geometry partitions have about
-    a thousand columns, and one pandas lookup per column cost more than writing them."""
+    """The plain numpy columns of a wide *df* (numbers, bools, naive datetimes) as Arrow
+    arrays by column position, taken out one 2-D block per dtype: the geometry partitions
+    have about a thousand columns, and one pandas lookup per column cost more than writing
+    them (for a narrow table the block costs more than the lookups)."""
     import numpy as np
     import pyarrow as pa
 
