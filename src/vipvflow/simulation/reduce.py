@@ -26,8 +26,9 @@ from ..store import DataDir, RunDir, write_json, write_parquet
 log = logging.getLogger(__name__)
 
 
-def _read_files(files) -> pa.Table | None:
-    """The partition *files* (in the given order) as one Arrow table (``None``: no files).
+def _read_files(files, columns: list[str] | None = None) -> pa.Table | None:
+    """The partition *files* (in the given order) as one Arrow table (``None``: no files);
+    with *columns*, only those of them the files have.
 
     One pyarrow dataset over the files, read by Arrow's own threads (a run has hundreds to
     thousands of small files: one pandas read each cost most of the reduce); files whose
@@ -37,19 +38,24 @@ def _read_files(files) -> pa.Table | None:
     if not files:
         return None
     try:
-        return ds.dataset(files, format="parquet").to_table()
+        dataset = ds.dataset(files, format="parquet")
+        if columns is not None:
+            columns = [c for c in columns if c in dataset.schema.names]
+        return dataset.to_table(columns=columns)
     except (pa.ArrowInvalid, pa.ArrowTypeError, pa.ArrowNotImplementedError):
         pass
     with ThreadPoolExecutor(max_workers=4) as pool:
         tables = list(pool.map(pq.read_table, files))
     filled = [t for t in tables if t.num_rows] or tables[:1]
-    return pa.concat_tables(filled, promote_options="permissive")
+    table = pa.concat_tables(filled, promote_options="permissive")
+    return table.select([c for c in columns if c in table.column_names]) if columns else table
 
 
-def _part_table(run_dir: Path, kind: str, pattern: str = "tile=*/month=*.parquet") -> pa.Table | None:
+def _part_table(run_dir: Path, kind: str, pattern: str = "tile=*/month=*.parquet",
+                columns: list[str] | None = None) -> pa.Table | None:
     """Every partition file of *kind* (``parts/<kind>/<pattern>``), in path order, as one Arrow
-    table (``None``: no files)."""
-    return _read_files(RunDir(run_dir).part_files(kind, pattern))
+    table (``None``: no files); with *columns*, only those."""
+    return _read_files(RunDir(run_dir).part_files(kind, pattern), columns)
 
 
 def _read_parts(run_dir: Path, kind: str) -> pd.DataFrame:
@@ -104,16 +110,33 @@ def segment_month_part(files: list, month: str) -> pd.DataFrame:
     """The segment partitions of one month as one table, each row with its ``tile`` and
     ``month`` (named by the file's path; older runs stored them as columns).  A Dask task of
     the reduce."""
-    frames = []
-    for f in map(Path, files):
-        df = pq.read_table(f).to_pandas()
-        if "tile" not in df:
-            df["tile"] = _tile_of(f)
-        if "month" not in df:
-            df["month"] = month
-        frames.append(df)
-    frames = [d for d in frames if len(d)] or frames[:1]
-    return pd.concat(frames, ignore_index=True) if frames else pd.DataFrame()
+    files = [Path(f) for f in files]
+    if not files:
+        return pd.DataFrame()
+    with ThreadPoolExecutor(max_workers=4) as pool:
+        tables = list(pool.map(pq.read_table, files))
+    try:                                    # one conversion to pandas for the month
+        table = pa.concat_tables(tables)
+    except pa.ArrowInvalid:                 # schemas differ (an older run's files)
+        table = None
+    if table is None or "tile" in table.column_names or "month" in table.column_names:
+        frames = [_with_tile_month(t.to_pandas(), _tile_of(f), month) for t, f in zip(tables, files)]
+        frames = [d for d in frames if len(d)] or frames[:1]
+        return pd.concat(frames, ignore_index=True)
+    df = table.to_pandas()
+    df["tile"] = np.repeat(np.array([_tile_of(f) for f in files], dtype=object),
+                           [t.num_rows for t in tables])
+    df["month"] = month
+    return df
+
+
+def _with_tile_month(df: pd.DataFrame, tile: str, month: str) -> pd.DataFrame:
+    """*df* with ``tile`` and ``month`` columns (an older run's files have them)."""
+    if "tile" not in df:
+        df["tile"] = tile
+    if "month" not in df:
+        df["month"] = month
+    return df
 
 
 def hourly_part(files: list, month: str) -> pd.DataFrame:
@@ -436,7 +459,8 @@ def _segment_outputs(cfg: Config, run_dir: Path, sm: pd.DataFrame, trip: pd.Data
     data_dir = Path(cfg.data_dir)
     segments = gpd.read_parquet(DataDir(data_dir).gtfs.segments)
     segments = segments[segments["shape_id"].isin(trip["shape_id"].unique())]
-    geo = _part_table(run_dir, "geometry", "tile=*.parquet")
+    geo = _part_table(run_dir, "geometry", "tile=*.parquet",
+                      columns=["segment_id", *annual.PUBLIC_FACTORS])
     geo = geo.to_pandas() if geo is not None else None
     # shading loss: sky and sun light the buildings take away (1 - (direct + diffuse) / unshaded);
     # the reflected light they add is reported apart as reflection gain
