@@ -314,11 +314,15 @@ def write_parquet(df, path: str | Path, pandas_dtypes: bool = False, compact: bo
 
 def _compact_options(table) -> dict:
     """Parquet settings of the partition files: floats (most of their bytes) byte-stream
-    split before zstd, dictionaries for the rest only (ids, dates)."""
+    split before zstd (level 1), dictionaries for the rest only (ids, dates), no column
+    statistics."""
     import pyarrow as pa
 
     floats = [f.name for f in table.schema if pa.types.is_floating(f.type)]
-    return {"compression": "zstd", "use_byte_stream_split": floats,
+    # zstd level 1 and no column statistics (nothing filters on them): a third less time
+    # per partition than level 3 with statistics, and files a few % smaller
+    return {"compression": "zstd", "compression_level": 1, "write_statistics": False,
+            "use_byte_stream_split": floats,
             "use_dictionary": [f.name for f in table.schema if f.name not in floats]}
 
 
