@@ -278,7 +278,8 @@ def atomic_path(path: str | Path, suffix: str = "") -> Iterator[Path]:
 WIDE_COLUMNS = 64
 
 
-def write_parquet(df, path: str | Path, pandas_dtypes: bool = False, compact: bool = False) -> Path:
+def write_parquet(df, path: str | Path, pandas_dtypes: bool = False, compact: bool = False,
+                  float32: tuple[str, ...] = ()) -> Path:
     """Write *df* (DataFrame or GeoDataFrame) to *path* atomically.
 
     With *pandas_dtypes* pandas writes it, with its metadata: nullable integers and pandas'
@@ -288,7 +289,8 @@ def write_parquet(df, path: str | Path, pandas_dtypes: bool = False, compact: bo
     outputs (``trip_energy.parquet``, ... :data:`dictionary.OUTPUTS`) is written as the data
     dictionary describes it: ``month`` as a date, every documented column with its unit and
     meaning in the field metadata.  *compact* (partition files): zstd, dictionaries for the
-    non-float columns only, floats byte-stream split."""
+    non-float columns only, floats byte-stream split.  Float columns whose names start with
+    one of *float32* are stored as float32 (rounded to nearest, as numpy does)."""
     import pyarrow.parquet as pq
 
     from .simulation.dictionary import OUTPUTS, annotate
@@ -297,6 +299,8 @@ def write_parquet(df, path: str | Path, pandas_dtypes: bool = False, compact: bo
     output = path.stem if path.suffix == ".parquet" and path.stem in OUTPUTS else None
     with atomic_path(path) as tmp:
         table = None if pandas_dtypes else _plain_table(df)
+        if table is not None and float32:
+            table = _as_float32(table, float32)
         if table is None and output is not None and not pandas_dtypes:
             table = _arrow_table(df)
         if table is None:
@@ -310,6 +314,17 @@ def write_parquet(df, path: str | Path, pandas_dtypes: bool = False, compact: bo
         else:
             pq.write_table(annotate(table, output) if output else table, tmp)
     return path
+
+
+def _as_float32(table, prefixes: tuple[str, ...]):
+    """*table* with its float columns named ``<prefix>...`` cast to float32."""
+    import pyarrow as pa
+
+    for i, field in enumerate(table.schema):
+        if field.name.startswith(prefixes) and pa.types.is_floating(field.type):
+            table = table.set_column(i, pa.field(field.name, pa.float32()),
+                                     table.column(i).cast(pa.float32(), safe=False))
+    return table
 
 
 def _compact_options(table) -> dict:

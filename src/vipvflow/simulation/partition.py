@@ -480,9 +480,8 @@ def write_partition_files(run: RunDir, tile: str, month: str, trip: pd.DataFrame
     """Write a partition's three files, holding what the reduce reads: no tile or month
     columns (the path names them), the trip kWh and seconds as float32 (the segment and
     hour sums, whose ratios the summary reports, stay float64), compact Parquet."""
-    trip = trip.astype({c: np.float32 for c in trip.columns if c.startswith(TRIP_FLOAT32)})
     write_parquet(hourly, run.part("hourly", tile, month), compact=True)
-    write_parquet(trip, run.part("trip", tile, month), compact=True)
+    write_parquet(trip, run.part("trip", tile, month), compact=True, float32=TRIP_FLOAT32)
     # segment_month last: its presence marks the partition complete
     write_parquet(segm, run.part("segment_month", tile, month), compact=True)
 

@@ -61,30 +61,25 @@ def run_simulation(cfg: Config, year: int, scheduler: str | None = None,
     t_start = time.perf_counter()
     timings: dict[str, float] = {}
     check_year(year)
-    ensure_demo(cfg, year, say=say)
-    checksums = ensure_ingested(cfg, say=say)
-    preflight(cfg, year, say=say)
-    run_dir = run_dir_of(cfg, year)
-    claim_run_dir(run_dir, cfg.digest(), force=force, say=say)
-    timings["prepare_s"] = time.perf_counter() - t_start
-
-    data_dir = Path(cfg.data_dir)
-    feed = json.loads(DataDir(data_dir).gtfs.feed_json.read_text())
-    trips, shapes, tiles = selected_network(cfg)
-    routes = cfg.run.routes
-    ctx = RunContext(
-        data_dir=str(data_dir.resolve()), run_dir=str(run_dir.resolve()), year=year,
-        irradiance=cfg.irradiance.model_dump(), pv_system=cfg.pv_system().model_dump(),
-        pv_mode=cfg.pv.mode, monthly_temperature_c=tuple(cfg.climate.monthly_mean_temperature_c),
-        wind_speed_mps=cfg.climate.wind_speed_mps, timezone=feed["timezone"],
-        bvh_cache_size=cfg.dask.bvh_cache_size, ground_albedo=cfg.city.albedo.ground,
-        routes=tuple(routes) if routes is not None else None, shapes=shapes,
-        route_of_trip=dict(zip(trips["trip_id"], trips["route_id"].astype(str))))
-
-    todo = [(t, m) for t in tiles for m in _months(cfg, year) if not partition_done(run_dir, t, m)]
-    # layovers and parked time: one ``standing`` task per tile holding standing points
-    t_tl = time.perf_counter()
-    standing = write_timeline(cfg, year, run_dir, routes=routes)
+    # the cluster starts (worker processes, their imports) while the inputs are checked
+    # and the timeline is written; closed again if those stop the run
+    starting = _Starting(cfg, scheduler, n_workers)
+    try:
+        ensure_demo(cfg, year, say=say)
+        checksums = ensure_ingested(cfg, say=say)
+        preflight(cfg, year, say=say)
+        run_dir = run_dir_of(cfg, year)
+        claim_run_dir(run_dir, cfg.digest(), force=force, say=say)
+        timings["prepare_s"] = time.perf_counter() - t_start
+        ctx, tiles = _run_context(cfg, year, run_dir)
+        routes = cfg.run.routes
+        todo = [(t, m) for t in tiles for m in _months(cfg, year) if not partition_done(run_dir, t, m)]
+        # layovers and parked time: one ``standing`` task per tile holding standing points
+        t_tl = time.perf_counter()
+        standing = write_timeline(cfg, year, run_dir, routes=routes)
+    except BaseException:
+        starting.close()
+        raise
     timings["timeline_s"] = time.perf_counter() - t_tl
     standing_todo = [t for t in standing if not standing_done(run_dir, t)]
     total = len(tiles) * len(cfg.run.months) + len(standing)
@@ -96,7 +91,7 @@ def run_simulation(cfg: Config, year: int, scheduler: str | None = None,
     warm = threading.Thread(target=_warm_radiation, args=(ctx.data_dir, year), daemon=True,
                             name="sun-positions")
     warm.start()
-    client, cluster = make_client(cfg, scheduler, n_workers)
+    client, cluster = starting.result()
     closer = threading.Thread(target=close_client, args=(client, cluster), name="close-cluster")
     try:
         n_workers_now = len(client.scheduler_info()["workers"])
@@ -139,6 +134,51 @@ def run_simulation(cfg: Config, year: int, scheduler: str | None = None,
     say(_summary_line(summary))
     say(f"outputs in {run_dir}")
     return run_dir
+
+
+def _run_context(cfg: Config, year: int, run_dir: Path) -> tuple[RunContext, list[str]]:
+    """What every task of the run is told, and the tiles the selected routes cross."""
+    data_dir = Path(cfg.data_dir)
+    feed = json.loads(DataDir(data_dir).gtfs.feed_json.read_text())
+    trips, shapes, tiles = selected_network(cfg)
+    routes = cfg.run.routes
+    ctx = RunContext(
+        data_dir=str(data_dir.resolve()), run_dir=str(run_dir.resolve()), year=year,
+        irradiance=cfg.irradiance.model_dump(), pv_system=cfg.pv_system().model_dump(),
+        pv_mode=cfg.pv.mode, monthly_temperature_c=tuple(cfg.climate.monthly_mean_temperature_c),
+        wind_speed_mps=cfg.climate.wind_speed_mps, timezone=feed["timezone"],
+        bvh_cache_size=cfg.dask.bvh_cache_size, ground_albedo=cfg.city.albedo.ground,
+        routes=tuple(routes) if routes is not None else None, shapes=shapes,
+        route_of_trip=dict(zip(trips["trip_id"], trips["route_id"].astype(str))))
+    return ctx, tiles
+
+
+class _Starting:
+    """:func:`make_client` in a thread of its own: :meth:`result` waits for it (and raises
+    its error), :meth:`close` closes what it started."""
+
+    def __init__(self, cfg: Config, scheduler: str | None, n_workers: int | None):
+        self._out: dict = {}
+        self._thread = threading.Thread(target=self._start, args=(cfg, scheduler, n_workers),
+                                        daemon=True, name="start-cluster")
+        self._thread.start()
+
+    def _start(self, cfg, scheduler, n_workers) -> None:
+        try:
+            self._out["client"] = make_client(cfg, scheduler, n_workers)
+        except BaseException as exc:  # noqa: BLE001 - raised again by result()
+            self._out["error"] = exc
+
+    def result(self):
+        self._thread.join()
+        if "error" in self._out:
+            raise self._out["error"]
+        return self._out["client"]
+
+    def close(self) -> None:
+        self._thread.join()
+        if "client" in self._out:
+            close_client(*self._out["client"])
 
 
 def _warm_radiation(data_dir: str, year: int) -> None:
