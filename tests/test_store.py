@@ -129,3 +129,36 @@ def test_a_folder_swapped_whole_and_a_killed_swap_repaired(tmp_path):
     final.rename(tmp_path / f".gtfs-old-{dead}")
     remove_stale(final)
     assert (final / "new.txt").read_text() == "new"
+
+
+def test_wide_and_float32_tables_read_back_as_written(tmp_path):
+    """The writer's fast paths: a wide table (the geometry partitions) taken out one dtype
+    block at a time, and float columns stored as float32 by prefix, read back equal to the
+    frame (the float32 ones equal to numpy's rounding)."""
+    import numpy as np
+
+    from vipvflow.models.view_factors import _frame_by_dtype
+    from vipvflow.store import WIDE_COLUMNS, write_parquet
+
+    rng = np.random.default_rng(7)
+    n = 50
+    columns = {"segment_id": np.arange(n, dtype=np.int64), "name": [f"s{i}" for i in range(n)]}
+    for k in range(WIDE_COLUMNS + 40):
+        columns[f"p{k}"] = rng.random(n) if k % 3 else rng.random(n).astype(np.float32)
+    columns["surface"] = rng.integers(0, 9, n).astype(np.int32)
+    wide = _frame_by_dtype({k: v for k, v in columns.items() if k != "name"})
+    plain = pd.DataFrame({k: v for k, v in columns.items() if k != "name"})
+    pd.testing.assert_frame_equal(wide, plain)          # same columns, order and dtypes
+    wide["name"] = columns["name"]
+    back = pd.read_parquet(write_parquet(wide, tmp_path / "wide.parquet"))
+    pd.testing.assert_frame_equal(back, wide, check_dtype=False)
+    assert list(back.dtypes[:3].astype(str)) == ["int64", "float32", "float64"]
+
+    trip = pd.DataFrame({"trip_id": ["a", "b"], "pv_kwh": [1.0 / 3, 2.0], "pv_kwh_x": [0.1, 0.2],
+                         "seconds": [61.7, 12.0], "other": [1.0 / 3, 0.5]})
+    back = pd.read_parquet(write_parquet(trip, tmp_path / "trip.parquet", compact=True,
+                                         float32=("pv_kwh", "seconds")))
+    for c in ("pv_kwh", "pv_kwh_x", "seconds"):
+        assert back[c].dtype == np.float32
+        np.testing.assert_array_equal(back[c].to_numpy(), trip[c].to_numpy().astype(np.float32))
+    assert back["other"].dtype == np.float64 and back["other"][0] == 1.0 / 3
