@@ -49,9 +49,6 @@ class _Entry:
         self.name, self.within, self.kind = name, within, kind
         self.__doc__ = doc or f"``{name}``"
 
-    def __set_name__(self, owner, attr: str):
-        self.attr = attr
-
     def __get__(self, folder, owner=None):
         if folder is None:
             return self
