@@ -277,7 +277,7 @@ WIDE_COLUMNS = 64
 
 def write_parquet(df, path: str | Path, pandas_dtypes: bool = False, compact: bool = False,
                   float32: tuple[str, ...] = ()) -> Path:
-    """Write *df* (DataFrame or GeoDataFrame) to *path* atomically.
+    """Write *df* (DataFrame, GeoDataFrame or pyarrow Table) to *path* atomically.
 
     With *pandas_dtypes* pandas writes it, with its metadata: nullable integers and pandas'
     string flavours read back as they were (the GTFS tables).  Otherwise plain tables
@@ -288,6 +288,7 @@ def write_parquet(df, path: str | Path, pandas_dtypes: bool = False, compact: bo
     meaning in the field metadata.  *compact* (partition files): zstd, dictionaries for the
     non-float columns only, floats byte-stream split.  Float columns whose names start with
     one of *float32* are stored as float32 (rounded to nearest, as numpy does)."""
+    import pyarrow as pa
     import pyarrow.parquet as pq
 
     from .simulation.dictionary import OUTPUTS, annotate
@@ -295,7 +296,10 @@ def write_parquet(df, path: str | Path, pandas_dtypes: bool = False, compact: bo
     path = Path(path)
     output = path.stem if path.suffix == ".parquet" and path.stem in OUTPUTS else None
     with atomic_path(path) as tmp:
-        table = None if pandas_dtypes else _plain_table(df)
+        if isinstance(df, pa.Table):
+            table = df
+        else:
+            table = None if pandas_dtypes else _plain_table(df)
         if table is not None and float32:
             table = _as_float32(table, float32)
         if table is None and output is not None and not pandas_dtypes:

@@ -274,12 +274,20 @@ def _irradiation_sums(irr: pd.DataFrame, g: dict, n_seg: int, n_runs: int):
 
 def aggregate_partition(passes: pd.DataFrame, irr: pd.DataFrame | None, month: int, ctx: RunContext,
                         groups: dict | None = None, bins: tuple | None = None):
+    """:func:`partition_tables` as three DataFrames (trip, segment, hourly)."""
+    return tuple(t.to_pandas() for t in partition_tables(passes, irr, month, ctx, groups, bins))
+
+
+def partition_tables(passes: pd.DataFrame, irr: pd.DataFrame | None, month: int, ctx: RunContext,
+                     groups: dict | None = None, bins: tuple | None = None):
     """Sum a partition's passes per trip and service date, per segment and per local hour.
 
-    Returns three tables: per trip (``trip_id, service_date``, PV kWh of all-sky, clear-sky,
-    the unshaded references and per component, ``seconds``), per segment (``segment_id,
-    n_passes``, the same kWh, irradiation ``h_<component>`` in Wh/m2, ``seconds``) and per
-    local clock hour (``hour``, irradiation, ``seconds``).
+    Returns three Arrow tables: per trip (``trip_id, service_date``, PV kWh of all-sky,
+    clear-sky, the unshaded references and per component, ``seconds``), per segment
+    (``segment_id, n_passes``, the same kWh, irradiation ``h_<component>`` in Wh/m2,
+    ``seconds``) and per local clock hour (``hour``, irradiation, ``seconds``).  Built from
+    numpy columns, with no pandas frame: a tile-month's tables are small, and pandas' fixed
+    costs per frame and column were a fifth of a partition's time.
 
     Parameters
     ----------
@@ -303,13 +311,14 @@ def aggregate_partition(passes: pd.DataFrame, irr: pd.DataFrame | None, month: i
     runs, over the passes that received any light only (a (trip, date) split over several
     runs is merged).
     """
+    import pyarrow as pa
+
     system = PVSystem(**ctx.pv_system)
     linear = ctx.pv_mode == "paper"
     pv_source = {**{f"pv_kwh{suffix}": col for suffix, col in VARIANTS.items()},
                  **{f"pv_kwh_{c}": c for c in PV_COMPONENTS}}
     g = groups if groups is not None else partition_groups(passes, ctx)
     dt, run, seg_pos, starts = g["dt"], g["run"], g["seg_pos"], g["starts"]
-    trip_code, day = g["trip_code"], g["day"]
     n_runs, seg_ids = len(starts), g["seg_ids"]
     n_seg = len(seg_ids)
     if bins is None:
@@ -339,31 +348,38 @@ def aggregate_partition(passes: pd.DataFrame, irr: pd.DataFrame | None, month: i
             e = pv_energy_kwh(comp[col][act].astype(np.float64), dt[act], speed, month, ctx)
             sums["trip"][name] = np.bincount(run[act], e, n_runs)
             sums["seg"][name] = np.bincount(seg_pos[act], e, n_seg)
-    seconds = {"trip": g["run_s"], "seg": g["seg_s"], "hour": g["hour_s"]}
     pv_cols = list(pv_source)
     h_cols = [f"h_{c}" for c in COMPONENTS]
-
-    # trips ordered by trip id and date
-    order = np.lexsort((day[starts], trip_code[starts]))
-    trip_names = np.asarray(np.asarray(g["trip_uniques"])[trip_code[starts][order]]).astype(str)
-    trip = pd.DataFrame({"trip_id": trip_names,
-                         "service_date": passes["service_date"].to_numpy()[starts][order],
-                         **{c: sums["trip"][c][order] for c in pv_cols},
-                         "seconds": seconds["trip"][order]})
-    same = (trip_names[1:] == trip_names[:-1]) & (day[starts][order][1:] == day[starts][order][:-1])
-    if same.any():       # a (trip, date) split over several runs: merge them
-        trip = trip.groupby(["trip_id", "service_date"], sort=True).sum().reset_index()
-
-    segm = pd.DataFrame({"segment_id": seg_ids,
-                         "n_passes": g["seg_n"],
-                         **{c: sums["seg"][c] for c in pv_cols + h_cols},
-                         "seconds": seconds["seg"]})
-
+    trip = _trip_table(passes, g, {**{c: sums["trip"][c] for c in pv_cols}, "seconds": g["run_s"]})
+    segm = pa.table({"segment_id": seg_ids, "n_passes": g["seg_n"],
+                     **{c: sums["seg"][c] for c in pv_cols + h_cols}, "seconds": g["seg_s"]})
     present = np.flatnonzero(g["hour_n"] > 0)
-    hourly = pd.DataFrame({"hour": present.astype(np.int8),
-                           **{c: sums["hour"][c][present] for c in h_cols},
-                           "seconds": seconds["hour"][present]})
+    hourly = pa.table({"hour": present.astype(np.int8),
+                       **{c: sums["hour"][c][present] for c in h_cols},
+                       "seconds": g["hour_s"][present]})
     return trip, segm, hourly
+
+
+def _trip_table(passes: pd.DataFrame, g: dict, per_run: dict):
+    """The runs' sums *per_run* (name -> (n_runs,) array) as an Arrow table per trip and
+    service date, sorted by both (trip codes follow the sorted trip names); a (trip, date)
+    split over several runs is merged."""
+    import pyarrow as pa
+
+    starts = g["starts"]
+    code, day = g["trip_code"][starts], g["day"][starts]
+    order = np.lexsort((day, code))
+    code, day = code[order], day[order]
+    dates = passes["service_date"].to_numpy()[starts][order]
+    cols = {c: v[order] for c, v in per_run.items()}
+    first = np.flatnonzero(np.r_[True, (code[1:] != code[:-1]) | (day[1:] != day[:-1])])
+    if len(first) < len(code):
+        cols = {c: np.add.reduceat(v, first) for c, v in cols.items()}
+        code, dates = code[first], dates[first]
+    used, inverse = np.unique(code, return_inverse=True)
+    names = pa.array(np.asarray(g["trip_uniques"][used], dtype=object).astype(str), pa.string())
+    return pa.table({"trip_id": names.take(pa.array(inverse.astype(np.int32))),
+                     "service_date": dates, **cols})
 
 
 def _fused_sums(ctx: RunContext, tile: str, passes: pd.DataFrame, geometry: pd.DataFrame,
@@ -450,24 +466,36 @@ def run_partition(ctx: RunContext, tile: str, month: str,
     t2 = time.perf_counter()
     if fused is not None:
         groups, bins = fused
-        trip, segm, hourly = aggregate_partition(passes, None, int(month[5:7]), ctx,
-                                                 groups=groups, bins=bins)
+        trip, segm, hourly = partition_tables(passes, None, int(month[5:7]), ctx,
+                                              groups=groups, bins=bins)
     else:
-        trip, segm, hourly = aggregate_partition(passes, irr, int(month[5:7]), ctx)
+        trip, segm, hourly = partition_tables(passes, irr, int(month[5:7]), ctx)
     timings["reduce_s"] = timings.get("reduce_s", 0.0) + time.perf_counter() - t2
 
     t3 = time.perf_counter()
     write_partition_files(run, tile, month, trip, segm, hourly)
     timings["write_s"] = time.perf_counter() - t3
 
-    by_route: dict[str, float] = {}
-    if ctx.route_of_trip and len(trip):
-        routes = trip["trip_id"].map(ctx.route_of_trip)
-        by_route = trip.groupby(routes)["pv_kwh"].sum().to_dict()
-    return {"tile": tile, "month": month, "passes": n, "trips": int(len(trip)),
-            "kwh": float(trip["pv_kwh"].sum()) if len(trip) else 0.0,
-            "kwh_by_route": by_route, "timings": timings,
+    kwh = trip.column("pv_kwh").to_numpy()
+    return {"tile": tile, "month": month, "passes": n, "trips": trip.num_rows,
+            "kwh": float(kwh.sum()), "kwh_by_route": _kwh_by_route(trip, kwh, ctx.route_of_trip),
+            "timings": timings,
             "elapsed_s": time.perf_counter() - t0}
+
+
+def _kwh_by_route(trip, kwh: np.ndarray, route_of_trip: dict) -> dict[str, float]:
+    """The trip table's kWh summed per route (for the progress view)."""
+    if not route_of_trip or not trip.num_rows:
+        return {}
+    ids = trip.column("trip_id").dictionary_encode().combine_chunks()
+    routes = np.array([route_of_trip.get(t) for t in ids.dictionary.to_pylist()], dtype=object)
+    known = np.array([r is not None for r in routes])
+    names, route_code = np.unique(routes[known].astype(str), return_inverse=True)
+    code = np.full(len(routes), -1, np.int64)
+    code[known] = route_code
+    row = code[ids.indices.to_numpy()]
+    sums = np.bincount(row[row >= 0], kwh[row >= 0], len(names))
+    return dict(zip(names.tolist(), sums.tolist()))
 
 
 #: float columns of the trip partitions stored as float32: the per-trip kWh and seconds of
@@ -475,8 +503,7 @@ def run_partition(ctx: RunContext, tile: str, month: str,
 TRIP_FLOAT32 = ("pv_kwh", "seconds")
 
 
-def write_partition_files(run: RunDir, tile: str, month: str, trip: pd.DataFrame,
-                          segm: pd.DataFrame, hourly: pd.DataFrame) -> None:
+def write_partition_files(run: RunDir, tile: str, month: str, trip, segm, hourly) -> None:
     """Write a partition's three files, holding what the reduce reads: no tile or month
     columns (the path names them), the trip kWh and seconds as float32 (the segment and
     hour sums, whose ratios the summary reports, stay float64), compact Parquet."""
