@@ -34,13 +34,43 @@ CLOSE_UP_M = 1200.0
 
 
 
-def _save(fig, run_dir: Path, name: str) -> str:
+def figure_png(make, *args) -> bytes:
+    """The figure ``make(*args)`` as PNG bytes (a task the run's workers can take)."""
+    fig = make(*args)
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=110, bbox_inches="tight")
     plt.close(fig)
-    data = buf.getvalue()
-    write_bytes(data, RunDir(run_dir).figures / f"{name}.png")
-    return base64.b64encode(data).decode()
+    return buf.getvalue()
+
+
+def _loaded() -> bool:
+    """Nothing: a task that loads this module (and matplotlib) on a worker."""
+    return True
+
+
+class Figures:
+    """The report's figures, drawn as they are added: on the workers of *client* while the
+    reduce goes on (a figure takes a core for 0.1-0.6 s, mostly text layout and PNG
+    encoding), or in this process without one.  :meth:`results` waits for them."""
+
+    def __init__(self, client=None):
+        self._client = client
+        self._items: list[tuple[str, str, object]] = []
+        # each worker loads matplotlib (about half a second) while it waits for the data
+        self._loading = [] if client is None else [
+            client.submit(_loaded, workers=[w], pure=False, key=f"figure-load-{i}")
+            for i, w in enumerate(client.scheduler_info()["workers"])]
+
+    def add(self, name: str, title: str, make, *args) -> None:
+        job = (self._client.submit(figure_png, make, *args, pure=False, key=f"figure-{name}")
+               if self._client is not None else figure_png(make, *args))
+        self._items.append((name, title, job))
+
+    def results(self) -> list[tuple[str, str, bytes]]:
+        """(name, title, PNG bytes) of every figure, in the order added."""
+        jobs = [job for _, _, job in self._items]
+        data = self._client.gather(jobs + self._loading)[:len(jobs)] if self._client is not None else jobs
+        return [(name, title, png) for (name, title, _), png in zip(self._items, data)]
 
 
 def _months(values) -> pd.DatetimeIndex:
@@ -360,43 +390,82 @@ def crs_label(crs) -> str:
     return f"EPSG:{epsg} ({crs.name})" if epsg else crs.name
 
 
-def write_report(run_dir: Path, summary: dict, monthly, smg, hp, rm, cfg=None, segments=None) -> Path:
-    """Write ``report.html`` and ``figures/*.png``.
+def _mapped(segments):
+    """The segments the maps show: those with passes."""
+    if "n_passes" in segments:
+        segments = segments[segments["n_passes"].fillna(0) > 0]
+    return segments
 
-    *segments*: the run's ``segments.parquet`` frame (each segment's year); read from
-    *run_dir* when not given. *cfg*: the run's configuration (inputs, data directory for
-    the building footprints)."""
+
+#: the maps: name -> (title, column, colour bar label, colour map, figure title, scale)
+MAPS = {
+    "map_yield": ("Yield per segment", "kwh_per_kwp_year", "specific yield (kWh/kWp per year)",
+                  "viridis", "PV yield of a bus in each segment's light, all-sky (kWh/kWp per year)", 1.0),
+    "map_shading": ("Shading loss per segment", "shading_loss", "shading loss, all-sky (%)", "magma_r",
+                    "Direct and sky light the buildings take away, all-sky (%)", 100.0),
+}
+
+
+def map_figure(run_dir: str, data_dir: str | None, name: str):
+    """The map *name* (:data:`MAPS`) of the run's ``segments.parquet`` over the building
+    footprints of the city model in *data_dir* (none without)."""
     import geopandas as gpd
 
     from ..inputs.city.footprints import building_footprints
 
+    segments = _mapped(gpd.read_parquet(RunDir(run_dir).output("segments.parquet")))
+    footprints = []
+    if data_dir is not None:
+        xmin, ymin, xmax, ymax = segments.total_bounds
+        tiles = sorted(segments["tile"].unique()) if "tile" in segments else None
+        footprints = building_footprints(data_dir, tiles=tiles,
+                                         bounds=(xmin - 200, ymin - 200, xmax + 200, ymax + 200))
+    _, column, label, cmap, title, scale = MAPS[name]
+    return fig_map(segments, column, label, cmap, title, footprints, crs_label(segments.crs), scale)
+
+
+def add_maps(figures: Figures, run_dir: Path, cfg=None) -> None:
+    """Start the maps of the run's ``segments.parquet`` (written) over the building
+    footprints of *cfg*'s city model."""
+    data_dir = str(cfg.data_dir) if cfg is not None else None
+    for name, (title, *_) in MAPS.items():
+        figures.add(name, title, map_figure, str(run_dir), data_dir, name)
+
+
+def add_charts(figures: Figures, summary: dict, monthly, hp, rm) -> None:
+    """Start the charts of the fleet's months, hours and routes."""
+    figures.add("monthly_yield", ("Monthly yield: driving, in service and whole day (all-sky), "
+                                  "with the shading loss on the road"), fig_monthly, monthly, summary)
+    figures.add("avoided_cycles", "Avoided charging cycles per month", fig_cycles, monthly)
+    figures.add("hourly_pattern", "Daily irradiance pattern by hour and month", fig_hourly, hp)
+    figures.add("routes", "Route comparison", fig_routes, rm)
+
+
+#: the figures in the report's order
+FIGURE_ORDER = ("monthly_yield", "map_yield", "map_shading", "avoided_cycles", "hourly_pattern", "routes")
+
+
+def write_report(run_dir: Path, summary: dict, figures: list[tuple[str, str, bytes]], cfg=None,
+                 segments=None) -> Path:
+    """Write ``report.html`` and ``figures/*.png``.
+
+    *figures*: :meth:`Figures.results` (:func:`add_maps`, :func:`add_charts`).  *segments*:
+    the run's ``segments.parquet`` frame (each segment's year); read from *run_dir* when not
+    given. *cfg*: the run's configuration (its inputs are listed)."""
+    import geopandas as gpd
+
     if segments is None:
         segments = gpd.read_parquet(run_dir / "segments.parquet")
-    segments = segments[segments["n_passes"].fillna(0) > 0] if "n_passes" in segments else segments
-    crs = crs_label(segments.crs)
-    tiles = sorted(segments["tile"].unique()) if "tile" in segments else None
-    footprints = []
-    if cfg is not None:
-        xmin, ymin, xmax, ymax = segments.total_bounds
-        footprints = building_footprints(cfg.data_dir, tiles=tiles,
-                                         bounds=(xmin - 200, ymin - 200, xmax + 200, ymax + 200))
-    figs = [
-        ("monthly_yield", ("Monthly yield: driving, in service and whole day (all-sky), with the "
-                           "shading loss on the road"), fig_monthly(monthly, summary)),
-        ("map_yield", "Yield per segment",
-         fig_map(segments, "kwh_per_kwp_year", "specific yield (kWh/kWp per year)", "viridis",
-                 "PV yield of a bus in each segment's light, all-sky (kWh/kWp per year)", footprints, crs)),
-        ("map_shading", "Shading loss per segment",
-         fig_map(segments, "shading_loss", "shading loss, all-sky (%)", "magma_r",
-                 "Direct and sky light the buildings take away, all-sky (%)", footprints, crs, scale=100.0)),
-        ("avoided_cycles", "Avoided charging cycles per month", fig_cycles(monthly)),
-        ("hourly_pattern", "Daily irradiance pattern by hour and month", fig_hourly(hp)),
-        ("routes", "Route comparison", fig_routes(rm)),
-    ]
+    mapped = _mapped(segments)
+    crs = crs_label(mapped.crs)
+    tiles = sorted(mapped["tile"].unique()) if "tile" in mapped else None
+    shown = {name: (title, png) for name, title, png in figures}
     parts = []
-    for name, title, fig in figs:
+    for name in FIGURE_ORDER:
+        title, png = shown[name]
+        write_bytes(png, RunDir(run_dir).figures / f"{name}.png")
         parts.append(f"<h2>{html.escape(title)}</h2>"
-                     f"<img alt='{name}' src='data:image/png;base64,{_save(fig, run_dir, name)}'>")
+                     f"<img alt='{name}' src='data:image/png;base64,{base64.b64encode(png).decode()}'>")
     title = f"{summary['scenario']} {summary['year']}"
     doc = f"""<!doctype html><html><head><meta charset="utf-8">
 <title>vipvflow: {html.escape(title)}</title>

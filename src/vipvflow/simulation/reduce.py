@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import logging
 import re
+import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
@@ -181,7 +182,8 @@ def _join_months(tables: list) -> pa.Table | None:
 def partial_sums(run_dir: Path, client=None) -> dict:
     """The partitions read and summed on the cluster of *client* (in this process without
     one): ``trip`` (Arrow: per trip and service date, sorted), ``segment_month`` (per segment
-    and month, with tile and month) and ``hourly`` (per month and local hour).
+    and month, with tile and month), ``hourly`` (per month and local hour) and ``geometry``
+    (the segments' public geometry factors).
 
     Each month's files are read by tasks of their own (trips in a tree of partial sums), so
     the reduce's reading grows with the partitions per worker; the client only joins the
@@ -193,10 +195,22 @@ def partial_sums(run_dir: Path, client=None) -> dict:
           for m, files in _month_files(run_dir, "segment_month").items()]
     hourly = [client.submit(hourly_part, [str(f) for f in files], m, pure=False)
               for m, files in _month_files(run_dir, "hourly").items()]
-    trip, sm, hourly = client.gather([trip, sm, hourly])
+    geometry = client.submit(geometry_factors, [str(f) for f in RunDir(run_dir).part_files(
+        "geometry", "tile=*.parquet")], pure=False)
+    trip, sm, hourly, geometry = client.gather([trip, sm, hourly, geometry])
     return {"trip": _join_months(trip),
             "segment_month": pd.concat(sm, ignore_index=True) if sm else pd.DataFrame(),
-            "hourly": pd.concat(hourly, ignore_index=True) if hourly else pd.DataFrame()}
+            "hourly": pd.concat(hourly, ignore_index=True) if hourly else pd.DataFrame(),
+            "geometry": geometry}
+
+
+def geometry_factors(files: list) -> pd.DataFrame | None:
+    """The public geometry factors (:data:`annual.PUBLIC_FACTORS`) of the segments in the
+    geometry partition *files* (``None``: no files).  A Dask task of the reduce."""
+    from . import annual
+
+    table = _read_files(files, columns=["segment_id", *annual.PUBLIC_FACTORS])
+    return table.to_pandas() if table is not None else None
 
 
 def _trip_totals(run_dir: Path, table: pa.Table | None = None) -> pd.DataFrame:
@@ -395,22 +409,31 @@ def block_day_table(cfg: Config, run_dir: Path, trip: pd.DataFrame, vehicle):
     return bd, idle, trip
 
 
-def reduce_run(cfg: Config, year: int, run_dir: Path, say=print, client=None, read=None) -> dict:
+def reduce_run(cfg: Config, year: int, run_dir: Path, say=print, client=None, cluster_done=None,
+               timings: dict | None = None) -> dict:
     """Write trip_energy, segments, segment_month, route_month, block_day, monthly, hourly
     outputs, ``summary.json`` and ``report.html``; return the summary.
 
     The partitions are read and summed by tasks on the cluster of *client* (its workers see
     *run_dir* at the same path), or in this process without one (:func:`partial_sums`);
-    the joins, the vehicles' balance and the outputs are computed here.  *read* is called
-    once the cluster's part is done (the run shuts its cluster down then)."""
-    from ..outputs.report import write_report
+    the joins, the vehicles' balance and the outputs are computed here, while the workers
+    draw the report's figures.  *cluster_done* is called once the cluster's part is done
+    (the run shuts its cluster down then, while this process writes the report).  The
+    seconds of each step are added to *timings* (``reduce_<step>_s``)."""
+    from ..outputs import report
 
+    clock = _Clock(timings)
     parts = partial_sums(run_dir, client)
-    if read is not None:
-        read()
+    clock("sums")
+    # the figures are drawn on the cluster's workers as their data is made (here without one)
+    figures = report.Figures(client)
     trips_meta = pd.read_parquet(DataDir(cfg.data_dir).gtfs.trips)
     trip, bd, idle = _trip_outputs(cfg, year, run_dir, parts["trip"], trips_meta, say)
-    smg, segments, sm = _segment_outputs(cfg, run_dir, parts["segment_month"], trip, trips_meta)
+    clock("trips")
+    _, segments, sm = _segment_outputs(cfg, run_dir, parts["segment_month"], parts["geometry"],
+                                    trip, trips_meta)
+    report.add_maps(figures, run_dir, cfg)
+    clock("segments")
     rm = _route_month(trip)
     write_parquet(rm, RunDir(run_dir).output("route_month.parquet"))
     write_parquet(bd, RunDir(run_dir).output("block_day.parquet"))
@@ -419,8 +442,28 @@ def reduce_run(cfg: Config, year: int, run_dir: Path, say=print, client=None, re
     monthly, summary = _fleet_year(cfg, year, run_dir, trip, bd, idle, sm, segments)
     write_parquet(monthly, RunDir(run_dir).output("monthly.parquet"))
     write_json(summary, RunDir(run_dir).output("summary.json"))
-    write_report(run_dir, summary, monthly, smg, hp, rm, cfg=cfg, segments=segments)
+    report.add_charts(figures, summary, monthly, hp, rm)
+    clock("fleet")
+    drawn = figures.results()
+    clock("figures")
+    if cluster_done is not None:
+        cluster_done()
+    report.write_report(run_dir, summary, drawn, cfg=cfg, segments=segments)
+    clock("report")
     return summary
+
+
+class _Clock:
+    """``clock(step)`` adds the seconds since the last call to ``timings["reduce_<step>_s"]``."""
+
+    def __init__(self, timings: dict | None):
+        self._timings = timings if timings is not None else {}
+        self._last = time.perf_counter()
+
+    def __call__(self, step: str) -> None:
+        now = time.perf_counter()
+        self._timings[f"reduce_{step}_s"] = now - self._last
+        self._last = now
 
 
 def _n_buses(trip: pd.DataFrame) -> int:
@@ -449,8 +492,8 @@ def _trip_outputs(cfg: Config, year: int, run_dir: Path, sums: pa.Table | None,
     return trip, bd, idle
 
 
-def _segment_outputs(cfg: Config, run_dir: Path, sm: pd.DataFrame, trip: pd.DataFrame,
-                     trips_meta: pd.DataFrame):
+def _segment_outputs(cfg: Config, run_dir: Path, sm: pd.DataFrame, geo: pd.DataFrame | None,
+                     trip: pd.DataFrame, trips_meta: pd.DataFrame):
     """Per segment and month (GeoParquet for maps) and per segment over the run (geometry
     factors and year); writes ``segment_month.parquet`` and ``segments.parquet``.  Returns
     both and the segment-month sums."""
@@ -459,9 +502,6 @@ def _segment_outputs(cfg: Config, run_dir: Path, sm: pd.DataFrame, trip: pd.Data
     data_dir = Path(cfg.data_dir)
     segments = gpd.read_parquet(DataDir(data_dir).gtfs.segments)
     segments = segments[segments["shape_id"].isin(trip["shape_id"].unique())]
-    geo = _part_table(run_dir, "geometry", "tile=*.parquet",
-                      columns=["segment_id", *annual.PUBLIC_FACTORS])
-    geo = geo.to_pandas() if geo is not None else None
     # shading loss: sky and sun light the buildings take away (1 - (direct + diffuse) / unshaded);
     # the reflected light they add is reported apart as reflection gain
     sm["shading_loss"] = shading_loss(sm["h_direct"], sm["h_diffuse"], sm["h_total_unshaded"])

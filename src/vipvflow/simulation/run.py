@@ -120,9 +120,10 @@ def run_simulation(cfg: Config, year: int, scheduler: str | None = None,
         # outputs are made here
         t_red = time.perf_counter()
         with FolderProgress("reduce", run_dir):
-            # the cluster shuts down once the partitions are read, while this process writes
+            # the cluster shuts down once the partitions are summed and the figures drawn,
+            # while this process writes the report
             summary = reduce_run(cfg, year, run_dir, say=say, client=client,
-                                 read=lambda: closer.start())
+                                 cluster_done=lambda: closer.start(), timings=timings)
         timings["reduce_s"] = time.perf_counter() - t_red
     finally:
         if closer.ident is not None:         # started by the reduce
