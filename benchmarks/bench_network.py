@@ -220,7 +220,7 @@ def run(tiny: bool = False, period: str | None = None, scheduler: str | None = N
 
 
 def _part_bytes(run_dir: Path) -> int:
-    """Bytes of the per-pass partition files (trip, segment_month, hourly) of a run."""
+    """Bytes of the per-pass partition files (trip, segment_month; hourly in older runs) of a run."""
     return sum(f.stat().st_size for kind in ("trip", "segment_month", "hourly")
                for f in (run_dir / "parts" / kind).glob("tile=*/month=*.parquet"))
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import os
 
+import numpy as np
 import pandas as pd
 import pyarrow.parquet as pq
 import pytest
@@ -12,8 +13,8 @@ import pytest
 from vipvflow.errors import InputError
 from vipvflow.simulation.dictionary import OUTPUTS
 from vipvflow.simulation.rundir import open_run
-from vipvflow.store import (ALL_MONTHS, GTFS_TABLES, PARTS, TIMELINE_TABLES, DataDir, RunDir,
-                            atomic_path, remove_stale, staging_dir, swap_dir, write_json)
+from vipvflow.store import (ALL_MONTHS, GTFS_TABLES, HOURLY_METADATA, PARTS, TIMELINE_TABLES, DataDir,
+                            RunDir, atomic_path, remove_stale, staging_dir, swap_dir, write_json)
 
 
 def _named_by_store(data_dir, run_dir) -> set:
@@ -69,7 +70,12 @@ def test_partitions_hold_the_key_columns_the_store_declares(small_run):
             for column, arrow_type in spec.key.items():
                 assert str(schema.field(column).type) == arrow_type, (path, column)
             seen.add(kind)
-    assert {"hourly", "trip", "segment_month", "geometry", "horizon", "timeline"} <= seen
+    assert {"trip", "segment_month", "geometry", "horizon", "timeline"} <= seen
+    assert "hourly" not in seen           # the sums per local hour are in the segment files
+    for path in run.part_files("segment_month"):
+        hourly = json.loads(pq.read_schema(path).metadata[HOURLY_METADATA])
+        assert set(hourly) >= {"hour", "h_total", "seconds"}, path
+        assert len(set(hourly["hour"])) == len(hourly["hour"]) <= 24, path
 
 
 def test_paths_of_a_kind_stored_otherwise_are_refused(tmp_path):
@@ -162,3 +168,34 @@ def test_wide_and_float32_tables_read_back_as_written(tmp_path):
         assert back[c].dtype == np.float32
         np.testing.assert_array_equal(back[c].to_numpy(), trip[c].to_numpy().astype(np.float32))
     assert back["other"].dtype == np.float64 and back["other"][0] == 1.0 / 3
+
+
+def test_runs_with_hourly_files_reduce_to_the_same_hours(small_run, tmp_path):
+    """A run folder written before the sums per local hour moved into the segment files'
+    metadata (one ``parts/hourly`` file per partition) reduces to the same sums; a segment
+    file with neither is named."""
+    import shutil
+
+    import pyarrow as pa
+
+    from vipvflow.simulation.reduce import partial_sums
+
+    old = tmp_path / "run"
+    shutil.copytree(small_run / "parts", old / "parts")
+    run = RunDir(old)
+    files = run.part_files("segment_month")
+    for path in files:
+        table = pq.read_table(path)
+        meta = dict(table.schema.metadata)
+        hourly = json.loads(meta.pop(HOURLY_METADATA))
+        legacy = run.part("hourly", path.parent.name[5:], path.stem[6:])
+        legacy.parent.mkdir(parents=True, exist_ok=True)
+        pq.write_table(pa.table({**hourly, "hour": pa.array(hourly["hour"], pa.int8())}), legacy)
+        pq.write_table(table.replace_schema_metadata(meta), path)
+    want = partial_sums(small_run)["hourly"]
+    got = partial_sums(old)["hourly"]
+    assert len(want) and want["hour"].dtype == np.int8
+    pd.testing.assert_frame_equal(got, want)
+    run.part("hourly", files[0].parent.name[5:], files[0].stem[6:]).unlink()
+    with pytest.raises(InputError, match=f"{files[0]}: no sums per local hour"):
+        partial_sums(old)

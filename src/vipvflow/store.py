@@ -167,11 +167,10 @@ class PartKind:
 #: every kind of file under a run's ``parts/``; a partition (tile, month) is complete when its
 #: :data:`PARTITION_KINDS` files exist (``segment_month`` is written last)
 PARTS = {
-    "hourly": PartKind("tile/month", "one local hour of the day: irradiation sums and pass time",
-                       {"hour": "int8"}),
     "trip": PartKind("tile/month", "one trip on one service date: PV kWh by sky and component",
                      {"trip_id": "string", "service_date": "timestamp[ns]"}),
-    "segment_month": PartKind("tile/month", "one segment: passes, irradiation sums, kWh",
+    "segment_month": PartKind("tile/month", "one segment: passes, irradiation sums, kWh (and "
+                              "in the file's metadata, HOURLY_METADATA, the sums per local hour)",
                               {"segment_id": "int64"}),
     "standing": PartKind("tile/month", "one layover or parked interval of a block at a stop "
                          "(month=all: the whole year)",
@@ -182,8 +181,16 @@ PARTS = {
     "horizon": PartKind("tile", "one segment: the horizon profile the web app reads",
                         {"segment_id": "int64"}),
     "timeline": PartKind("run", "the fleet's day: block_days, intervals, trip_runs, points", {}),
+    "hourly": PartKind("tile/month", "one local hour of the day: irradiation sums and pass time "
+                       "(runs before 2026-11-26 only, read by the reduce; now HOURLY_METADATA)",
+                       {"hour": "int8"}),
 }
-PARTITION_KINDS = ("hourly", "trip", "segment_month")
+PARTITION_KINDS = ("trip", "segment_month")
+#: the key of a segment partition's Parquet metadata holding the partition's sums per local
+#: hour of the day (``hour``, irradiation ``h_*``, ``seconds``) as JSON of the table's
+#: columns: 24 rows did not earn a file of their own (a third of the files a run wrote and
+#: the reduce read)
+HOURLY_METADATA = b"vipvflow.hourly"
 #: the tables of ``parts/timeline/``, each ``<name>.parquet``
 TIMELINE_TABLES = ("block_days", "intervals", "trip_runs", "points")
 #: the ``month`` of a standing partition: one per tile holds all the run's months (a tile

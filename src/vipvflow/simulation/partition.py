@@ -7,6 +7,7 @@ pass of its partition with the irradiance engine and writes its partition files 
 from __future__ import annotations
 
 import collections
+import json
 import time
 from dataclasses import dataclass, field
 from functools import lru_cache
@@ -16,7 +17,7 @@ import numpy as np
 import pandas as pd
 
 from ..config import IrradianceCfg, PVSystem
-from ..store import PARTITION_KINDS, DataDir, RunDir, write_parquet
+from ..store import HOURLY_METADATA, PARTITION_KINDS, DataDir, RunDir, write_parquet
 
 #: per-pass energy columns (kWh) and irradiation columns (Wh/m2) summed in a partition
 PV_COMPONENTS = ("direct", "diffuse", "reflected")
@@ -504,13 +505,15 @@ TRIP_FLOAT32 = ("pv_kwh", "seconds")
 
 
 def write_partition_files(run: RunDir, tile: str, month: str, trip, segm, hourly) -> None:
-    """Write a partition's three files, holding what the reduce reads: no tile or month
+    """Write a partition's two files, holding what the reduce reads: no tile or month
     columns (the path names them), the trip kWh and seconds as float32 (the segment and
-    hour sums, whose ratios the summary reports, stay float64), compact Parquet."""
-    write_parquet(hourly, run.part("hourly", tile, month), compact=True)
+    hour sums, whose ratios the summary reports, stay float64), compact Parquet; the sums
+    per local hour in the segment file's metadata (:data:`vipvflow.store.HOURLY_METADATA`)."""
     write_parquet(trip, run.part("trip", tile, month), compact=True, float32=TRIP_FLOAT32)
+    meta = {**(segm.schema.metadata or {}), HOURLY_METADATA: json.dumps(hourly.to_pydict()).encode()}
     # segment_month last: its presence marks the partition complete
-    write_parquet(segm, run.part("segment_month", tile, month), compact=True)
+    write_parquet(segm.replace_schema_metadata(meta), run.part("segment_month", tile, month),
+                  compact=True)
 
 
 def partition_done(run_dir: Path, tile: str, month: str) -> bool:

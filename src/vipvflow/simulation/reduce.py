@@ -6,6 +6,7 @@ and day; and the fleet-year summary with coverage, avoided charging cycles and p
 """
 from __future__ import annotations
 
+import json
 import logging
 import re
 import time
@@ -22,7 +23,7 @@ import pyarrow.parquet as pq
 from ..config import Config
 from ..errors import InputError
 from ..models.irradiance import shading_loss
-from ..store import DataDir, RunDir, write_json, write_parquet
+from ..store import HOURLY_METADATA, DataDir, RunDir, write_json, write_parquet
 
 log = logging.getLogger(__name__)
 
@@ -107,15 +108,16 @@ def sum_trips(parts: list) -> pa.Table | None:
     return summed.sort_by([(k, "ascending") for k in keys])
 
 
-def segment_month_part(files: list, month: str) -> pd.DataFrame:
+def segment_month_part(files: list, month: str) -> tuple[pd.DataFrame, pd.DataFrame]:
     """The segment partitions of one month as one table, each row with its ``tile`` and
-    ``month`` (named by the file's path; older runs stored them as columns).  A Dask task of
-    the reduce."""
+    ``month`` (named by the file's path; older runs stored them as columns), and the
+    month's sums per local hour (:func:`hourly_sums`).  A Dask task of the reduce."""
     files = [Path(f) for f in files]
     if not files:
-        return pd.DataFrame()
+        return pd.DataFrame(), hourly_sums([], month)
     with ThreadPoolExecutor(max_workers=4) as pool:
         tables = list(pool.map(pq.read_table, files))
+    hourly = hourly_sums([_hourly_of(t, f) for t, f in zip(tables, files)], month)
     try:                                    # one conversion to pandas for the month
         table = pa.concat_tables(tables)
     except pa.ArrowInvalid:                 # schemas differ (an older run's files)
@@ -123,12 +125,12 @@ def segment_month_part(files: list, month: str) -> pd.DataFrame:
     if table is None or "tile" in table.column_names or "month" in table.column_names:
         frames = [_with_tile_month(t.to_pandas(), _tile_of(f), month) for t, f in zip(tables, files)]
         frames = [d for d in frames if len(d)] or frames[:1]
-        return pd.concat(frames, ignore_index=True)
+        return pd.concat(frames, ignore_index=True), hourly
     df = table.to_pandas()
     df["tile"] = np.repeat(np.array([_tile_of(f) for f in files], dtype=object),
                            [t.num_rows for t in tables])
     df["month"] = month
-    return df
+    return df, hourly
 
 
 def _with_tile_month(df: pd.DataFrame, tile: str, month: str) -> pd.DataFrame:
@@ -140,13 +142,29 @@ def _with_tile_month(df: pd.DataFrame, tile: str, month: str) -> pd.DataFrame:
     return df
 
 
-def hourly_part(files: list, month: str) -> pd.DataFrame:
-    """The hourly partitions of one month summed per local hour (``month, hour``, the
-    irradiation sums ``h_*`` in Wh/m2, ``seconds``).  A Dask task of the reduce."""
-    table = _read_files(files)
-    hourly = table.to_pandas() if table is not None else pd.DataFrame({"hour": []})
+def _hourly_of(table: pa.Table, path: Path) -> pa.Table:
+    """A segment partition's sums per local hour: from its metadata (:data:`HOURLY_METADATA`),
+    or from the hourly file beside it (runs before 2026-11-26)."""
+    meta = (table.schema.metadata or {}).get(HOURLY_METADATA)
+    if meta is not None:
+        return pa.table(json.loads(meta))
+    tile, month = _tile_of(path), path.stem.split("=", 1)[1]
+    legacy = RunDir(path.parents[3]).part("hourly", tile, month)
+    if not legacy.exists():
+        raise InputError(f"{path}: no sums per local hour (neither in its metadata nor in "
+                         f"{legacy}): compute the partition again (delete the file and rerun)")
+    return pq.read_table(legacy)
+
+
+def hourly_sums(tables: list, month: str) -> pd.DataFrame:
+    """The partitions' sums per local hour (*tables*) summed per hour (``month, hour``, the
+    irradiation sums ``h_*`` in Wh/m2, ``seconds``)."""
+    tables = [t for t in tables if t.num_rows]
+    hourly = (pa.concat_tables(tables, promote_options="permissive").to_pandas() if tables
+              else pd.DataFrame({"hour": [], "seconds": []}))
     cols = [c for c in hourly.columns if c.startswith("h_")] + ["seconds"]
     out = hourly.groupby("hour", sort=True)[cols].sum().reset_index()
+    out["hour"] = out["hour"].astype(np.int8)
     out.insert(0, "month", month)
     return out
 
@@ -193,14 +211,13 @@ def partial_sums(run_dir: Path, client=None) -> dict:
     trip = _trip_tree(run_dir, client)
     sm = [client.submit(segment_month_part, [str(f) for f in files], m, pure=False)
           for m, files in _month_files(run_dir, "segment_month").items()]
-    hourly = [client.submit(hourly_part, [str(f) for f in files], m, pure=False)
-              for m, files in _month_files(run_dir, "hourly").items()]
     geometry = client.submit(geometry_factors, [str(f) for f in RunDir(run_dir).part_files(
         "geometry", "tile=*.parquet")], pure=False)
-    trip, sm, hourly, geometry = client.gather([trip, sm, hourly, geometry])
+    trip, sm, geometry = client.gather([trip, sm, geometry])
     return {"trip": _join_months(trip),
-            "segment_month": pd.concat(sm, ignore_index=True) if sm else pd.DataFrame(),
-            "hourly": pd.concat(hourly, ignore_index=True) if hourly else pd.DataFrame(),
+            "segment_month": pd.concat([s for s, _ in sm], ignore_index=True) if sm else pd.DataFrame(),
+            "hourly": (pd.concat([h for _, h in sm], ignore_index=True) if sm
+                       else hourly_sums([], "")[:0]),
             "geometry": geometry}
 
 
