@@ -91,7 +91,9 @@ def run_simulation(cfg: Config, year: int, scheduler: str | None = None,
     warm = threading.Thread(target=_warm_radiation, args=(ctx.data_dir, year), daemon=True,
                             name="sun-positions")
     warm.start()
+    t_wait = time.perf_counter()
     client, cluster = starting.result()
+    timings["cluster_wait_s"] = time.perf_counter() - t_wait
     closer = threading.Thread(target=close_client, args=(client, cluster), name="close-cluster")
     try:
         n_workers_now = len(client.scheduler_info()["workers"])
@@ -126,10 +128,12 @@ def run_simulation(cfg: Config, year: int, scheduler: str | None = None,
                                  cluster_done=lambda: closer.start(), timings=timings)
         timings["reduce_s"] = time.perf_counter() - t_red
     finally:
+        t_close = time.perf_counter()
         if closer.ident is not None:         # started by the reduce
             closer.join()
         else:
             close_client(client, cluster)
+        timings["close_wait_s"] = time.perf_counter() - t_close
     timings["total_s"] = time.perf_counter() - t_start
     write_manifest(cfg, year, run_dir, checksums, timings, results, builds)
     say(_summary_line(summary))
