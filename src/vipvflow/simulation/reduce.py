@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import json
 import logging
-import os
 import re
 import time
 from concurrent.futures import ThreadPoolExecutor
@@ -27,11 +26,6 @@ from ..models.irradiance import shading_loss
 from ..store import HOURLY_METADATA, DataDir, RunDir, write_json, write_parquet
 
 log = logging.getLogger(__name__)
-
-# Arrow tables that crossed processes (the trip sums of the workers) may hold buffers that
-# are not 8-byte aligned after unpickling: Acero's group_by then printed a warning to stderr
-# each time; it copies such buffers instead (unless the user chose otherwise)
-os.environ.setdefault("ACERO_ALIGNMENT_HANDLING", "reallocate")
 
 
 def _read_files(files, columns: list[str] | None = None) -> pa.Table | None:
