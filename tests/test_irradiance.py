@@ -345,6 +345,31 @@ def test_geometry_is_per_segment_and_plain_numeric():
     assert {f"r2_p2_{c}" for c in "xyz"} | {"r2_sky", "r2_gnd", "r2_open"} <= set(together.columns)
 
 
+def test_geometry_file_reads_back_as_computed(tmp_path):
+    """The geometry file (the sample points in one list column per reflector) reads back
+    as the table segment_geometry made: the same columns, in order, dtypes and values; a
+    file written the older way (one column per coordinate) too."""
+    import pyarrow.parquet as pq
+
+    from vipvflow.models.view_factors import geometry_table, read_geometry
+    from vipvflow.store import write_parquet
+
+    scene = Scene(box_mesh([[8, -50, 0, 12, 50, 15], [-14, -20, 0, -9, 30, 22]]))
+    cfg = IrradianceCfg(svf_rays=32, reflection_rays=64, reflector_points=5, reflector_sky_rays=8)
+    segs = _segments(np.linspace(-5, 5, 7), np.linspace(-30, 30, 7), 3.2, 10.0, 0.02)
+    segs["segment_id"] = [40, 3, 17, 8, 99, 5, 61]
+    geometry = segment_geometry(scene, segs, cfg)
+    path = write_parquet(geometry_table(geometry), tmp_path / "tile=A.parquet")
+    names = pq.read_schema(path).names
+    assert "r0_points" in names and "st_points" in names and "r0_p0_x" not in names
+    assert not any("_p0_" in n for n in names) and len(names) == len(geometry.columns) - 3 * 5 * 5 + 5
+    pd.testing.assert_frame_equal(read_geometry(path), geometry, check_exact=True)
+    pd.testing.assert_frame_equal(read_geometry(path, columns=["segment_id", "svf"]),
+                                  geometry[["segment_id", "svf"]], check_exact=True)
+    older = write_parquet(geometry, tmp_path / "tile=B.parquet")
+    pd.testing.assert_frame_equal(read_geometry(older), geometry, check_exact=True)
+
+
 def test_exchange_weights_are_the_radiosity_solution():
     """Two facades facing each other (view factors f_A of B from A, f_B of A from B, albedo
     included) and no street: E_A = S_A + f_A E_B, E_B = S_B + f_B E_A, so the roof

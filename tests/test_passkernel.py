@@ -11,7 +11,7 @@ from vipvflow.models import passkernel
 from vipvflow.models.irradiance import evaluate_passes
 from vipvflow.models.shading import Scene, box_mesh
 from vipvflow.models.sun_sky import RadiationTable
-from vipvflow.models.view_factors import COMPONENTS, pack_geometry, segment_geometry
+from vipvflow.models.view_factors import COMPONENTS, pack_geometry, read_geometry, segment_geometry
 
 LAT, LON, ALT = 49.61, 6.13, 300.0
 
@@ -123,7 +123,7 @@ def test_fused_equals_numpy_on_the_demo_passes(small_run, small_config):
         if not len(passes):
             continue
         n_passes += len(passes)
-        geometry = pd.read_parquet(small_run / "parts" / "geometry" / f"tile={tile}.parquet")
+        geometry = read_geometry(small_run / "parts" / "geometry" / f"tile={tile}.parquet")
         scene = part._scene(ctx, tile)
         geo = part._packed_geometry(ctx, tile, geometry, scene)
         ref = evaluate_passes(passes, None, geometry, table, scene, irr_cfg, packed=geo, kernel="numpy")

@@ -162,7 +162,7 @@ class TripModel:
 
     def __init__(self, run_dir):
         from ..models.horizon import horizon_columns, load_horizons
-        from ..models.view_factors import pack_geometry
+        from ..models.view_factors import pack_geometry, read_geometry
         from ..models.sun_sky import RadiationTable
         from ..inputs.gtfs import service_dates
 
@@ -186,8 +186,7 @@ class TripModel:
             inverter_efficiency=self.run_pv.inverter_efficiency)
 
         # segments with geometry factors and horizons, one row per segment id
-        geo = pd.concat([pd.read_parquet(f) for f in
-                         RunDir(self.run_dir).part_files("geometry")],
+        geo = pd.concat([read_geometry(f) for f in RunDir(self.run_dir).part_files("geometry")],
                         ignore_index=True)
         hor = load_horizons(self.run_dir)
         if len(hor) == 0:

@@ -7,6 +7,7 @@ geometry and read by the per-pass irradiance (:mod:`.irradiance`).
 from __future__ import annotations
 
 import math
+import re
 
 import numpy as np
 import pandas as pd
@@ -574,6 +575,74 @@ def _frame_by_dtype(columns: dict) -> pd.DataFrame:
     frames = [pd.DataFrame(np.column_stack([columns[c] for c in names]), columns=names)
               for names in by_dtype.values()]
     return pd.concat(frames, axis=1)[list(columns)]
+
+
+_POINT_COLUMN = re.compile(r"(r\d+|st)_p(\d+)_([xyz])")
+
+
+def geometry_table(geometry: pd.DataFrame):
+    """The geometry table (:func:`segment_geometry`) as Arrow for its file: each reflector's
+    P sample points (``r{g}_p{k}_{x,y,z}``, ``st_p{k}_...``) in one fixed-size list column
+    ``<prefix>_points`` of its P x 3 coordinates (x, y, z of point 0, then point 1, ...),
+    where the points' first column was; the other columns as they are.  A thousand scalar
+    columns of a few dozen rows cost ten times more to write than the values
+    (:func:`read_geometry` restores them)."""
+    import pyarrow as pa
+
+    names = [str(c) for c in geometry.columns]
+    # the values as one 2-D block per dtype (a pandas lookup per column cost more than the
+    # write): column i is block[i][:, where[i]]
+    block, where = {}, {}
+    by_dtype: dict = {}
+    for i, dtype in enumerate(geometry.dtypes):
+        by_dtype.setdefault(dtype, []).append(i)
+    for positions in by_dtype.values():
+        values = geometry.iloc[:, positions].to_numpy()
+        for j, i in enumerate(positions):
+            block[i], where[i] = values, j
+    points: dict[str, list[int]] = {}
+    for i, name in enumerate(names):
+        m = _POINT_COLUMN.fullmatch(name)
+        if m:
+            points.setdefault(m.group(1), []).append(i)
+    first = {}
+    for prefix, idx in points.items():
+        P = len(idx) // 3
+        if [names[i] for i in idx] != [f"{prefix}_p{k}_{c}" for k in range(P) for c in "xyz"]:
+            raise ValueError(f"geometry columns of {prefix} not in point order")
+        flat = np.ascontiguousarray(block[idx[0]][:, [where[i] for i in idx]], np.float64).ravel()
+        first[idx[0]] = (f"{prefix}_points", pa.FixedSizeListArray.from_arrays(pa.array(flat), 3 * P))
+    in_points = {i for idx in points.values() for i in idx}
+    out_names, out_arrays = [], []
+    for i, name in enumerate(names):
+        if i in first:
+            out_names.append(first[i][0])
+            out_arrays.append(first[i][1])
+        elif i not in in_points:
+            out_names.append(name)
+            out_arrays.append(pa.array(np.ascontiguousarray(block[i][:, where[i]])))
+    return pa.Table.from_arrays(out_arrays, names=out_names)
+
+
+def read_geometry(path, columns: list[str] | None = None) -> pd.DataFrame:
+    """A geometry file as the table :func:`segment_geometry` made (the sample points'
+    list columns of :func:`geometry_table` expanded back; files written before them, with
+    one column per coordinate, read as they are).  *columns*: only these scalar columns."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    table = pq.read_table(path, columns=columns)
+    out = {}
+    for name, col in zip(table.column_names, table.columns):
+        if pa.types.is_fixed_size_list(col.type) and name.endswith("_points"):
+            prefix, size = name[:-len("_points")], col.type.list_size
+            flat = col.combine_chunks().flatten().to_numpy().reshape(-1, size)
+            for k in range(size // 3):
+                for j, c in enumerate("xyz"):
+                    out[f"{prefix}_p{k}_{c}"] = flat[:, 3 * k + j]
+        else:
+            out[name] = col.to_numpy()
+    return _frame_by_dtype(out) if out else table.to_pandas()
 
 
 COMPONENTS = ("direct", "diffuse", "reflected", "total", "direct_clear", "diffuse_clear",

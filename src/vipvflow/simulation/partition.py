@@ -124,18 +124,18 @@ def tile_geometry(ctx: RunContext, tile: str) -> pd.DataFrame:
     horizon profiles (:func:`vipvflow.models.horizon.horizon_profile` from the roof ray origins)
     in ``parts/horizon/tile=<TILE>.parquet``, so a trip can be recomputed without rays."""
     from ..models.horizon import horizon_frame, horizon_profile
-    from ..models.view_factors import segment_geometry
+    from ..models.view_factors import geometry_table, read_geometry, segment_geometry
 
     path = RunDir(ctx.run_dir).tile_part("geometry", tile)
     if path.exists():
-        geom = pd.read_parquet(path)
+        geom = read_geometry(path)
     else:
         seg = _segments(ctx.data_dir)
         seg = seg[seg["tile"] == tile]
         if ctx.shapes is not None:
             seg = seg[seg["shape_id"].isin(ctx.shapes)]
         geom = segment_geometry(_scene(ctx, tile), seg, IrradianceCfg(**ctx.irradiance))
-        write_parquet(geom, path)
+        write_parquet(geometry_table(geom), path)
     hpath = RunDir(ctx.run_dir).tile_part("horizon", tile)
     if not hpath.exists():
         origins = geom[["px", "py", "pz"]].to_numpy(np.float64)
