@@ -520,6 +520,34 @@ def partition_done(run_dir: Path, tile: str, month: str) -> bool:
     return all(RunDir(run_dir).part(kind, tile, month).exists() for kind in PARTITION_KINDS)
 
 
+def release_memory() -> None:
+    """Drop this process's caches of the map (the tiles' scenes and packed geometry, the
+    segments, the radiation table, the GTFS tables) and hand freed memory back to the
+    operating system (Arrow's pool, glibc's heap).  Run on every worker once the map is done:
+    the workers live on through the reduce (its sums, the maps), and held their map's
+    memory while the client joined the fleet's tables."""
+    import gc
+
+    import pyarrow as pa
+
+    from ..inputs.gtfs import schedule
+    from ..models import shading
+
+    shading.clear_scene_cache()
+    _PACKED.clear()
+    _segments.cache_clear()
+    _radiation.cache_clear()
+    schedule.clear_caches()
+    gc.collect()
+    pa.default_memory_pool().release_unused()
+    try:
+        import ctypes
+
+        ctypes.CDLL("libc.so.6").malloc_trim(0)
+    except (OSError, AttributeError):      # not glibc
+        pass
+
+
 def worker_bvh_builds() -> dict:
     """BVH builds per tile in this process (collected from every worker after a run)."""
     from ..models import shading

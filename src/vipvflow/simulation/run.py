@@ -19,7 +19,7 @@ from ..store import DataDir
 from .cluster import close_client, make_client
 from .manifest import claim_run_dir, write_manifest
 from .network import selected_network
-from .partition import RunContext, partition_done, worker_bvh_builds
+from .partition import RunContext, partition_done, release_memory, worker_bvh_builds
 from .standing import standing_done, write_timeline
 from .tasks import map_tasks
 
@@ -114,6 +114,7 @@ def run_simulation(cfg: Config, year: int, scheduler: str | None = None,
         results = map_tasks(client, ctx, todo, standing_todo)
         timings["map_s"] = time.perf_counter() - t_map
         builds = client.run(worker_bvh_builds)
+        client.run(release_memory)          # the workers' caches of the map are done with
         if not (all(partition_done(run_dir, t, m) for t in tiles for m in _months(cfg, year))
                 and all(standing_done(run_dir, t) for t in standing)):
             say("stopped before all partitions were computed; run the same command again to resume")

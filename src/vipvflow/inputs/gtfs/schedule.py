@@ -344,6 +344,13 @@ def iter_passes(data_dir, tile: str, month, year: int | None = None,
     return _expand(runs, pat)
 
 
+def clear_caches() -> None:
+    """Drop this process's cached GTFS tables (service dates, a tile's patterns, a month's
+    runs)."""
+    for cached in (_service_dates_cached, _tile_patterns, _month_runs):
+        cached.cache_clear()
+
+
 _GTFS_TABLES = ("trips.parquet", "patterns.parquet", "segments.parquet", "calendar.parquet",
                 "calendar_dates.parquet", "feed.json")
 
