@@ -57,8 +57,11 @@ class Figures:
         self._client = client
         self._items: list[tuple[str, str, object]] = []
         # each worker loads matplotlib (about half a second) while it waits for the data
+        # (held until the figures are in, never waited for: a worker gone meanwhile is no
+        # matter)
         self._loading = [] if client is None else [
-            client.submit(_loaded, workers=[w], pure=False, key=f"figure-load-{i}")
+            client.submit(_loaded, workers=[w], allow_other_workers=True, pure=False,
+                          key=f"figure-load-{i}")
             for i, w in enumerate(client.scheduler_info()["workers"])]
 
     def add(self, name: str, title: str, make, *args) -> None:
@@ -69,7 +72,8 @@ class Figures:
     def results(self) -> list[tuple[str, str, bytes]]:
         """(name, title, PNG bytes) of every figure, in the order added."""
         jobs = [job for _, _, job in self._items]
-        data = self._client.gather(jobs + self._loading)[:len(jobs)] if self._client is not None else jobs
+        data = self._client.gather(jobs) if self._client is not None else jobs
+        self._loading = []
         return [(name, title, png) for (name, title, _), png in zip(self._items, data)]
 
 
