@@ -163,3 +163,19 @@ def test_failure_is_one_line(name, small_config, tmp_path, mounts):
         assert [ln for ln in err.splitlines() if "error" in ln] == [last], err
     for word in words:
         assert word in last, err
+
+
+def test_worker_lines_the_command_speaks_for_are_left_out():
+    """The worker log lines the command reports itself (a task's failure, a heartbeat cut by
+    the shutdown of a stopped run's cluster) are filtered; others pass."""
+    import logging
+
+    from vipvflow.simulation.worker_setup import _not_said_by_the_command
+
+    def record(msg):
+        return logging.LogRecord("distributed.worker", logging.ERROR, __file__, 1, msg, (), None)
+
+    assert not _not_said_by_the_command(record("Compute Failed\nKey: irradiance-E1N2-2024-06"))
+    assert not _not_said_by_the_command(record("Failed to communicate with scheduler during heartbeat."))
+    assert _not_said_by_the_command(record("Unexpected exception during heartbeat. Closing worker."))
+    assert _not_said_by_the_command(record("Worker stream died during communication"))

@@ -5,7 +5,8 @@ them too. They ignore it (the command closes the cluster), instead of each print
 ``KeyboardInterrupt`` traceback. A task's failure reaches the command, which prints it as one
 line (a :class:`vipvflow.errors.VipvError`) or with its traceback (a bug): the worker's own
 "Compute Failed ... Traceback" log of the same failure is left out unless the command runs
-with ``-v`` (Dask setting ``vipvflow.worker-failure-log``).
+with ``-v`` (Dask setting ``vipvflow.worker-failure-log``), and so is a heartbeat's
+traceback when the command closes the cluster of a run that stopped.
 
 Each worker loads the fused per-pass kernel (:func:`vipvflow.models.passkernel.warm`: compiled once
 and cached on disk, loaded here) before its first task, so no task pays for the compilation.
@@ -16,8 +17,14 @@ import logging
 import signal
 
 
-def _not_compute_failed(record: logging.LogRecord) -> bool:
-    return not (isinstance(record.msg, str) and record.msg.startswith("Compute Failed"))
+#: worker log lines the command speaks for itself: a task's failure (reported by the command
+#: as one line), and a heartbeat cut by the cluster's shutdown when a run stops (an error,
+#: Ctrl-C; the command has said why: a scheduler really lost is reported by the command too)
+_SAID_BY_THE_COMMAND = ("Compute Failed", "Failed to communicate with scheduler during heartbeat")
+
+
+def _not_said_by_the_command(record: logging.LogRecord) -> bool:
+    return not (isinstance(record.msg, str) and record.msg.startswith(_SAID_BY_THE_COMMAND))
 
 
 def dask_setup(worker) -> None:
@@ -33,7 +40,7 @@ def dask_setup(worker) -> None:
         except ValueError:      # not the process's main thread
             pass
     if not dask.config.get("vipvflow.worker-failure-log", False):
-        logging.getLogger("distributed.worker").addFilter(_not_compute_failed)
+        logging.getLogger("distributed.worker").addFilter(_not_said_by_the_command)
     from ..models import passkernel
 
     passkernel.warm()
