@@ -46,8 +46,12 @@ def assert_same_results(a: Path, b: Path):
 
 
 def test_outputs_written(small_run):
+    import gc
+
     for name in OUTPUTS + ["segments.parquet", "summary.json", "manifest.json", "report.html"]:
         assert (small_run / name).exists(), name
+    # the run kept this process's heap out of the collector's passes during its reduce only
+    assert gc.get_freeze_count() == 0
     smg = gpd.read_parquet(small_run / "segment_month.parquet")
     assert smg.crs.to_epsg() == 2169 and smg.geometry.has_z.all()
     trips = pd.read_parquet(small_run / "trip_energy.parquet")
@@ -257,3 +261,27 @@ def test_local_cluster_profiles_workers_only_when_asked(small_config, tmp_path, 
         cluster.close()
     # this process's own Dask configuration is left as it was
     assert dask.config.get("distributed.admin.tick.interval") == "20ms"
+
+
+def _frozen_objects() -> int:
+    import gc
+
+    return gc.get_freeze_count()
+
+
+def test_workers_keep_what_they_loaded_out_of_the_collector(small_config, tmp_path):
+    """A run's workers move what their set-up loaded (the libraries, the compiled kernels)
+    out of the cyclic garbage collector's full passes; the process that starts them is left
+    as it was."""
+    import gc
+
+    from vipvflow.simulation.cluster import make_client
+
+    client, cluster = make_client(_cfg(small_config, tmp_path), None, 2)
+    try:
+        frozen = client.run(_frozen_objects)
+        assert len(frozen) == 2 and all(n > 50_000 for n in frozen.values()), frozen
+    finally:
+        client.close()
+        cluster.close()
+    assert gc.get_freeze_count() == 0
