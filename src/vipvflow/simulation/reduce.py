@@ -445,18 +445,21 @@ def reduce_run(cfg: Config, year: int, run_dir: Path, say=print, client=None, cl
     # the figures are drawn on the cluster's workers as their data is made (here without one)
     figures = report.Figures(client)
     trips_meta = pd.read_parquet(DataDir(cfg.data_dir).gtfs.trips)
-    trip, bd, idle = _trip_outputs(cfg, year, run_dir, parts["trip"], trips_meta, say)
-    clock("trips")
+    totals = _trip_totals(run_dir, parts["trip"])
+    n_buses = _n_buses(run_dir, totals)
+    # the segments first: the workers draw the maps while the trips are joined here
     _, segments, sm = _segment_outputs(cfg, run_dir, parts["segment_month"], parts["geometry"],
-                                    trip, trips_meta)
+                                       totals, n_buses, trips_meta)
     report.add_maps(figures, run_dir, cfg)
     clock("segments")
+    trip, bd, idle = _trip_outputs(cfg, year, run_dir, totals, trips_meta, say)
+    clock("trips")
     rm = _route_month(trip)
     write_parquet(rm, RunDir(run_dir).output("route_month.parquet"))
     write_parquet(bd, RunDir(run_dir).output("block_day.parquet"))
     hp = _hourly_pattern(parts["hourly"])
     write_parquet(hp, RunDir(run_dir).output("hourly_pattern.parquet"))
-    monthly, summary = _fleet_year(cfg, year, run_dir, trip, bd, idle, sm, segments)
+    monthly, summary = _fleet_year(cfg, year, run_dir, trip, bd, idle, sm, segments, n_buses)
     write_parquet(monthly, RunDir(run_dir).output("monthly.parquet"))
     write_json(summary, RunDir(run_dir).output("summary.json"))
     report.add_charts(figures, summary, monthly, hp, rm)
@@ -483,18 +486,24 @@ class _Clock:
         self._last = now
 
 
-def _n_buses(trip: pd.DataFrame) -> int:
-    """The fleet: the most vehicle blocks on one service date."""
-    return int(trip.groupby("service_date")["block_id"].nunique().max())
+def _n_buses(run_dir: Path, totals: pd.DataFrame) -> int:
+    """The fleet: the most vehicle blocks on one service date among the trips of *totals*
+    (:func:`_trip_totals`), each in the timeline's block (the GTFS block or the inferred
+    one, as :func:`block_day_table` sets them)."""
+    runs = pd.read_parquet(RunDir(run_dir).timeline_table("trip_runs"),
+                           columns=["trip_id", "service_date", "block_id"])
+    blocks = totals[["trip_id", "service_date"]].merge(runs, on=["trip_id", "service_date"],
+                                                      how="left", validate="one_to_one")
+    return int(blocks.groupby("service_date")["block_id"].nunique().max())
 
 
-def _trip_outputs(cfg: Config, year: int, run_dir: Path, sums: pa.Table | None,
+def _trip_outputs(cfg: Config, year: int, run_dir: Path, totals: pd.DataFrame,
                   trips_meta: pd.DataFrame, say):
-    """Per trip and service date (PV, the trip's metadata, the vehicle model's consumption)
-    and per block-day (driving, layovers, parked; the battery's share); writes
-    ``trip_energy.parquet``.  Returns the trips, the block-days and the idle buses' days."""
-    trip = _trip_totals(run_dir, sums)
-    trip = trip.merge(trips_meta[["trip_id", "route_id", "route_short_name", "direction_id",
+    """Per trip and service date (PV of *totals*, :func:`_trip_totals`; the trip's metadata,
+    the vehicle model's consumption) and per block-day (driving, layovers, parked; the
+    battery's share); writes ``trip_energy.parquet``.  Returns the trips, the block-days and
+    the idle buses' days."""
+    trip = totals.merge(trips_meta[["trip_id", "route_id", "route_short_name", "direction_id",
                                   "shape_id", "service_id", "block_id", "pattern_id", "start_s"]],
                       on="trip_id", how="left", validate="many_to_one")
     trip["month"] = pd.to_datetime(trip["service_date"]).dt.strftime("%Y-%m")
@@ -510,15 +519,17 @@ def _trip_outputs(cfg: Config, year: int, run_dir: Path, sums: pa.Table | None,
 
 
 def _segment_outputs(cfg: Config, run_dir: Path, sm: pd.DataFrame, geo: pd.DataFrame | None,
-                     trip: pd.DataFrame, trips_meta: pd.DataFrame):
+                     totals: pd.DataFrame, n_buses: int, trips_meta: pd.DataFrame):
     """Per segment and month (GeoParquet for maps) and per segment over the run (geometry
-    factors and year); writes ``segment_month.parquet`` and ``segments.parquet``.  Returns
-    both and the segment-month sums."""
+    factors and year) of the shapes of the trips in *totals* (:func:`_trip_totals`) run by
+    *n_buses*; writes ``segment_month.parquet`` and ``segments.parquet``.  Returns both and
+    the segment-month sums."""
     from . import annual
 
     data_dir = Path(cfg.data_dir)
     segments = gpd.read_parquet(DataDir(data_dir).gtfs.segments)
-    segments = segments[segments["shape_id"].isin(trip["shape_id"].unique())]
+    shapes = trips_meta.loc[trips_meta["trip_id"].isin(totals["trip_id"].unique()), "shape_id"]
+    segments = segments[segments["shape_id"].isin(shapes.unique())]
     # shading loss: sky and sun light the buildings take away (1 - (direct + diffuse) / unshaded);
     # the reflected light they add is reported apart as reflection gain
     sm["shading_loss"] = shading_loss(sm["h_direct"], sm["h_diffuse"], sm["h_total_unshaded"])
@@ -530,7 +541,7 @@ def _segment_outputs(cfg: Config, run_dir: Path, sm: pd.DataFrame, geo: pd.DataF
     smg = gpd.GeoDataFrame(smg.merge(shape_route, on="shape_id", how="left"),
                            geometry="geometry", crs=segments.crs)
     write_parquet(smg, RunDir(run_dir).output("segment_month.parquet"))
-    hours_per_bus = annual.service_hours_per_bus(float(trip["seconds"].sum()), _n_buses(trip),
+    hours_per_bus = annual.service_hours_per_bus(float(totals["seconds"].sum()), n_buses,
                                                  12.0 / len(cfg.run.months))
     segments = annual.segment_year(segments.merge(shape_route, on="shape_id", how="left"), geo, sm,
                                    cfg.pv_system().kwp, hours_per_bus)
@@ -633,13 +644,13 @@ def _monthly(cfg: Config, trip: pd.DataFrame, bd: pd.DataFrame, idle: pd.DataFra
     return monthly
 
 
-def _fleet_year(cfg: Config, year: int, run_dir: Path, trip, bd, idle, sm, segments) -> tuple[pd.DataFrame, dict]:
+def _fleet_year(cfg: Config, year: int, run_dir: Path, trip, bd, idle, sm, segments,
+                n_buses: int) -> tuple[pd.DataFrame, dict]:
     """The fleet per month and the fleet-year summary (checked: :func:`_check_totals`)."""
     from . import annual
 
     data_dir = Path(cfg.data_dir)
     pv = cfg.pv_system()
-    n_buses = _n_buses(trip)
     # a run over some months states annual figures scaled by 12 / months (flagged in the summary)
     annualise = 12.0 / len(cfg.run.months)
     hours_per_bus = annual.service_hours_per_bus(float(trip["seconds"].sum()), n_buses, annualise)
