@@ -548,8 +548,12 @@ def release_memory() -> None:
         pass
 
 
-def worker_bvh_builds() -> dict:
-    """BVH builds per tile in this process (collected from every worker after a run)."""
+def worker_bvh_builds(release: bool = False) -> dict:
+    """BVH builds per tile in this process (collected from every worker after a run); with
+    *release*, the map's caches are dropped then (:func:`release_memory`)."""
     from ..models import shading
 
-    return {tile: n for (_, tile), n in shading.BVH_BUILDS.items()}
+    builds = {tile: n for (_, tile), n in shading.BVH_BUILDS.items()}
+    if release:
+        release_memory()
+    return builds

@@ -20,7 +20,7 @@ from ..store import DataDir
 from .cluster import close_client, make_client
 from .manifest import claim_run_dir, write_manifest
 from .network import selected_network
-from .partition import RunContext, partition_done, release_memory, worker_bvh_builds
+from .partition import RunContext, partition_done, worker_bvh_builds
 from .standing import standing_done, write_timeline
 from .tasks import map_tasks
 
@@ -109,26 +109,27 @@ def run_simulation(cfg: Config, year: int, scheduler: str | None = None,
         say(f"{len(tiles)} tiles x {len(cfg.run.months)} months + {len(standing)} standing = {total} "
             f"partitions, {n_todo} to compute ({total - n_todo} already done) with {n_workers_now} workers")
         warm.join()
+        # what this process holds by now (the libraries, the inputs' tables) outlives the
+        # run: the cyclic collector leaves it alone until the run is done (each of its full
+        # passes walked ~300,000 objects, ~0.15 s, while the scheduler and the reduce work
+        # here); a freeze of the caller's own is left as it is
+        froze = gc.get_freeze_count() == 0
+        if froze:
+            gc.freeze()
         t_map = time.perf_counter()
         # the reduce's plotting libraries load while the workers compute
         threading.Thread(target=importlib.import_module, args=("vipvflow.outputs.report",),
                          daemon=True, name="import-report").start()
         results = map_tasks(client, ctx, todo, standing_todo)
         timings["map_s"] = time.perf_counter() - t_map
-        builds = client.run(worker_bvh_builds)
-        client.run(release_memory)          # the workers' caches of the map are done with
+        # the BVH builds of each worker, whose caches of the map are then dropped
+        builds = client.run(worker_bvh_builds, release=True)
         if not (all(partition_done(run_dir, t, m) for t in tiles for m in _months(cfg, year))
                 and all(standing_done(run_dir, t) for t in standing)):
             say("stopped before all partitions were computed; run the same command again to resume")
             return run_dir
         # the partitions are read and summed by tasks on the cluster; the joins and the
-        # outputs are made here.  What this process holds by now (the libraries, the
-        # inputs' tables) outlives the reduce: the cyclic collector leaves it alone until
-        # the run is done (each of its full passes walked ~300,000 objects, ~0.15 s); a
-        # freeze of the caller's own is left as it is
-        froze = gc.get_freeze_count() == 0
-        if froze:
-            gc.freeze()
+        # outputs are made here
         t_red = time.perf_counter()
         with FolderProgress("reduce", run_dir):
             # the cluster shuts down once the partitions are summed and the figures drawn,
