@@ -4,6 +4,8 @@ site figures, and the report (its table, inputs, CRS and maps over the building 
 from __future__ import annotations
 
 import json
+import subprocess
+import sys
 from pathlib import Path
 
 import geopandas as gpd
@@ -209,3 +211,14 @@ def test_app_map_draws_the_same_footprints(small_run):
     rings = building_footprints(model.data_dir, tiles=sorted(g["tile"].unique()), bounds=bounds)
     assert len(xs) == len(rings) > 0
     assert [list(r[:, 0]) for r in rings] == [list(x) for x in xs]
+
+
+def test_the_report_module_leaves_matplotlib_to_where_figures_are_drawn():
+    """The command's process loads the report module for the reduce; a run's workers draw
+    the figures, so matplotlib is loaded there (and by the first figure drawn here) only."""
+    code = ("import sys\n"
+            "import vipvflow.simulation.reduce, vipvflow.simulation.run, vipvflow.outputs.report as r\n"
+            "assert 'matplotlib' not in sys.modules, 'matplotlib loaded by an import'\n"
+            "assert r._loaded() and 'matplotlib.pyplot' in sys.modules\n")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr

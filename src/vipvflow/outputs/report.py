@@ -12,18 +12,12 @@ import html
 import io
 from pathlib import Path
 
-import matplotlib
+import numpy as np
+import pandas as pd
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-import pandas as pd  # noqa: E402
-from matplotlib.collections import LineCollection, PolyCollection  # noqa: E402
-from matplotlib.patches import Rectangle  # noqa: E402
-
-from ..models.irradiance import shading_loss  # noqa: E402
-from ..simulation.dictionary import SUMMARY  # noqa: E402
-from ..store import RunDir, write_bytes, write_text  # noqa: E402
+from ..models.irradiance import shading_loss
+from ..simulation.dictionary import SUMMARY
+from ..store import RunDir, write_bytes, write_text
 
 #: colour limits of the maps: these percentiles of the segments' values (a few segments with
 #: a stop or a tunnel-like canyon would otherwise flatten the rest)
@@ -34,18 +28,30 @@ CLOSE_UP_M = 1200.0
 
 
 
+def _pyplot():
+    """matplotlib's pyplot on its file-only backend, loaded where a figure is drawn (a run's
+    workers draw them: the command's own process then never loads matplotlib, ~0.6 s of
+    a core taken from the workers while they compute)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
 def figure_png(make, *args) -> bytes:
     """The figure ``make(*args)`` as PNG bytes (a task the run's workers can take)."""
     fig = make(*args)
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=110, bbox_inches="tight")
-    plt.close(fig)
+    _pyplot().close(fig)
     return buf.getvalue()
 
 
 def _loaded() -> bool:
-    """Nothing: a task that loads this module (and matplotlib) on a worker."""
-    return True
+    """A task that loads this module and matplotlib on a worker."""
+    return _pyplot() is not None
 
 
 class Figures:
@@ -88,6 +94,7 @@ def fig_monthly(monthly: pd.DataFrame, summary: dict):
     of each bar the whole day.  Black marks: driving without buildings (the gap to the
     driving bar is the shading loss on the road).  Runs without the split (driving only)
     show the driving bar alone."""
+    plt = _pyplot()
     fig, ax = plt.subplots(figsize=(9.5, 4))
     x = np.arange(len(monthly))
     kwp = summary["kwp_per_bus"] * summary["buses"]
@@ -149,6 +156,10 @@ def fig_map(segments, column: str, label: str, cmap: str, title: str, footprints
             scale: float = 1.0):
     """The segments coloured by *column* (x *scale*) over the building footprints: the whole
     network and a close-up of the canyons, colour limits at :data:`MAP_PERCENTILES`."""
+    from matplotlib.collections import LineCollection, PolyCollection
+    from matplotlib.patches import Rectangle
+
+    plt = _pyplot()
     values = segments[column].to_numpy(np.float64) * scale
     vmin, vmax = _robust_limits(values)
     lines = _segment_lines(segments)
@@ -186,6 +197,7 @@ def fig_map(segments, column: str, label: str, cmap: str, title: str, footprints
 
 
 def fig_cycles(monthly: pd.DataFrame):
+    plt = _pyplot()
     fig, ax = plt.subplots(figsize=(8, 3.5))
     ax.bar(_months(monthly["month"]).strftime("%b"), monthly["avoided_charging_cycles"], color="#0f9d58")
     ax.set_ylabel("avoided charging cycles (fleet)")
@@ -194,6 +206,7 @@ def fig_cycles(monthly: pd.DataFrame):
 
 
 def fig_hourly(hp: pd.DataFrame):
+    plt = _pyplot()
     hp = hp.assign(month=_months(hp["month"]))
     grid = hp.pivot_table(index="hour", columns="month", values="g_total", aggfunc="sum")
     fig, ax = plt.subplots(figsize=(8, 4.5))
@@ -207,6 +220,7 @@ def fig_hourly(hp: pd.DataFrame):
 
 
 def fig_routes(rm: pd.DataFrame):
+    plt = _pyplot()
     r = rm.groupby(["route_short_name", "direction_id"]).agg(
         trips=("trips", "sum"), pv_kwh=("pv_kwh", "sum"), consumption_kwh=("consumption_kwh", "sum"),
         pv_kwh_unshaded=("pv_kwh_unshaded", "sum"), pv_kwh_direct=("pv_kwh_direct", "sum"),

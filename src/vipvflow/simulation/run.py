@@ -117,7 +117,8 @@ def run_simulation(cfg: Config, year: int, scheduler: str | None = None,
         if froze:
             gc.freeze()
         t_map = time.perf_counter()
-        # the reduce's plotting libraries load while the workers compute
+        # the reduce's modules load while the workers compute (not matplotlib: the workers
+        # draw the figures)
         threading.Thread(target=importlib.import_module, args=("vipvflow.outputs.report",),
                          daemon=True, name="import-report").start()
         results = map_tasks(client, ctx, todo, standing_todo)
