@@ -221,6 +221,33 @@ def test_vecto_cycles_written_and_vmod_replaces_consumption(small_run, small_con
         trip_consumption(cfg, Path(cfg.data_dir), 2024, patterns.index, say=lambda *a: None)
 
 
+def test_consumption_made_by_tasks_joins_what_the_reduce_computes(small_run, small_config, tmp_path):
+    """The patterns a run's tasks computed (:class:`Consumption`) and those the reduce finds
+    missing give the table and the VECTO cycles and job of one computation in the reduce."""
+    from concurrent.futures import Future
+
+    from vipvflow.simulation.reduce import Consumption, pattern_consumption, trip_consumption
+
+    cfg = load_config(small_config)
+    patterns = sorted(pd.read_parquet(small_run / "trip_energy.parquet")["pattern_id"].unique())
+    assert len(patterns) >= 2
+    here, split = tmp_path / "here", tmp_path / "split"
+    whole = trip_consumption(cfg, Path(cfg.data_dir), 2024, patterns, vecto_dir=here, say=lambda *a: None)
+    split.mkdir()
+    task = Future()
+    task.set_result(pattern_consumption(cfg, Path(cfg.data_dir), 2024, patterns[:1], split, {}))
+    joined = trip_consumption(cfg, Path(cfg.data_dir), 2024, patterns, vecto_dir=split,
+                              say=lambda *a: None, made=Consumption([task], {}))
+    pd.testing.assert_frame_equal(joined, whole, check_exact=True)
+    names = sorted(p.name for p in here.iterdir())
+    assert names == sorted(p.name for p in split.iterdir())
+    for name in names:
+        if name.endswith(".vdri"):
+            assert (here / name).read_bytes() == (split / name).read_bytes(), name
+    job = json.loads(next(split.glob("*.vecto")).read_text())
+    assert json.dumps(job).count(".vdri") == len(patterns)
+
+
 def test_plan_lists_the_graph_and_what_is_done(small_run, small_config):
     import runpy
 

@@ -243,38 +243,69 @@ def _trip_totals(run_dir: Path, table: pa.Table | None = None) -> pd.DataFrame:
 
 
 def trip_consumption(cfg: Config, data_dir: Path, year: int, pattern_ids, vecto_dir: Path | None = None,
-                     say=print) -> pd.DataFrame:
+                     say=print, made: "Consumption | None" = None) -> pd.DataFrame:
     """Battery energy per trip pattern and month (kWh) from the vehicle model run over each
     pattern's 2 s driving cycle at the month's mean ambient temperature.
 
     With *vecto_dir* each pattern's cycle is also written as a VECTO driving cycle
     (``pattern_<id>.vdri``) with a VECTO job of the vehicle, so a VECTO user can run them;
     with ``vehicle.vmod_dir`` the VECTO modal results ``pattern_<id>.vmod`` found there
-    replace the built-in consumption of those patterns (for every month).
+    replace the built-in consumption of those patterns (for every month).  *made*: the
+    patterns already computed by the run's tasks (:func:`consumption_tasks`, into the same
+    *vecto_dir*); the others of *pattern_ids* are computed here.
     """
+    from ..outputs import vecto
+
+    vmod = _vmod_consumption(cfg, say) if made is None else made.vmod
+    done = made.results() if made is not None else {}
+    if vecto_dir is not None:
+        vecto_dir.mkdir(parents=True, exist_ok=True)
+    missing = sorted(set(pattern_ids) - set(done))
+    if missing:
+        done.update(pattern_consumption(cfg, data_dir, year, missing, vecto_dir, vmod))
+    patterns = sorted(done)
+    if vecto_dir is not None and patterns:
+        vecto.write_vecto_job(vecto_dir, cfg.vehicle_params(), cycles=[done[p][1] for p in patterns])
+    return pd.DataFrame([row for p in patterns for row in done[p][0]])
+
+
+def _vmod_consumption(cfg: Config, say) -> dict:
+    """Battery energy per pattern (kWh) from the VECTO modal results in ``vehicle.vmod_dir``
+    (empty without)."""
+    from ..outputs import vecto
+
+    if cfg.vehicle.vmod_dir is None:
+        return {}
+    files = {int(p.stem.split("_", 1)[1]): p for p in Path(cfg.vehicle.vmod_dir).glob("pattern_*.vmod")}
+    if not files:
+        return {}
+    vmod = vecto.vmod_trip_energies(files)["consumption_kwh"].to_dict()
+    bad = [str(files[k]) for k, v in vmod.items() if not np.isfinite(v)]
+    if bad:
+        raise InputError(f"{bad[0]}: no battery power columns (P_REESS_*): not the modal "
+                         "result of a battery-electric VECTO run")
+    say(f"consumption of {len(vmod)} pattern(s) from VECTO results in {cfg.vehicle.vmod_dir}")
+    return vmod
+
+
+def pattern_consumption(cfg: Config, data_dir: Path, year: int, pattern_ids, vecto_dir: Path | None,
+                        vmod: dict) -> dict:
+    """Per pattern of *pattern_ids*: its rows of :func:`trip_consumption` (one per month of
+    the run) and the name of its VECTO cycle file (written into *vecto_dir*; None without).
+    A Dask task of the run (:func:`consumption_tasks`)."""
     from ..models.driving_cycle import pattern_cycle
     from ..models.vehicle import simulate_cycle
     from ..outputs import vecto
 
     params = cfg.vehicle_params()
     temps = cfg.climate.monthly_mean_temperature_c
-    vmod = {}
-    if cfg.vehicle.vmod_dir is not None:
-        files = {int(p.stem.split("_", 1)[1]): p for p in Path(cfg.vehicle.vmod_dir).glob("pattern_*.vmod")}
-        if files:
-            vmod = vecto.vmod_trip_energies(files)["consumption_kwh"].to_dict()
-            bad = [str(files[k]) for k, v in vmod.items() if not np.isfinite(v)]
-            if bad:
-                raise InputError(f"{bad[0]}: no battery power columns (P_REESS_*): not the modal "
-                                 "result of a battery-electric VECTO run")
-            say(f"consumption of {len(vmod)} pattern(s) from VECTO results in {cfg.vehicle.vmod_dir}")
-    rows, cycles = [], []
-    if vecto_dir is not None:
-        vecto_dir.mkdir(parents=True, exist_ok=True)
+    out = {}
     for pattern_id in sorted(set(pattern_ids)):
         cycle = pattern_cycle(data_dir, pattern_id, cfg.trajectory.cycle)
+        name = None
         if vecto_dir is not None:
-            cycles.append(vecto.write_vdri(cycle, vecto_dir / f"pattern_{pattern_id}.vdri"))
+            name = Path(vecto.write_vdri(cycle, vecto_dir / f"pattern_{pattern_id}.vdri")).name
+        rows = []
         for m in cfg.run.months:
             e = simulate_cycle(cycle, params, ambient_c=temps[m - 1])
             rows.append({"pattern_id": pattern_id, "month": f"{year}-{m:02d}",
@@ -282,9 +313,45 @@ def trip_consumption(cfg: Config, data_dir: Path, year: int, pattern_ids, vecto_
                          "consumption_source": "vecto" if int(pattern_id) in vmod else "built-in",
                          "traction_kwh": e["traction_kwh"], "recuperated_kwh": e["recuperated_kwh"],
                          "aux_kwh": e["aux_kwh"]})
-    if vecto_dir is not None and cycles:
-        vecto.write_vecto_job(vecto_dir, params, cycles=[Path(c).name for c in cycles])
-    return pd.DataFrame(rows)
+        out[pattern_id] = (rows, name)
+    return out
+
+
+#: trip patterns per consumption task of a run
+PATTERNS_PER_TASK = 20
+
+
+class Consumption:
+    """The consumption of a run's trip patterns, computed by tasks on its cluster while the
+    partitions are (:func:`consumption_tasks`); :meth:`results` waits for them."""
+
+    def __init__(self, futures: list, vmod: dict):
+        self.futures, self.vmod = futures, vmod
+
+    def results(self) -> dict:
+        out = {}
+        for part in (f.result() for f in self.futures):
+            out.update(part)
+        return out
+
+
+def consumption_tasks(client, cfg: Config, year: int, run_dir: Path, say=print) -> Consumption:
+    """Submit the vehicle model over the driving cycles of the patterns of the trips that run
+    in the run's months (the timeline's trips; :func:`pattern_consumption`, a task per
+    :data:`PATTERNS_PER_TASK`), writing their VECTO cycles into the run folder: none of it
+    waits for the partitions (at network scale it was most of the reduce's time in this
+    process)."""
+    data_dir = Path(cfg.data_dir)
+    vmod = _vmod_consumption(cfg, say)
+    runs = pd.read_parquet(RunDir(run_dir).timeline_table("trip_runs"), columns=["trip_id"])
+    trips = pd.read_parquet(DataDir(data_dir).gtfs.trips, columns=["trip_id", "pattern_id"])
+    patterns = sorted(set(trips.loc[trips["trip_id"].isin(runs["trip_id"].unique()), "pattern_id"]))
+    vecto_dir = RunDir(run_dir).vecto
+    vecto_dir.mkdir(parents=True, exist_ok=True)
+    futures = [client.submit(pattern_consumption, cfg, data_dir, year, patterns[i:i + PATTERNS_PER_TASK],
+                             vecto_dir, vmod, pure=False)
+               for i in range(0, len(patterns), PATTERNS_PER_TASK)]
+    return Consumption(futures, vmod)
 
 
 def _radiation_gaps(data_dir: Path, year: int, months) -> dict:
@@ -427,7 +494,7 @@ def block_day_table(cfg: Config, run_dir: Path, trip: pd.DataFrame, vehicle):
 
 
 def reduce_run(cfg: Config, year: int, run_dir: Path, say=print, client=None, cluster_done=None,
-               timings: dict | None = None) -> dict:
+               timings: dict | None = None, consumption: Consumption | None = None) -> dict:
     """Write trip_energy, segments, segment_month, route_month, block_day, monthly, hourly
     outputs, ``summary.json`` and ``report.html``; return the summary.
 
@@ -436,7 +503,8 @@ def reduce_run(cfg: Config, year: int, run_dir: Path, say=print, client=None, cl
     the joins, the vehicles' balance and the outputs are computed here, while the workers
     draw the report's figures.  *cluster_done* is called once the cluster's part is done
     (the run shuts its cluster down then, while this process writes the report).  The
-    seconds of each step are added to *timings* (``reduce_<step>_s``)."""
+    seconds of each step are added to *timings* (``reduce_<step>_s``).  *consumption*: the
+    trip patterns' consumption already submitted to the cluster (:func:`consumption_tasks`)."""
     from ..outputs import report
 
     clock = _Clock(timings)
@@ -452,7 +520,7 @@ def reduce_run(cfg: Config, year: int, run_dir: Path, say=print, client=None, cl
                                        totals, n_buses, trips_meta)
     report.add_maps(figures, run_dir, cfg)
     clock("segments")
-    trip, bd, idle = _trip_outputs(cfg, year, run_dir, totals, trips_meta, say)
+    trip, bd, idle = _trip_outputs(cfg, year, run_dir, totals, trips_meta, say, consumption)
     clock("trips")
     rm = _route_month(trip)
     write_parquet(rm, RunDir(run_dir).output("route_month.parquet"))
@@ -498,7 +566,7 @@ def _n_buses(run_dir: Path, totals: pd.DataFrame) -> int:
 
 
 def _trip_outputs(cfg: Config, year: int, run_dir: Path, totals: pd.DataFrame,
-                  trips_meta: pd.DataFrame, say):
+                  trips_meta: pd.DataFrame, say, consumption: Consumption | None = None):
     """Per trip and service date (PV of *totals*, :func:`_trip_totals`; the trip's metadata,
     the vehicle model's consumption) and per block-day (driving, layovers, parked; the
     battery's share); writes ``trip_energy.parquet``.  Returns the trips, the block-days and
@@ -508,7 +576,7 @@ def _trip_outputs(cfg: Config, year: int, run_dir: Path, totals: pd.DataFrame,
                       on="trip_id", how="left", validate="many_to_one")
     trip["month"] = pd.to_datetime(trip["service_date"]).dt.strftime("%Y-%m")
     cons = trip_consumption(cfg, Path(cfg.data_dir), year, trip["pattern_id"].unique(),
-                            vecto_dir=RunDir(run_dir).vecto, say=say)
+                            vecto_dir=RunDir(run_dir).vecto, say=say, made=consumption)
     trip = trip.merge(cons, on=["pattern_id", "month"], how="left", validate="many_to_one")
     trip["coverage"] = trip["pv_kwh"] / trip["consumption_kwh"]
     # vehicle block per day: driving, layovers, parked; the battery's share (sets the

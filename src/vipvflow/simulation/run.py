@@ -121,6 +121,10 @@ def run_simulation(cfg: Config, year: int, scheduler: str | None = None,
         # draw the figures)
         threading.Thread(target=importlib.import_module, args=("vipvflow.outputs.report",),
                          daemon=True, name="import-report").start()
+        # the trip patterns' consumption (vehicle model, VECTO cycles) is computed with the map
+        from .reduce import consumption_tasks
+
+        consumption = consumption_tasks(client, cfg, year, run_dir, say=say)
         results = map_tasks(client, ctx, todo, standing_todo)
         timings["map_s"] = time.perf_counter() - t_map
         # the BVH builds of each worker, whose caches of the map are then dropped
@@ -136,7 +140,8 @@ def run_simulation(cfg: Config, year: int, scheduler: str | None = None,
             # the cluster shuts down once the partitions are summed and the figures drawn,
             # while this process writes the report
             summary = reduce_run(cfg, year, run_dir, say=say, client=client,
-                                 cluster_done=lambda: closer.start(), timings=timings)
+                                 cluster_done=lambda: closer.start(), timings=timings,
+                                 consumption=consumption)
         timings["reduce_s"] = time.perf_counter() - t_red
     finally:
         t_close = time.perf_counter()
