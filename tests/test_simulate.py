@@ -312,3 +312,27 @@ def test_workers_keep_what_they_loaded_out_of_the_collector(small_config, tmp_pa
         client.close()
         cluster.close()
     assert gc.get_freeze_count() == 0
+
+
+def test_a_dashboard_port_taken_meanwhile_is_not_warned_about(small_config, tmp_path, monkeypatch):
+    """Two runs starting together: the port one found free is taken by the other before its
+    cluster binds it. Dask serves the dashboard elsewhere; its warning is not printed."""
+    import socket
+    import warnings
+
+    from vipvflow.simulation import cluster as cluster_mod
+
+    with socket.socket() as taken:
+        taken.bind(("", 0))
+        taken.listen()
+        port = taken.getsockname()[1]
+        monkeypatch.setattr(cluster_mod, "dashboard_address", lambda _port: f":{port}")
+        with warnings.catch_warnings(record=True) as seen:
+            warnings.simplefilter("always")
+            client, cluster = cluster_mod.make_client(_cfg(small_config, tmp_path), None, 1)
+            try:
+                assert not client.dashboard_link.endswith(f":{port}/status")
+            finally:
+                client.close()
+                cluster.close()
+    assert not [w for w in seen if "already in use" in str(w.message)], [str(w.message) for w in seen]

@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import logging
 import os
+import warnings
 
 from ..config import Config
 
@@ -38,6 +39,10 @@ def make_client(cfg: Config, scheduler: str | None, n_workers: int | None):
     if scheduler:
         return Client(scheduler), None
     n = n_workers or cfg.dask.n_workers or os.cpu_count() or 1
+    # the dashboard's port was free a moment ago (dashboard_address); a run starting at the
+    # same time may take it first: Dask then serves on another port and warns, but the
+    # command prints the dashboard's address itself
+    warnings.filterwarnings("ignore", message=r"Port \d+ is already in use", category=UserWarning)
     settings = {**LOCAL_CLUSTER_DASK_CONFIG, "distributed.worker.profile.enabled": cfg.dask.worker_profile,
                 # workers ignore Ctrl-C and leave a task's failure for this process to report
                 "distributed.worker.preload": ["vipvflow.simulation.worker_setup"],
