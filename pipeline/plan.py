@@ -2,9 +2,10 @@
 
     .venv/bin/python pipeline/plan.py --config conf/demo.yaml --year 2024
 
-Shows the ``geometry-<TILE>`` and ``irradiance-<TILE>-<YYYY-MM>`` tasks the simulation will
-submit, how many are already written (a re-run resumes from them) and the partition count
-per tile, so a user can size a cluster. The inputs must have been ingested once
+Shows the ``irradiance-<TILE>`` tasks the simulation will submit (one per tile: its
+geometry, then its (tile, month) partitions), how many partitions are already written (a
+re-run resumes from them, and submits tasks for the missing months only), so a user can size
+a cluster. The inputs must have been ingested once
 (``vipvflow ingest ...`` or a first ``make simulate``). The graph itself is built by
 :mod:`vipvflow.simulation.run`; this script only prints :func:`vipvflow.simulation.run.plan`.
 """
@@ -30,11 +31,13 @@ def main(argv=None) -> int:
         print(f"plan: {exc}", file=sys.stderr)
         return 2
     tiles = table["tile"].nunique()
-    print(f"{tiles} geometry tasks, {len(table)} irradiance tasks "
-          f"({int(table['done'].sum())} already written, {int((~table['done']).sum())} to compute)")
+    todo = table[~table["done"]]
+    print(f"{tiles} tiles x {table['month'].nunique()} months = {len(table)} partitions "
+          f"({int(table['done'].sum())} already written, {len(todo)} to compute "
+          f"by {todo['key'].nunique()} irradiance tasks)")
     if args.tasks:
         for row in table.itertuples():
-            print(f"{row.key:<40} <- {row.depends_on:<22} {'done' if row.done else 'to do'}")
+            print(f"{row.key:<30} {row.month}  {'done' if row.done else 'to do'}")
     return 0
 
 

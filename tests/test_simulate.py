@@ -256,7 +256,8 @@ def test_plan_lists_the_graph_and_what_is_done(small_run, small_config):
     table = plan(load_config(small_config), 2024)
     segs = pd.read_parquet(Path(load_config(small_config).data_dir) / "gtfs" / "segments.parquet")
     assert sorted(table["tile"].unique()) == sorted(segs["tile"].unique())
-    assert (table["key"] == "irradiance-" + table["tile"] + "-2024-06").all()
+    assert (table["key"] == "irradiance-" + table["tile"]).all()
+    assert (table["month"] == "2024-06").all()
     assert table["done"].all()   # the session's run wrote every partition
     main = runpy.run_path(str(Path(__file__).parents[1] / "pipeline" / "plan.py"))["main"]
     assert main(["--config", str(small_config), "--year", "2024"]) == 0

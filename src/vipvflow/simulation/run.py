@@ -36,14 +36,14 @@ def _months(cfg: Config, year: int) -> list[str]:
 
 
 def plan(cfg: Config, year: int) -> pd.DataFrame:
-    """The task graph of a scenario-year as a table: one row per ``irradiance`` task with its
-    tile, month, key, the ``geometry`` task it depends on, and whether its partition is
-    already written (a resumed run skips those)."""
+    """The partitions of a scenario-year as a table: one row per (tile, month) with the key
+    of the task that computes it (``irradiance-<TILE>``: the tile's geometry, then its
+    months) and whether it is already written (a resumed run skips those)."""
     _, _, tiles = selected_network(cfg)
     run_dir = run_dir_of(cfg, year)
-    rows = [{"tile": t, "month": m, "key": f"irradiance-{t}-{m}", "depends_on": f"geometry-{t}",
-             "done": partition_done(run_dir, t, m)} for t in tiles for m in _months(cfg, year)]
-    return pd.DataFrame(rows, columns=["tile", "month", "key", "depends_on", "done"])
+    rows = [{"tile": t, "month": m, "key": f"irradiance-{t}", "done": partition_done(run_dir, t, m)}
+            for t in tiles for m in _months(cfg, year)]
+    return pd.DataFrame(rows, columns=["tile", "month", "key", "done"])
 
 
 def run_simulation(cfg: Config, year: int, scheduler: str | None = None,

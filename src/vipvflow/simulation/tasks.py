@@ -4,24 +4,25 @@ from __future__ import annotations
 import time
 
 from ..progress import MapProgress
-from .partition import RunContext, geometry_task, run_partition
+from .partition import RunContext, tile_task
 from .standing import run_standing
 
 
 def map_tasks(client, ctx: RunContext, todo: list[tuple[str, str]], standing: list[str] = (),
          every_s: float = 1.0) -> list[dict]:
+    """Compute the partitions *todo* ((tile, month) pairs) and the standing points of the
+    tiles *standing* on the cluster; the partitions' summaries (:func:`run_partition`), in
+    the order they were done.  One ``irradiance-<TILE>`` task per tile computes its months
+    (:func:`tile_task`); the progress view counts partitions."""
     from distributed import as_completed
 
-    geometry = {}
-    futures = []
-    for tile in sorted({t for t, _ in todo}):
-        geometry[tile] = client.submit(geometry_task, ctx, tile, key=f"geometry-{tile}")
+    months: dict[str, list[str]] = {}
     for tile, month in todo:
-        futures.append(client.submit(run_partition, ctx, tile, month, geometry[tile],
-                                     key=f"irradiance-{tile}-{month}"))
-    for tile in standing:
-        futures.append(client.submit(run_standing, ctx, tile, key=f"standing-{tile}"))
-    view = MapProgress(len(futures))
+        months.setdefault(tile, []).append(month)
+    futures = [client.submit(tile_task, ctx, tile, ms, key=f"irradiance-{tile}")
+               for tile, ms in months.items()]
+    futures += [client.submit(run_standing, ctx, tile, key=f"standing-{tile}") for tile in standing]
+    view = MapProgress(len(todo) + len(standing))
     results = []
     done, last = [], time.perf_counter()
     # the finished partitions' summaries are fetched together about once a second: one
@@ -30,9 +31,10 @@ def map_tasks(client, ctx: RunContext, todo: list[tuple[str, str]], standing: li
     for n_done, fut in enumerate(as_completed(futures), start=1):
         done.append(fut)
         if time.perf_counter() - last >= every_s or n_done == len(futures):
-            for res in client.gather(done):
-                results.append(res)
-                view.add(res)
+            for out in client.gather(done):
+                for res in out if isinstance(out, list) else [out]:
+                    results.append(res)
+                    view.add(res)
             for f in done:
                 f.release()
             done, last = [], time.perf_counter()
