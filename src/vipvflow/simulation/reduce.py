@@ -396,7 +396,7 @@ def _check_totals(summary: dict, run_dir: Path) -> None:
     json.dumps(summary, allow_nan=False, default=str)
 
 
-def block_day_table(cfg: Config, run_dir: Path, trip: pd.DataFrame, vehicle):
+def block_day_table(cfg: Config, run_dir: Path, trip: pd.DataFrame, vehicle, placed: pd.DataFrame):
     """Per block-day: PV driving, at layovers and parked (kWh), the time of each, the
     layovers' auxiliaries, and the PV the battery takes (``pv_kwh_usable``) or not
     (``pv_kwh_curtailed``) under ``fleet.harvest``; the idle buses' parked days; and
@@ -415,12 +415,11 @@ def block_day_table(cfg: Config, run_dir: Path, trip: pd.DataFrame, vehicle):
 
     run = RunDir(run_dir)
     tl = pd.read_parquet(run.timeline_table("block_days"))
-    runs = pd.read_parquet(run.timeline_table("trip_runs"))
     key = ["block_id", "service_date"]
-    merged = trip.drop(columns=["block_id"]).merge(runs, on=["trip_id", "service_date"], how="left",
-                                                   validate="one_to_one")
-    trip = trip.assign(block_id=merged["block_id"].to_numpy())
-    position = merged["position"].to_numpy(np.int64)
+    if len(placed) != len(trip):
+        raise ValueError("the trips' blocks are not row by row with the trips")
+    trip = trip.assign(block_id=placed["block_id"].to_numpy())
+    position = placed["position"].to_numpy(np.int64)
     st = _read_parts(run_dir, "standing")
     if st.empty:
         st = pd.DataFrame({c: pd.Series(dtype=t) for c, t in (
@@ -514,13 +513,14 @@ def reduce_run(cfg: Config, year: int, run_dir: Path, say=print, client=None, cl
     figures = report.Figures(client)
     trips_meta = pd.read_parquet(DataDir(cfg.data_dir).gtfs.trips)
     totals = _trip_totals(run_dir, parts["trip"])
-    n_buses = _n_buses(run_dir, totals)
+    placed = _placed_trips(run_dir, totals)
+    n_buses = int(placed.groupby("service_date")["block_id"].nunique().max())
     # the segments first: the workers draw the maps while the trips are joined here
     _, segments, sm = _segment_outputs(cfg, run_dir, parts["segment_month"], parts["geometry"],
                                        totals, n_buses, trips_meta)
     report.add_maps(figures, run_dir, cfg)
     clock("segments")
-    trip, bd, idle = _trip_outputs(cfg, year, run_dir, totals, trips_meta, say, consumption)
+    trip, bd, idle = _trip_outputs(cfg, year, run_dir, totals, placed, trips_meta, say, consumption)
     clock("trips")
     rm = _route_month(trip)
     write_parquet(rm, RunDir(run_dir).output("route_month.parquet"))
@@ -554,23 +554,25 @@ class _Clock:
         self._last = now
 
 
-def _n_buses(run_dir: Path, totals: pd.DataFrame) -> int:
-    """The fleet: the most vehicle blocks on one service date among the trips of *totals*
-    (:func:`_trip_totals`), each in the timeline's block (the GTFS block or the inferred
-    one, as :func:`block_day_table` sets them)."""
+def _placed_trips(run_dir: Path, totals: pd.DataFrame) -> pd.DataFrame:
+    """The timeline's vehicle block (the GTFS block or the inferred one) and position in it of
+    each trip of *totals* (:func:`_trip_totals`), row by row: ``service_date, block_id,
+    position``.  The fleet is the most blocks on one service date; the block-days
+    (:func:`block_day_table`) take the trips' blocks from it."""
     runs = pd.read_parquet(RunDir(run_dir).timeline_table("trip_runs"),
-                           columns=["trip_id", "service_date", "block_id"])
-    blocks = totals[["trip_id", "service_date"]].merge(runs, on=["trip_id", "service_date"],
+                           columns=["trip_id", "service_date", "block_id", "position"])
+    placed = totals[["trip_id", "service_date"]].merge(runs, on=["trip_id", "service_date"],
                                                       how="left", validate="one_to_one")
-    return int(blocks.groupby("service_date")["block_id"].nunique().max())
+    return placed[["service_date", "block_id", "position"]]
 
 
-def _trip_outputs(cfg: Config, year: int, run_dir: Path, totals: pd.DataFrame,
+def _trip_outputs(cfg: Config, year: int, run_dir: Path, totals: pd.DataFrame, placed: pd.DataFrame,
                   trips_meta: pd.DataFrame, say, consumption: Consumption | None = None):
     """Per trip and service date (PV of *totals*, :func:`_trip_totals`; the trip's metadata,
-    the vehicle model's consumption) and per block-day (driving, layovers, parked; the
-    battery's share); writes ``trip_energy.parquet``.  Returns the trips, the block-days and
-    the idle buses' days."""
+    the vehicle model's consumption; the timeline's block of each, *placed*, row by row with
+    *totals*: the joins here keep their rows' order) and per block-day (driving, layovers,
+    parked; the battery's share); writes ``trip_energy.parquet``.  Returns the trips, the
+    block-days and the idle buses' days."""
     trip = totals.merge(trips_meta[["trip_id", "route_id", "route_short_name", "direction_id",
                                   "shape_id", "service_id", "block_id", "pattern_id", "start_s"]],
                       on="trip_id", how="left", validate="many_to_one")
@@ -581,7 +583,7 @@ def _trip_outputs(cfg: Config, year: int, run_dir: Path, totals: pd.DataFrame,
     trip["coverage"] = trip["pv_kwh"] / trip["consumption_kwh"]
     # vehicle block per day: driving, layovers, parked; the battery's share (sets the
     # trips' block_id to the timeline's: the GTFS block or the inferred one)
-    bd, idle, trip = block_day_table(cfg, run_dir, trip, cfg.vehicle_params())
+    bd, idle, trip = block_day_table(cfg, run_dir, trip, cfg.vehicle_params(), placed)
     write_parquet(trip, RunDir(run_dir).output("trip_energy.parquet"))
     return trip, bd, idle
 
