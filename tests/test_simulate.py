@@ -263,6 +263,19 @@ def test_plan_lists_the_graph_and_what_is_done(small_run, small_config):
     assert main(["--config", str(small_config), "--year", "2024"]) == 0
 
 
+def test_tiles_run_largest_first(small_run, small_config):
+    """The map takes the tiles with the most passes first, so the cluster's last tasks are
+    small ones: the planned order against the passes the run counted per tile."""
+    from vipvflow.simulation.run import plan
+
+    order = plan(load_config(small_config), 2024).drop_duplicates("tile")["tile"].tolist()
+    sm = pd.read_parquet(small_run / "segment_month.parquet", columns=["tile", "n_passes"])
+    passes = sm.groupby("tile")["n_passes"].sum().reindex(order, fill_value=0).to_numpy()
+    assert len(order) >= 3 and passes[0] == passes.max() > passes.min()
+    assert passes[-1] <= np.median(passes)
+    assert passes[: len(passes) // 2].sum() > passes[len(passes) // 2:].sum()
+
+
 def _busy(seconds: float) -> int:
     n, end = 0, time.perf_counter() + seconds
     while time.perf_counter() < end:

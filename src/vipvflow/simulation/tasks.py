@@ -13,15 +13,16 @@ def map_tasks(client, ctx: RunContext, todo: list[tuple[str, str]], standing: li
     """Compute the partitions *todo* ((tile, month) pairs) and the standing points of the
     tiles *standing* on the cluster; the partitions' summaries (:func:`run_partition`), in
     the order they were done.  One ``irradiance-<TILE>`` task per tile computes its months
-    (:func:`tile_task`); the progress view counts partitions."""
+    (:func:`tile_task`), in the order of *todo* (the run's: largest tiles first); the
+    standing tasks (a few large ones) go first; the progress view counts partitions."""
     from distributed import as_completed
 
     months: dict[str, list[str]] = {}
     for tile, month in todo:
         months.setdefault(tile, []).append(month)
-    futures = [client.submit(tile_task, ctx, tile, ms, key=f"irradiance-{tile}")
-               for tile, ms in months.items()]
-    futures += [client.submit(run_standing, ctx, tile, key=f"standing-{tile}") for tile in standing]
+    futures = [client.submit(run_standing, ctx, tile, key=f"standing-{tile}") for tile in standing]
+    futures += [client.submit(tile_task, ctx, tile, ms, key=f"irradiance-{tile}")
+                for tile, ms in months.items()]
     view = MapProgress(len(todo) + len(standing))
     results = []
     done, last = [], time.perf_counter()
