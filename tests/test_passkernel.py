@@ -170,3 +170,23 @@ def test_pass_groups_equal_the_numpy_reference(spread):
     np.testing.assert_allclose(g["run_s"], np.bincount(g["run"], dt), rtol=1e-12)
     np.testing.assert_allclose(g["hour_s"], np.bincount(hour, dt, 24), rtol=1e-12)
     assert (g["seg_n"] == np.bincount(pos)).all() and g["seg_s"].sum() == pytest.approx(dt.sum())
+
+
+def test_utc_offsets_from_the_cached_table_equal_pandas_conversion():
+    """The per-process table of UTC offsets, sliced, gives what pandas' own conversion of the
+    span gives: across clock changes, at the table's block edges, over a year's end, and
+    for a span longer than a table."""
+    from vipvflow.models.passkernel import _OFFSET_TABLE_HOURS, _offsets, utc_offsets
+
+    block = _OFFSET_TABLE_HOURS // 2
+    h_2024 = int(pd.Timestamp("2024-01-01", tz="UTC").timestamp() // 3600)
+    spans = [(h_2024 + 2000, h_2024 + 2000 + 744),          # March-April: spring change
+             (h_2024 + 7200, h_2024 + 7200 + 744),          # October-November: autumn change
+             (h_2024 + 8700, h_2024 + 8784 + 300),          # over the year's end
+             (block * 95 - 10, block * 95 + 10),            # over a block edge
+             (block * 95, block * 95 + _OFFSET_TABLE_HOURS + 5)]   # longer than a table
+    for tz in ("Europe/Luxembourg", "Asia/Tokyo", "America/New_York", "Australia/Lord_Howe"):
+        for lo, hi in spans:
+            got, want = utc_offsets(tz, lo, hi), _offsets(tz, lo, hi)
+            assert got.shape == (hi - lo + 1,) and (got == want).all(), (tz, lo, hi)
+

@@ -148,7 +148,7 @@ class DaskCfg(_Model):
     threads_per_worker: int | None = Field(None, gt=0)
     memory_limit: str = "auto"
     bvh_cache_size: int = Field(8, gt=0)
-    # Embree threads per partition task; null: cores / workers on a LocalCluster, 1 on a
+    # Embree threads per task (a tile's months); null: cores / workers on a LocalCluster, 1 on a
     # remote cluster (one task per worker thread already fills the cores)
     ray_threads: int | None = Field(None, gt=0)
     # Dask's statistical profiler (the dashboard's Profile tab) on the LocalCluster's workers:
