@@ -276,6 +276,61 @@ def test_tiles_run_largest_first(small_run, small_config):
     assert passes[: len(passes) // 2].sum() > passes[len(passes) // 2:].sum()
 
 
+def test_map_tasks_take_a_tiles_months_or_split_them_for_a_large_cluster():
+    from vipvflow.simulation.tasks import tile_tasks
+
+    def todo(n_tiles):
+        return [(f"T{t:02d}", f"2024-{m:02d}") for t in range(n_tiles) for m in range(1, 13)]
+
+    def covers(tasks, pairs):
+        """Every pair once, each task's months a run of the tile's months in *pairs*."""
+        got = [(t, m) for t, ms in tasks for m in ms]
+        assert sorted(got) == sorted(pairs) and len(got) == len(set(got))
+        for tile, ms in tasks:
+            of_tile = [m for t, m in pairs if t == tile]
+            i = of_tile.index(ms[0])
+            assert of_tile[i:i + len(ms)] == ms
+
+    line_year = todo(41)           # the line-year on 2 workers: one task per tile, in order
+    tasks = tile_tasks(line_year, 2)
+    assert [t for t, _ in tasks] == [f"T{t:02d}" for t in range(41)]
+    assert all(len(ms) == 12 for _, ms in tasks)
+    covers(tasks, line_year)
+    small = todo(6)                # 6 tiles for 8 wanted tasks: halves of the year
+    tasks = tile_tasks(small, 2)
+    assert len(tasks) == 12 and {len(ms) for _, ms in tasks} == {6}
+    covers(tasks, small)
+    few = todo(3)                  # 3 tiles on 16 slots: every month its own task
+    tasks = tile_tasks(few, 16)
+    assert len(tasks) == 36 and {len(ms) for _, ms in tasks} == {1}
+    covers(tasks, few)
+    resumed = [p for p in todo(2) if p[1] not in ("2024-03", "2024-04")]
+    covers(tile_tasks(resumed, 1), resumed)
+
+
+def test_split_tiles_give_the_partitions_of_whole_tiles(small_run, small_config, tmp_path):
+    """The small demo's May and June on 2 workers: 6 tiles for 8 wanted tasks, so each tile's
+    months run as two tasks after its geometry task; June's partitions equal those of the
+    session's June run (one task per tile)."""
+    import pyarrow.parquet as pq
+
+    from vipvflow.simulation.tasks import tile_tasks
+    from vipvflow.store import PARTITION_KINDS, RunDir
+
+    cfg = load_config(small_config, overrides={"out_dir": str(tmp_path / "split"),
+                                               "run": {"months": [5, 6]}, "dask": {"n_workers": 2}})
+    run_dir = run_simulation(cfg, 2024, say=lambda *a: None)
+    split, whole = RunDir(run_dir), RunDir(small_run)
+    tiles = sorted({p.parent.name.split("=", 1)[1] for p in whole.part_files("trip")})
+    assert tiles and all(split.part("trip", t, "2024-05").exists() for t in tiles)
+    assert len(tile_tasks([(t, m) for t in tiles for m in ("2024-05", "2024-06")], 2)) == 2 * len(tiles)
+    for kind in PARTITION_KINDS:
+        for tile in tiles:
+            a = pq.read_table(split.part(kind, tile, "2024-06"))
+            b = pq.read_table(whole.part(kind, tile, "2024-06"))
+            assert a.equals(b), (kind, tile)
+
+
 def _busy(seconds: float) -> int:
     n, end = 0, time.perf_counter() + seconds
     while time.perf_counter() < end:

@@ -146,16 +146,39 @@ def tile_geometry(ctx: RunContext, tile: str) -> pd.DataFrame:
     return geom
 
 
-def tile_task(ctx: RunContext, tile: str, months: list[str]) -> list[dict]:
-    """A tile's geometry (:func:`tile_geometry`), then its partitions of *months*
-    (:func:`run_partition`, each written as it is done): one task of the run's graph.
+class TileGeometry:
+    """A tile's geometry table as the result of its Dask task (:func:`geometry_task`).
+
+    Dask measures every result it keeps; walking the thousand columns of a geometry table
+    for that cost more than computing the table, so this wrapper gives its size from its
+    shape (8 bytes a value)."""
+    __slots__ = ("frame",)
+
+    def __init__(self, frame: pd.DataFrame):
+        self.frame = frame
+
+    def __sizeof__(self) -> int:
+        return 64 + 8 * self.frame.shape[0] * self.frame.shape[1]
+
+
+def geometry_task(ctx: RunContext, tile: str) -> TileGeometry:
+    """:func:`tile_geometry` as a task of the run's graph (for a tile whose months are split
+    over several tasks, :func:`vipvflow.simulation.tasks.tile_tasks`)."""
+    return TileGeometry(tile_geometry(ctx, tile))
+
+
+def tile_task(ctx: RunContext, tile: str, months: list[str],
+              geometry: TileGeometry | None = None) -> list[dict]:
+    """A tile's geometry (:func:`tile_geometry`, or the result of its :func:`geometry_task`),
+    then its partitions of *months* (:func:`run_partition`, each written as it is done): one
+    task of the run's graph.
 
     One task per tile rather than per partition: the tile's BVH is built once and its
     geometry table never leaves the worker, and the scheduler (in the command's process on a
     LocalCluster) handles 12 times fewer tasks: the line-year's 492 partitions as 41 tasks
     took ~2 s of a core off the command's process."""
-    geometry = tile_geometry(ctx, tile)
-    return [run_partition(ctx, tile, month, geometry) for month in months]
+    frame = geometry.frame if geometry is not None else tile_geometry(ctx, tile)
+    return [run_partition(ctx, tile, month, frame) for month in months]
 
 
 def pv_energy_kwh(poa_wm2: np.ndarray, dt_s: np.ndarray, speed_mps: np.ndarray, month: int,

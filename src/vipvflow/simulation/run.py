@@ -38,7 +38,9 @@ def _months(cfg: Config, year: int) -> list[str]:
 def plan(cfg: Config, year: int) -> pd.DataFrame:
     """The partitions of a scenario-year as a table: one row per (tile, month) with the key
     of the task that computes it (``irradiance-<TILE>``: the tile's geometry, then its
-    months) and whether it is already written (a resumed run skips those)."""
+    months; split by month on a cluster with many worker threads for the tiles,
+    :func:`vipvflow.simulation.tasks.tile_tasks`) and whether it is already written (a
+    resumed run skips those)."""
     _, _, tiles = selected_network(cfg)
     run_dir = run_dir_of(cfg, year)
     rows = [{"tile": t, "month": m, "key": f"irradiance-{t}", "done": partition_done(run_dir, t, m)}

@@ -2,10 +2,33 @@
 from __future__ import annotations
 
 import time
+from collections import Counter
 
 from ..progress import MapProgress
-from .partition import RunContext, tile_task
+from .partition import RunContext, geometry_task, tile_task
 from .standing import run_standing
+
+
+#: a run's map has at least this many tasks per task slot of the cluster (worker threads)
+#: where its tiles allow: fewer tiles split their months over several tasks
+TASKS_PER_SLOT = 4
+
+
+def tile_tasks(todo: list[tuple[str, str]], slots: int) -> list[tuple[str, list[str]]]:
+    """The map's tasks as (tile, months) in the order of *todo*: each tile's months in one
+    task, or, when the tiles are fewer than :data:`TASKS_PER_SLOT` x *slots* (a large
+    cluster on a small city), in runs of consecutive months split evenly over as many tasks
+    per tile as make up the difference."""
+    months: dict[str, list[str]] = {}
+    for tile, month in todo:
+        months.setdefault(tile, []).append(month)
+    pieces = -(-TASKS_PER_SLOT * max(1, slots) // max(1, len(months)))
+    out = []
+    for tile, ms in months.items():
+        k = min(pieces, len(ms))
+        size = -(-len(ms) // k)
+        out += [(tile, ms[i:i + size]) for i in range(0, len(ms), size)]
+    return out
 
 
 def map_tasks(client, ctx: RunContext, todo: list[tuple[str, str]], standing: list[str] = (),
@@ -13,16 +36,21 @@ def map_tasks(client, ctx: RunContext, todo: list[tuple[str, str]], standing: li
     """Compute the partitions *todo* ((tile, month) pairs) and the standing points of the
     tiles *standing* on the cluster; the partitions' summaries (:func:`run_partition`), in
     the order they were done.  One ``irradiance-<TILE>`` task per tile computes its months
-    (:func:`tile_task`), in the order of *todo* (the run's: largest tiles first); the
-    standing tasks (a few large ones) go first; the progress view counts partitions."""
+    (:func:`tile_task`), in the order of *todo* (the run's: largest tiles first); on a
+    cluster with many task slots for the tiles, a tile's months are split over several
+    ``irradiance-<TILE>-<first month>`` tasks after one ``geometry-<TILE>`` task
+    (:func:`tile_tasks`); the standing tasks (a few large ones) go first; the progress view
+    counts partitions."""
     from distributed import as_completed
 
-    months: dict[str, list[str]] = {}
-    for tile, month in todo:
-        months.setdefault(tile, []).append(month)
+    slots = sum(w.get("nthreads", 1) for w in client.scheduler_info()["workers"].values())
+    tasks = tile_tasks(todo, slots)
+    split = {t for t, n in Counter(t for t, _ in tasks).items() if n > 1}
+    geometry = {t: client.submit(geometry_task, ctx, t, key=f"geometry-{t}") for t in sorted(split)}
     futures = [client.submit(run_standing, ctx, tile, key=f"standing-{tile}") for tile in standing]
-    futures += [client.submit(tile_task, ctx, tile, ms, key=f"irradiance-{tile}")
-                for tile, ms in months.items()]
+    futures += [client.submit(tile_task, ctx, tile, ms, geometry[tile], key=f"irradiance-{tile}-{ms[0]}")
+                if tile in split else client.submit(tile_task, ctx, tile, ms, key=f"irradiance-{tile}")
+                for tile, ms in tasks]
     view = MapProgress(len(todo) + len(standing))
     results = []
     done, last = [], time.perf_counter()
