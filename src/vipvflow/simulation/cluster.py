@@ -38,7 +38,7 @@ def make_client(cfg: Config, scheduler: str | None, n_workers: int | None):
             logging.getLogger(name).setLevel(logging.WARNING)
     if scheduler:
         return Client(scheduler), None
-    n = n_workers or cfg.dask.n_workers or os.cpu_count() or 1
+    n, threads = local_cluster_size(cfg, n_workers)
     # the dashboard's port was free a moment ago (dashboard_address); a run starting at the
     # same time may take it first: Dask then serves on another port and warns, but the
     # command prints the dashboard's address itself
@@ -48,11 +48,17 @@ def make_client(cfg: Config, scheduler: str | None, n_workers: int | None):
                 "distributed.worker.preload": ["vipvflow.simulation.worker_setup"],
                 "vipvflow.worker-failure-log": log.isEnabledFor(logging.INFO)}
     with dask.config.set(settings):     # the nannies hand this configuration to their workers
-        cluster = LocalCluster(n_workers=n, threads_per_worker=cfg.dask.threads_per_worker or 1,
+        cluster = LocalCluster(n_workers=n, threads_per_worker=threads,
                                processes=True, memory_limit=cfg.dask.memory_limit,
                                dashboard_address=dashboard_address(cfg.dask.dashboard_port),
                                silence_logs=logging.ERROR)
     return Client(cluster), cluster
+
+
+def local_cluster_size(cfg: Config, n_workers: int | None = None) -> tuple[int, int]:
+    """Workers and threads per worker of the LocalCluster a run starts: *n_workers*, else
+    ``dask.n_workers``, else one per core; ``dask.threads_per_worker``, else 1."""
+    return n_workers or cfg.dask.n_workers or os.cpu_count() or 1, cfg.dask.threads_per_worker or 1
 
 
 def dashboard_address(port: int | None) -> str:

@@ -17,7 +17,7 @@ import pandas as pd
 from ..config import Config
 from ..progress import FolderProgress
 from ..store import DataDir
-from .cluster import close_client, make_client
+from .cluster import close_client, local_cluster_size, make_client
 from .manifest import claim_run_dir, write_manifest
 from .network import selected_network
 from .partition import RunContext, partition_done, worker_bvh_builds
@@ -37,14 +37,18 @@ def _months(cfg: Config, year: int) -> list[str]:
 
 def plan(cfg: Config, year: int) -> pd.DataFrame:
     """The partitions of a scenario-year as a table: one row per (tile, month) with the key
-    of the task that computes it (``irradiance-<TILE>``: the tile's geometry, then its
-    months; split by month on a cluster with many worker threads for the tiles,
-    :func:`vipvflow.simulation.tasks.tile_tasks`) and whether it is already written (a
-    resumed run skips those)."""
+    of the task that computes it on the LocalCluster the configuration starts
+    (``irradiance-<TILE>``: the tile's geometry, then its months; split by month when the
+    cluster has many worker threads for the tiles, :func:`vipvflow.simulation.tasks.tile_tasks`)
+    and whether it is already written (a resumed run skips those)."""
+    from .tasks import task_keys, tile_tasks
+
     _, _, tiles = selected_network(cfg)
     run_dir = run_dir_of(cfg, year)
-    rows = [{"tile": t, "month": m, "key": f"irradiance-{t}", "done": partition_done(run_dir, t, m)}
-            for t in tiles for m in _months(cfg, year)]
+    n, threads = local_cluster_size(cfg)
+    tasks = tile_tasks([(t, m) for t in tiles for m in _months(cfg, year)], n * threads)
+    rows = [{"tile": t, "month": m, "key": key, "done": partition_done(run_dir, t, m)}
+            for (t, ms), key in zip(tasks, task_keys(tasks)) for m in ms]
     return pd.DataFrame(rows, columns=["tile", "month", "key", "done"])
 
 

@@ -31,6 +31,17 @@ def tile_tasks(todo: list[tuple[str, str]], slots: int) -> list[tuple[str, list[
     return out
 
 
+def task_keys(tasks: list[tuple[str, list[str]]]) -> list[str]:
+    """The Dask key of each (tile, months) task of :func:`tile_tasks`: ``irradiance-<TILE>``,
+    or ``irradiance-<TILE>-<first month>`` for a tile split over several tasks."""
+    split = _split_tiles(tasks)
+    return [f"irradiance-{t}-{ms[0]}" if t in split else f"irradiance-{t}" for t, ms in tasks]
+
+
+def _split_tiles(tasks: list[tuple[str, list[str]]]) -> set[str]:
+    return {t for t, n in Counter(t for t, _ in tasks).items() if n > 1}
+
+
 def map_tasks(client, ctx: RunContext, todo: list[tuple[str, str]], standing: list[str] = (),
          every_s: float = 1.0) -> list[dict]:
     """Compute the partitions *todo* ((tile, month) pairs) and the standing points of the
@@ -45,12 +56,11 @@ def map_tasks(client, ctx: RunContext, todo: list[tuple[str, str]], standing: li
 
     slots = sum(w.get("nthreads", 1) for w in client.scheduler_info()["workers"].values())
     tasks = tile_tasks(todo, slots)
-    split = {t for t, n in Counter(t for t, _ in tasks).items() if n > 1}
-    geometry = {t: client.submit(geometry_task, ctx, t, key=f"geometry-{t}") for t in sorted(split)}
+    geometry = {t: client.submit(geometry_task, ctx, t, key=f"geometry-{t}")
+                for t in sorted(_split_tiles(tasks))}
     futures = [client.submit(run_standing, ctx, tile, key=f"standing-{tile}") for tile in standing]
-    futures += [client.submit(tile_task, ctx, tile, ms, geometry[tile], key=f"irradiance-{tile}-{ms[0]}")
-                if tile in split else client.submit(tile_task, ctx, tile, ms, key=f"irradiance-{tile}")
-                for tile, ms in tasks]
+    futures += [client.submit(tile_task, ctx, tile, ms, geometry.get(tile), key=key)
+                for (tile, ms), key in zip(tasks, task_keys(tasks))]
     view = MapProgress(len(todo) + len(standing))
     results = []
     done, last = [], time.perf_counter()
