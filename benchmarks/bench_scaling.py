@@ -13,7 +13,15 @@ that run is made once as well and its wall time reported (``wall_s_1_worker_all_
 with ``speedup_wall_vs_1_worker_all_cores``).  ``machine_speedup_2_processes``: the
 same fixed numpy work (gather, multiply, bincount: the hot path's kind) twice in two
 processes against once in one, before and after the runs: the machine's own ceiling for a
-2-worker speed-up at the time (a shared 2-vCPU machine gives less than 2).
+2-worker speed-up at the time (a shared 2-vCPU machine gives less than 2).  The issue's
+target: the whole run at least 1.8x faster, or within 5 % of that ceiling
+(``speedup_wall_share_of_machine`` >= 0.95).
+
+Where the rest goes, from the fastest run of each: the time outside the map (the start and
+the reduce), the CPU seconds of the command's process (scheduler, client, prepare, the
+reduce's joins) and of the workers, the cores the 2-worker run kept busy, and
+``speedup_wall_if_map_at_machine``: the whole run's speed-up had its map scaled as the
+machine's ceiling with the time outside the map as measured (Amdahl's bound of the run).
 
 ``tiny``: the small demo, one month, once.
 """
@@ -100,16 +108,22 @@ def run(tiny: bool = False) -> dict:
         runs[workers if ray_threads else "1_all_cores"].append({
             "wall_s": r["wall_s"], "map_s": r["manifest"]["timings_s"]["map_s"],
             "reduce_s": r["manifest"]["timings_s"]["reduce_s"],
+            "outside_map_s": r["wall_s"] - r["manifest"]["timings_s"]["map_s"],
+            "cpu_s_command": r["cpu_s_command"], "cpu_s_workers": r["cpu_s_workers"],
+            "cores_busy": (r["cpu_s_command"] + r["cpu_s_workers"]) / r["wall_s"],
             "passes": r["manifest"]["passes_computed"], "peak_rss_mb": r["peak_rss_mb"]})
     probes.append(machine_scaling(100 if tiny else 1500))
     checks = [_same(tables[0][name], t[name]) for t in tables[1:] for name in t]
     best = {w: {k: min(x[k] for x in runs[w]) for k in ("wall_s", "map_s")} for w in (1, 2)}
+    fastest = {w: min(runs[w], key=lambda x: x["wall_s"]) for w in (1, 2)}
     machine = max(p["machine_speedup_2_processes"] for p in probes)
+    speedup = best[1]["wall_s"] / best[2]["wall_s"]
     figures = {
         "passes": runs[2][0]["passes"],
         "wall_s_1_worker": round(best[1]["wall_s"], 2),
         "wall_s_2_workers": round(best[2]["wall_s"], 2),
-        "speedup_wall": round(best[1]["wall_s"] / best[2]["wall_s"], 3),
+        "speedup_wall": round(speedup, 3),
+        "speedup_wall_share_of_machine": round(speedup / machine, 3),
         "map_s_1_worker": best[1]["map_s"],
         "map_s_2_workers": best[2]["map_s"],
         "speedup_map": round(best[1]["map_s"] / best[2]["map_s"], 3),
@@ -117,10 +131,25 @@ def run(tiny: bool = False) -> dict:
         "speedup_wall_vs_1_worker_all_cores": round(runs["1_all_cores"][0]["wall_s"] / best[2]["wall_s"], 3),
         "machine_speedup_2_processes": machine,
         "machine_speedup_2_processes_runs": [p["machine_speedup_2_processes"] for p in probes],
+        # the fastest run of each: the time outside the map (start, reduce), the CPU seconds
+        # of the command's process and of the workers, and the cores they kept busy
+        "outside_map_s_1_worker": round(fastest[1]["outside_map_s"], 2),
+        "outside_map_s_2_workers": round(fastest[2]["outside_map_s"], 2),
+        "cpu_s_command_1_worker": round(fastest[1]["cpu_s_command"], 2),
+        "cpu_s_command_2_workers": round(fastest[2]["cpu_s_command"], 2),
+        "cpu_s_workers_1_worker": round(fastest[1]["cpu_s_workers"], 2),
+        "cpu_s_workers_2_workers": round(fastest[2]["cpu_s_workers"], 2),
+        "cores_busy_2_workers": round(fastest[2]["cores_busy"], 2),
+        # the whole run's speed-up had its map scaled as the machine's ceiling, with the
+        # time outside the map as measured (Amdahl's bound for this run)
+        "speedup_wall_if_map_at_machine": round(
+            fastest[1]["wall_s"] / (fastest[1]["map_s"] / machine + fastest[2]["outside_map_s"]), 3),
         "results_equal": all(ok for ok, _ in checks) if checks else True,
         "max_rel_diff": max((d for _, d in checks), default=0.0),
     }
-    targets = {"speedup_wall": ">= 1.7", "speedup_map": ">= 1.7", "results_equal": "True"}
+    # the issue's acceptance: at least 1.8x, or within 5 % of the machine's own ceiling
+    targets = {"speedup_wall": ">= 1.8, or speedup_wall_share_of_machine >= 0.95",
+               "results_equal": "True"}
     return {"figures": figures, "targets": targets, "runs": runs,
             "config": {"size": size, "routes": ["L1"], "months": months, "repeats": repeats,
                        "ray_threads_per_worker": 1}}

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import json
 import os
+import resource
 import shutil
 import threading
 import time
@@ -75,8 +76,6 @@ class PeakRSS:
         self._stop.set()
         self._thread.join()
         if self.pid == os.getpid():
-            import resource
-
             self.peak_self_mb = max(self.peak_self_mb,
                                     resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024)
 
@@ -150,18 +149,29 @@ def remove(path: Path) -> None:
 def run_pipeline(cfg, year: int = YEAR, n_workers: int | None = None, rss_interval_s: float = 0.25,
                  scheduler: str | None = None) -> dict:
     """One :func:`run_simulation` of *cfg* (on the cluster at *scheduler*, if given): wall
-    time, peak RSS of the process tree, manifest."""
+    time, peak RSS of the process tree, manifest, and the CPU time of this process (the
+    command's: scheduler, client, prepare, the reduce's joins; all its threads) and of the
+    child processes that ended during the run (a LocalCluster's workers and nannies)."""
     from vipvflow.simulation.run import run_simulation
 
     log: list[str] = []
     with PeakRSS(interval_s=rss_interval_s) as mem:
+        cpu0, children0 = time.process_time(), _children_cpu()
         t0 = time.perf_counter()
         run_dir = run_simulation(cfg, year, scheduler=scheduler, n_workers=n_workers,
                                  say=lambda *a: log.append(" ".join(map(str, a))))
         wall = time.perf_counter() - t0
+        cpu, children = time.process_time() - cpu0, _children_cpu() - children0
     manifest = json.loads((run_dir / "manifest.json").read_text())
     return {"wall_s": wall, "peak_rss_mb": mem.peak_mb, "peak_rss_main_mb": mem.peak_self_mb,
+            "cpu_s_command": cpu, "cpu_s_workers": children,
             "run_dir": run_dir, "manifest": manifest, "log": log}
+
+
+def _children_cpu() -> float:
+    """User and system CPU seconds of this process's ended (and waited for) children."""
+    r = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return r.ru_utime + r.ru_stime
 
 
 def stage_split(manifest: dict) -> dict:

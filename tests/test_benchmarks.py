@@ -50,6 +50,8 @@ def test_facts_in_the_tiny_results(tiny_results):
     results, names, _ = tiny_results
     scaling = json.loads((results / "scaling.tiny.json").read_text())["figures"]
     assert scaling["results_equal"] is True
+    # the CPU accounting sees the workers (child processes) and the command's own process
+    assert scaling["cpu_s_workers_2_workers"] > 0 and scaling["cpu_s_command_2_workers"] > 0
     line = json.loads((results / "line_year.tiny.json").read_text())["figures"]
     assert line["passes"] > 0 and line["partitions"] > 0
     if "postgis" in names:
