@@ -412,3 +412,38 @@ def test_sun_along_the_canyon_lights_the_roof_through_the_street():
     f_wall = max(row[f"r{g}_wall"] for g in groups)
     assert via_street > 0 and out["sun_visible"][0]
     assert via_street * 0.97 <= out["reflected_clear"][0] <= via_street / (1 - f_wall) * 1.03
+
+
+def _cosine_directions_numpy(normals, n_rays, uni):
+    """The numpy form of ``cosine_directions`` (the product's before it was compiled):
+    Malley's method on a jittered Fibonacci spiral about each normal's tangent frame."""
+    golden = (np.sqrt(5.0) - 1.0) / 2.0
+    k = np.arange(n_rays)
+    u = (k[None] + uni[:, :n_rays]) / n_rays
+    phi = 2 * np.pi * ((k[None] * golden + uni[:, n_rays:]) % 1.0)
+    r = np.sqrt(u)
+    lx, ly, lz = r * np.cos(phi), r * np.sin(phi), np.sqrt(np.clip(1 - u, 0, 1))
+    ref = np.where(np.abs(normals[:, 0:1]) < 0.9, [[1.0, 0.0, 0.0]], [[0.0, 1.0, 0.0]])
+    t1 = np.cross(normals, ref)
+    t1 /= np.linalg.norm(t1, axis=1, keepdims=True)
+    t2 = np.cross(normals, t1)
+    return lx[..., None] * t1[:, None] + ly[..., None] * t2[:, None] + lz[..., None] * normals[:, None]
+
+
+@pytest.mark.parametrize("m, n_rays", [(500, 64), (7, 1024), (1, 1), (0, 16)])
+def test_compiled_hemisphere_directions_equal_the_numpy_form(m, n_rays):
+    from vipvflow.models.view_factors import cosine_directions, segment_uniforms
+
+    rng = np.random.default_rng(7)
+    normals = rng.normal(size=(m, 3))
+    normals[: m // 4] = [0.0, 0.0, 1.0]                      # roofs: both tangent frames
+    normals[m // 4: m // 2, 0] = 5.0                          # |n_x| >= 0.9: the other reference
+    normals /= np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), 1e-300)
+    uni = segment_uniforms(3, 1, np.arange(m), n_rays + 1)
+    got = cosine_directions(normals, n_rays, uni)
+    want = _cosine_directions_numpy(normals, n_rays, uni)
+    assert got.shape == (m, n_rays, 3)
+    np.testing.assert_allclose(got, want, rtol=0, atol=1e-15)
+    if m:
+        np.testing.assert_allclose(np.linalg.norm(got, axis=2), 1.0, atol=1e-12)
+        assert (np.einsum("mkc,mc->mk", got, normals) >= -1e-12).all()    # the upper hemisphere

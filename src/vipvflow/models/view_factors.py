@@ -63,14 +63,6 @@ def sun_vector(zenith_deg, azimuth_deg) -> np.ndarray:
 
 
 # ---------------------------------------------------------------------------- sampling
-def _basis(n: np.ndarray):
-    """Two unit tangents completing the normals *n* (m, 3) to right-handed frames."""
-    ref = np.where(np.abs(n[:, 0:1]) < 0.9, [[1.0, 0.0, 0.0]], [[0.0, 1.0, 0.0]])
-    t1 = np.cross(n, ref)
-    t1 /= np.linalg.norm(t1, axis=1, keepdims=True)
-    return t1, np.cross(n, t1)
-
-
 def segment_uniforms(seed: int, stream: int, keys: np.ndarray, n: int) -> np.ndarray:
     """Uniform random numbers drawn from a generator of its own per key (segment id).
 
@@ -128,20 +120,15 @@ def cosine_directions(normals: np.ndarray, n_rays: int, rng) -> np.ndarray:
     13.6.3 (Malley's method) and 7.3 (stratified sampling); R. Swinbank, R. J. Purser
     (2006), Fibonacci grids, Q. J. R. Meteorol. Soc. 132, 1769-1793.
     """
+    from .hemisphere import directions
+
     m = len(normals)
-    k = np.arange(n_rays)
     if isinstance(rng, np.random.Generator):
         uni = rng.random((m, n_rays + 1))
     else:
         uni = np.asarray(rng, dtype=np.float64).reshape(m, n_rays + 1)
-    jitter = uni[:, :n_rays]
-    u = (k[None] + jitter) / n_rays                            # radial strata
-    phi = 2 * np.pi * ((k[None] * _GOLDEN + uni[:, n_rays:]) % 1.0)
-    r = np.sqrt(u)
-    lx, ly, lz = r * np.cos(phi), r * np.sin(phi), np.sqrt(np.clip(1 - u, 0, 1))
-    t1, t2 = _basis(np.asarray(normals, np.float64))
-    return (lx[..., None] * t1[:, None] + ly[..., None] * t2[:, None]
-            + lz[..., None] * normals[:, None])
+    return directions(np.ascontiguousarray(normals, dtype=np.float64),
+                      np.ascontiguousarray(uni), int(n_rays), _GOLDEN)
 
 
 # ---------------------------------------------------------------------------- geometry
