@@ -222,3 +222,18 @@ def test_the_report_module_leaves_matplotlib_to_where_figures_are_drawn():
             "assert r._loaded() and 'matplotlib.pyplot' in sys.modules\n")
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert done.returncode == 0, done.stderr
+
+
+def test_map_lines_and_the_close_ups_shapes():
+    from shapely.geometry import LineString
+
+    from vipvflow.outputs.report import _near, _segment_lines
+
+    geoms = [LineString([(0, 0), (10, 0)]), LineString([(5, 5), (6, 7), (9, 9)]), LineString([(100, 100), (110, 100)])]
+    lines = _segment_lines(gpd.GeoDataFrame(geometry=geoms))
+    assert [a.tolist() for a in lines] == [np.asarray(g.coords)[:, :2].tolist() for g in geoms]
+    # inside the view, crossing its edge, within the margin, beyond it
+    shapes = [np.array([[1.0, 1.0], [2.0, 2.0]]), np.array([[-5.0, 3.0], [5.0, 3.0]]),
+              np.array([[11.5, 0.0], [12.0, 1.0]]), np.array([[13.0, 0.0], [14.0, 1.0]])]
+    assert _near(shapes, (0.0, 0.0, 10.0, 10.0), 2.0).tolist() == [True, True, True, False]
+    assert _near([], (0.0, 0.0, 10.0, 10.0), 2.0).tolist() == []

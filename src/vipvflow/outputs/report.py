@@ -125,7 +125,24 @@ def fig_monthly(monthly: pd.DataFrame, summary: dict):
 
 
 def _segment_lines(segments) -> list[np.ndarray]:
-    return [np.asarray(g.coords)[:, :2] for g in segments.geometry]
+    """Each segment's vertices as an (n, 2) array of x, y."""
+    import shapely
+
+    xy, index = shapely.get_coordinates(np.asarray(segments.geometry.values), return_index=True)
+    return np.split(xy, np.flatnonzero(np.diff(index)) + 1) if len(xy) else []
+
+
+def _near(shapes: list[np.ndarray], window, margin: float) -> np.ndarray:
+    """Which of *shapes* ((n, 2) arrays) have their bounding box within *margin* of *window*
+    (xmin, ymin, xmax, ymax): the close-up draws only those (the others lie outside its view,
+    further than a stroke reaches into it)."""
+    if not len(shapes):
+        return np.zeros(0, bool)
+    xy = np.concatenate(shapes)
+    start = np.cumsum([0] + [len(a) for a in shapes[:-1]])
+    lo, hi = np.minimum.reduceat(xy, start), np.maximum.reduceat(xy, start)
+    return ((hi[:, 0] >= window[0] - margin) & (lo[:, 0] <= window[2] + margin)
+            & (hi[:, 1] >= window[1] - margin) & (lo[:, 1] <= window[3] + margin))
 
 
 def _robust_limits(values: np.ndarray) -> tuple[float, float]:
@@ -166,12 +183,17 @@ def fig_map(segments, column: str, label: str, cmap: str, title: str, footprints
     window = close_up_window(segments)
     fig, axes = plt.subplots(1, 2, figsize=(13, 5.2), gridspec_kw={"width_ratios": [1.6, 1]},
                              layout="constrained")
+    # the close-up's shapes: those reaching within a tenth of its side of its view
+    near_lines = _near(lines, window, 0.1 * (window[2] - window[0]))
+    near_prints = _near(list(footprints), window, 0.1 * (window[2] - window[0]))
     for ax, zoom in zip(axes, (False, True)):
-        if len(footprints):
-            ax.add_collection(PolyCollection(footprints, facecolors="#d4d4d4", edgecolors="#a8a8a8",
+        prints = [f for f, near in zip(footprints, near_prints) if near] if zoom else footprints
+        if len(prints):
+            ax.add_collection(PolyCollection(prints, facecolors="#d4d4d4", edgecolors="#a8a8a8",
                                              linewidths=0.3, zorder=1))
-        lc = LineCollection(lines, array=values, cmap=cmap, linewidths=4.0 if zoom else 1.8,
-                            zorder=2, capstyle="butt")
+        lc = LineCollection([a for a, near in zip(lines, near_lines) if near] if zoom else lines,
+                            array=values[near_lines] if zoom else values, cmap=cmap,
+                            linewidths=4.0 if zoom else 1.8, zorder=2, capstyle="butt")
         lc.set_clim(vmin, vmax)
         ax.add_collection(lc)
         ax.set_aspect("equal")
