@@ -447,3 +447,12 @@ def test_compiled_hemisphere_directions_equal_the_numpy_form(m, n_rays):
     if m:
         np.testing.assert_allclose(np.linalg.norm(got, axis=2), 1.0, atol=1e-12)
         assert (np.einsum("mkc,mc->mk", got, normals) >= -1e-12).all()    # the upper hemisphere
+
+
+def test_segment_uniforms_are_each_keys_own_default_rng():
+    from vipvflow.models.view_factors import segment_uniforms
+
+    keys = np.array([0, 7, 123456789, 2**40])
+    got = segment_uniforms(42, 2, keys, 33)
+    for row, key in zip(got, keys):
+        np.testing.assert_array_equal(row, np.random.default_rng([42, 2, int(key)]).random(33))
