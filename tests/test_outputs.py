@@ -229,11 +229,17 @@ def test_map_lines_and_the_close_ups_shapes():
 
     from vipvflow.outputs.report import _near, _segment_lines
 
-    geoms = [LineString([(0, 0), (10, 0)]), LineString([(5, 5), (6, 7), (9, 9)]), LineString([(100, 100), (110, 100)])]
+    geoms = [LineString([(0, 0), (10, 0)]), LineString(), LineString([(5, 5, 1), (6, 7, 1), (9, 9, 2)]),
+             LineString([(100, 100), (110, 100)]), LineString()]
     lines = _segment_lines(gpd.GeoDataFrame(geometry=geoms))
-    assert [a.tolist() for a in lines] == [np.asarray(g.coords)[:, :2].tolist() for g in geoms]
+    assert [a.tolist() for a in lines] == [np.asarray(g.coords).reshape(-1, 2 + g.has_z)[:, :2].tolist()
+                                           for g in geoms]
     # inside the view, crossing its edge, within the margin, beyond it
     shapes = [np.array([[1.0, 1.0], [2.0, 2.0]]), np.array([[-5.0, 3.0], [5.0, 3.0]]),
               np.array([[11.5, 0.0], [12.0, 1.0]]), np.array([[13.0, 0.0], [14.0, 1.0]])]
     assert _near(shapes, (0.0, 0.0, 10.0, 10.0), 2.0).tolist() == [True, True, True, False]
     assert _near([], (0.0, 0.0, 10.0, 10.0), 2.0).tolist() == []
+    # shapes without points (an empty line) are never drawn in the close-up
+    empty = np.zeros((0, 2))
+    assert _near([empty, shapes[0], empty], (0.0, 0.0, 10.0, 10.0), 2.0).tolist() == [False, True, False]
+    assert _near([empty], (0.0, 0.0, 10.0, 10.0), 2.0).tolist() == [False]

@@ -128,21 +128,26 @@ def _segment_lines(segments) -> list[np.ndarray]:
     """Each segment's vertices as an (n, 2) array of x, y."""
     import shapely
 
-    xy, index = shapely.get_coordinates(np.asarray(segments.geometry.values), return_index=True)
-    return np.split(xy, np.flatnonzero(np.diff(index)) + 1) if len(xy) else []
+    geoms = np.asarray(segments.geometry.values)
+    xy, index = shapely.get_coordinates(geoms, return_index=True)
+    # one array per segment, an empty one for an empty line
+    return np.split(xy, np.cumsum(np.bincount(index, minlength=len(geoms)))[:-1])
 
 
 def _near(shapes: list[np.ndarray], window, margin: float) -> np.ndarray:
     """Which of *shapes* ((n, 2) arrays) have their bounding box within *margin* of *window*
     (xmin, ymin, xmax, ymax): the close-up draws only those (the others lie outside its view,
     further than a stroke reaches into it)."""
-    if not len(shapes):
-        return np.zeros(0, bool)
-    xy = np.concatenate(shapes)
-    start = np.cumsum([0] + [len(a) for a in shapes[:-1]])
+    sizes = np.array([len(a) for a in shapes], dtype=np.int64)
+    near = np.zeros(len(shapes), bool)
+    if not sizes.any():
+        return near
+    xy = np.concatenate([np.asarray(a, dtype=np.float64).reshape(-1, 2) for a in shapes])
+    start = (np.cumsum(sizes) - sizes)[sizes > 0]           # shapes without points stay out
     lo, hi = np.minimum.reduceat(xy, start), np.maximum.reduceat(xy, start)
-    return ((hi[:, 0] >= window[0] - margin) & (lo[:, 0] <= window[2] + margin)
-            & (hi[:, 1] >= window[1] - margin) & (lo[:, 1] <= window[3] + margin))
+    near[sizes > 0] = ((hi[:, 0] >= window[0] - margin) & (lo[:, 0] <= window[2] + margin)
+                       & (hi[:, 1] >= window[1] - margin) & (lo[:, 1] <= window[3] + margin))
+    return near
 
 
 def _robust_limits(values: np.ndarray) -> tuple[float, float]:
