@@ -52,9 +52,25 @@ def test_facts_in_the_tiny_results(tiny_results):
     assert scaling["results_equal"] is True
     # the CPU accounting sees the workers (child processes) and the command's own process
     assert scaling["cpu_s_workers_2_workers"] > 0 and scaling["cpu_s_command_2_workers"] > 0
+    # the machine's ceiling is probed before the pair of runs and after, by both probes
+    assert len(scaling["machine_speedup_2_processes_probes"]) == 2
+    assert len(scaling["machine_speedup_2_processes_numpy_probes"]) == 2
+    assert scaling["machine_speedup_2_processes"] > 0
     line = json.loads((results / "line_year.tiny.json").read_text())["figures"]
     assert line["passes"] > 0 and line["partitions"] > 0
     if "postgis" in names:
         pg = json.loads((results / "postgis.tiny.json").read_text())["figures"]
         # every disagreement between PostGIS and Embree must be a graze (1 mm changes it)
         assert pg["agreement_apart_from_grazes"] == 1.0
+
+
+def test_the_ceiling_is_the_best_one_process_over_the_best_two():
+    """The machine's ceiling takes the statistic of the runs' speed-up: the best time of one
+    process over the best of two, whichever probes they came from."""
+    sys.path.insert(0, str(ROOT))
+    from benchmarks.bench_scaling import ceiling
+
+    probes = [{"kernel": {"s_1_process": 10.0, "s_2_processes": 6.0}},
+              {"kernel": {"s_1_process": 9.0, "s_2_processes": 6.5}},
+              {"kernel": {"s_1_process": 12.0, "s_2_processes": 5.5}}]
+    assert ceiling(probes, "kernel") == round(2 * 9.0 / 5.5, 3)
