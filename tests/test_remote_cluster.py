@@ -87,3 +87,18 @@ def test_simulate_on_a_dask_cli_cluster_equals_the_local_run(small_run, small_co
     # the partitions were computed by the two CLI workers (each built the BVHs of its tiles)
     builds = json.loads((run_dir / "manifest.json").read_text())["bvh_builds_per_worker"]
     assert len(builds) == 2 and all(sum(per.values()) >= 1 for per in builds.values())
+
+
+@pytest.mark.slow
+def test_the_network_benchmark_asks_an_outside_cluster_for_its_peak_rss(cli_cluster):
+    """On an outside cluster the benchmark states each process's own peak RSS: the scheduler's
+    and both workers', asked of them (the cluster need not see ``benchmarks/``)."""
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+    from benchmarks.bench_network import outside_cluster_peak_rss
+
+    rss = outside_cluster_peak_rss(cli_cluster)
+    per = rss["cluster_peak_rss_mb"]
+    assert set(per) - {"scheduler"} and len(per) == 3
+    # a Python process with Dask loaded holds tens of MB at least
+    assert all(mb > 20 for mb in per.values())
+    assert abs(rss["cluster_peak_rss_gb_sum"] - sum(per.values()) / 1024) < 0.01
