@@ -152,6 +152,52 @@ def test_killed_worker_gives_the_same_result(small_run, small_config, tmp_path):
     assert_same_results(small_run, result)
 
 
+def _slow_inc(x, seconds):
+    time.sleep(seconds)
+    return x + 1
+
+
+def test_a_result_lost_with_its_worker_is_waited_for_beside_another_default_client(tmp_path):
+    """The map's results are awaited on its own client's event loop.  A caller with a client
+    of its own (the default client of its thread) ran ``run_simulation`` against its
+    scheduler: the run's client, started in a thread, has another loop.  A finished result
+    lost with its worker before the map fetched it then failed the run ("bound to a
+    different event loop") instead of being waited for while Dask computed it again (how
+    ``test_killed_worker_gives_the_same_result`` failed now and then)."""
+    from distributed import Client, LocalCluster
+
+    from vipvflow.simulation.tasks import finished_results
+
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0",
+                      local_directory=str(tmp_path)) as cluster, Client(cluster):
+        started = {}
+        t = threading.Thread(target=lambda: started.update(client=Client(cluster.scheduler_address)))
+        t.start()
+        t.join()
+        client = started["client"]
+        try:
+            first, second = sorted(client.scheduler_info()["workers"])
+            # one result on the worker that dies, one slow task on the other: the lost result
+            # is computed again after it, while the map waits for it
+            lost = client.submit(_slow_inc, 1, 1.0, key="lost", workers=[first], allow_other_workers=True)
+            slow = client.submit(_slow_inc, 10, 3.0, key="slow", workers=[second])
+            victim = client.run(os.getpid, workers=[first])[first]
+
+            def kill_when_done():
+                deadline = time.time() + 60
+                while not lost.done() and time.time() < deadline:
+                    time.sleep(0.01)
+                os.kill(victim, signal.SIGKILL)
+
+            killer = threading.Thread(target=kill_when_done)
+            killer.start()
+            out = list(finished_results(client, [lost, slow], every_s=3600.0))
+            killer.join()
+            assert sorted(out) == [2, 11]
+        finally:
+            client.close()
+
+
 def _stretch_kind(segments: gpd.GeoDataFrame, layout: dict) -> np.ndarray:
     lines = [(s["kind"], LineString(s["centerline"])) for s in layout["stretches"]]
     mids = [Point(g.interpolate(0.5, normalized=True).coords[0][:2]) for g in segments.geometry]

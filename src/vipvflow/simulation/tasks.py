@@ -52,8 +52,6 @@ def map_tasks(client, ctx: RunContext, todo: list[tuple[str, str]], standing: li
     ``irradiance-<TILE>-<first month>`` tasks after one ``geometry-<TILE>`` task
     (:func:`tile_tasks`); the standing tasks (a few large ones) go first; the progress view
     counts partitions."""
-    from distributed import as_completed
-
     slots = sum(w.get("nthreads", 1) for w in client.scheduler_info()["workers"].values())
     tasks = tile_tasks(todo, slots)
     geometry = {t: client.submit(geometry_task, ctx, t, key=f"geometry-{t}")
@@ -63,19 +61,32 @@ def map_tasks(client, ctx: RunContext, todo: list[tuple[str, str]], standing: li
                 for (tile, ms), key in zip(tasks, task_keys(tasks))]
     view = MapProgress(len(todo) + len(standing))
     results = []
+    for out in finished_results(client, futures, every_s):
+        for res in out if isinstance(out, list) else [out]:
+            results.append(res)
+            view.add(res)
+    view.close()
+    return results
+
+
+def finished_results(client, futures: list, every_s: float = 1.0):
+    """The results of *futures* (of *client*) as they finish, fetched together about every
+    *every_s* seconds (one fetch per partition kept the scheduler's event loop, in this
+    process, busy ~15 % of a core, taken from the workers when they fill the machine); each
+    future is released once fetched.
+
+    The futures are awaited on *client*'s own event loop: Dask's ``as_completed`` otherwise
+    takes the loop of the process's default client, which is another one when the caller
+    has a client of its own (a notebook's) and the run's client was started here; a result
+    lost with its worker before it was fetched then failed the run with "bound to a
+    different event loop" instead of being waited for while Dask computes it again."""
+    from distributed import as_completed
+
     done, last = [], time.perf_counter()
-    # the finished partitions' summaries are fetched together about once a second: one
-    # fetch per partition kept the scheduler's event loop (in this process) busy ~15 % of a
-    # core, taken from the workers when they fill the machine
-    for n_done, fut in enumerate(as_completed(futures), start=1):
+    for n_done, fut in enumerate(as_completed(futures, loop=client.loop), start=1):
         done.append(fut)
         if time.perf_counter() - last >= every_s or n_done == len(futures):
-            for out in client.gather(done):
-                for res in out if isinstance(out, list) else [out]:
-                    results.append(res)
-                    view.add(res)
+            yield from client.gather(done)
             for f in done:
                 f.release()
             done, last = [], time.perf_counter()
-    view.close()
-    return results
