@@ -169,9 +169,21 @@ def run_pipeline(cfg, year: int = YEAR, n_workers: int | None = None, rss_interv
 
 
 def _children_cpu() -> float:
-    """User and system CPU seconds of this process's ended (and waited for) children."""
+    """User and system CPU seconds of this process's ended (and waited for) children, and of
+    its live children with their own ended children: a LocalCluster's workers are forked
+    by a forkserver (:mod:`vipvflow.simulation.worker_preload`) that outlives the run and
+    waits for them itself."""
+    import psutil
+
     r = resource.getrusage(resource.RUSAGE_CHILDREN)
-    return r.ru_utime + r.ru_stime
+    total = r.ru_utime + r.ru_stime
+    for child in psutil.Process().children():
+        try:
+            t = child.cpu_times()
+        except psutil.Error:
+            continue
+        total += t.user + t.system + t.children_user + t.children_system
+    return total
 
 
 def stage_split(manifest: dict) -> dict:

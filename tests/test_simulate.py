@@ -405,6 +405,39 @@ def test_local_cluster_profiles_workers_only_when_asked(small_config, tmp_path, 
     assert dask.config.get("distributed.admin.tick.interval") == "20ms"
 
 
+def _worker_origin() -> tuple:
+    import os
+    import sys
+
+    return (os.getppid(), os.getcwd(), "vipvflow.simulation.worker_preload" in sys.modules,
+            "matplotlib.pyplot" in sys.modules)
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="workers are forked on Linux only")
+def test_local_cluster_workers_are_forked_from_one_preloaded_server_in_the_callers_directory(
+        small_config, tmp_path, monkeypatch):
+    """A run's LocalCluster forks its workers from one server process per process, which has
+    loaded what a worker needs (the simulation, matplotlib); a later run's workers come from
+    the same server, and each run's work in the directory the run was started from."""
+    from vipvflow.simulation.cluster import make_client
+
+    origins = []
+    for name in ("first", "second"):
+        (tmp_path / name).mkdir()
+        monkeypatch.chdir(tmp_path / name)
+        client, cluster = make_client(_cfg(small_config, tmp_path), None, 2)
+        try:
+            origins.append(sorted(client.run(_worker_origin).values()))
+        finally:
+            client.close()
+            cluster.close()
+    servers = {ppid for run in origins for ppid, *_ in run}
+    assert len(servers) == 1 and os.getpid() not in servers, origins
+    assert [[cwd for _, cwd, *_ in run] for run in origins] == [
+        [str(tmp_path / "first")] * 2, [str(tmp_path / "second")] * 2]
+    assert all(preloaded and pyplot for run in origins for _, _, preloaded, pyplot in run), origins
+
+
 def _frozen_objects() -> int:
     import gc
 

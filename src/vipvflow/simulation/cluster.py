@@ -27,7 +27,8 @@ def make_client(cfg: Config, scheduler: str | None, n_workers: int | None):
     The LocalCluster's workers run without Dask's statistical profiler unless
     ``dask.worker_profile`` is set: on a machine whose cores the workers fill, its 100 stack
     samples a second per worker come out of the simulation's time (the 2-worker line-year
-    spent ~7 % of each worker's CPU on it)."""
+    spent ~7 % of each worker's CPU on it).  On Linux the workers are forked from a
+    preloaded server (:func:`_forkserver`)."""
     import dask
     from distributed import Client, LocalCluster
 
@@ -47,12 +48,39 @@ def make_client(cfg: Config, scheduler: str | None, n_workers: int | None):
                 # workers ignore Ctrl-C and leave a task's failure for this process to report
                 "distributed.worker.preload": ["vipvflow.simulation.worker_setup"],
                 "vipvflow.worker-failure-log": log.isEnabledFor(logging.INFO)}
+    settings.update(_forkserver())
     with dask.config.set(settings):     # the nannies hand this configuration to their workers
         cluster = LocalCluster(n_workers=n, threads_per_worker=threads,
                                processes=True, memory_limit=cfg.dask.memory_limit,
                                dashboard_address=dashboard_address(cfg.dask.dashboard_port),
                                silence_logs=logging.ERROR)
     return Client(cluster), cluster
+
+
+#: the module the forkserver of a run's LocalCluster loads before it forks the workers
+FORKSERVER_PRELOAD = "vipvflow.simulation.worker_preload"
+
+
+def _forkserver() -> dict:
+    """The Dask settings that make a LocalCluster's nannies fork their workers from a
+    forkserver preloaded with :mod:`vipvflow.simulation.worker_preload` (on Linux; elsewhere
+    none: the workers are spawned).  The server is started once per process, by the first
+    worker; its preload is set here, after Dask's own (``distributed.utils.get_mp_context``,
+    which would replace it), and does nothing when a server already runs.  Each worker still
+    starts in the directory and with the ``sys.path`` of the process at its own start
+    (multiprocessing hands them over with every fork request)."""
+    import multiprocessing
+    import sys
+
+    if not sys.platform.startswith("linux") or "forkserver" not in multiprocessing.get_all_start_methods():
+        return {}
+    import dask
+    from distributed.utils import get_mp_context
+
+    settings = {"distributed.worker.multiprocessing-method": "forkserver"}
+    with dask.config.set(settings):
+        get_mp_context().set_forkserver_preload(["distributed", FORKSERVER_PRELOAD])
+    return settings
 
 
 def local_cluster_size(cfg: Config, n_workers: int | None = None) -> tuple[int, int]:
