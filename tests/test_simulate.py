@@ -122,6 +122,49 @@ def test_interrupted_run_resumes_to_the_same_result(small_run, small_config, tmp
     assert_same_results(small_run, resumed)
 
 
+def test_a_timeline_that_fails_while_the_tiles_compute_stops_the_run_with_its_error(
+        small_config, tmp_path, monkeypatch):
+    """The timeline is written while the tiles' tasks already run: its error stops the run
+    as it would have before the map (the same error, the cluster closed, no outputs), and
+    the same command then resumes from the partitions already written."""
+    from vipvflow.simulation import run as run_mod
+
+    real = run_mod.write_timeline
+    started = threading.Event()
+
+    def failing(*args, **kwargs):
+        started.wait(30)            # the tiles' tasks are submitted by then
+        time.sleep(0.5)
+        raise InputError("trips.txt: line 7: block_id 'B1' runs two trips at once")
+
+    submit = run_mod.submit_tiles
+
+    def submit_then_fail(*args, **kwargs):
+        futures = submit(*args, **kwargs)
+        started.set()
+        return futures
+
+    monkeypatch.setattr(run_mod, "write_timeline", failing)
+    monkeypatch.setattr(run_mod, "submit_tiles", submit_then_fail)
+    cfg = _cfg(small_config, tmp_path / "out", n_workers=1)
+    run_dir = tmp_path / "out" / cfg.scenario / "2024"
+    with pytest.raises(InputError, match="block_id 'B1' runs two trips at once"):
+        run_simulation(cfg, 2024, say=lambda *a: None)
+    assert started.is_set()
+    parts = run_dir / "parts" / "segment_month"
+    written = sorted(parts.glob("tile=*/month=*.parquet"))
+    time.sleep(2.0)                 # nothing goes on computing after the error
+    assert sorted(parts.glob("tile=*/month=*.parquet")) == written
+    assert not (run_dir / "summary.json").exists()
+    monkeypatch.setattr(run_mod, "write_timeline", real)
+    monkeypatch.setattr(run_mod, "submit_tiles", submit)
+    resumed = run_simulation(cfg, 2024, say=lambda *a: None)
+    manifest = json.loads((resumed / "manifest.json").read_text())
+    assert manifest["partitions_computed"] == 6 - len(written)
+    assert manifest["standing_partitions_computed"] >= 1     # none was started before
+    assert (resumed / "summary.json").exists()
+
+
 def test_killed_worker_gives_the_same_result(small_run, small_config, tmp_path):
     from distributed import Client, LocalCluster
 

@@ -477,13 +477,21 @@ def add_maps(figures: Figures, run_dir: Path, cfg=None) -> None:
         figures.add(name, title, map_figure, str(run_dir), data_dir, name)
 
 
-def add_charts(figures: Figures, summary: dict, monthly, hp, rm) -> None:
-    """Start the charts of the fleet's months, hours and routes."""
+def add_hourly(figures: Figures, hp) -> None:
+    """Start the chart of the irradiance per hour and month (*hp*: ``hourly_pattern``)."""
+    figures.add("hourly_pattern", "Daily irradiance pattern by hour and month", fig_hourly, hp)
+
+
+def add_routes(figures: Figures, rm) -> None:
+    """Start the chart comparing the routes (*rm*: ``route_month``)."""
+    figures.add("routes", "Route comparison", fig_routes, rm)
+
+
+def add_charts(figures: Figures, summary: dict, monthly) -> None:
+    """Start the charts of the fleet's months (*monthly*, *summary*)."""
     figures.add("monthly_yield", ("Monthly yield: driving, in service and whole day (all-sky), "
                                   "with the shading loss on the road"), fig_monthly, monthly, summary)
     figures.add("avoided_cycles", "Avoided charging cycles per month", fig_cycles, monthly)
-    figures.add("hourly_pattern", "Daily irradiance pattern by hour and month", fig_hourly, hp)
-    figures.add("routes", "Route comparison", fig_routes, rm)
 
 
 #: the figures in the report's order
@@ -494,7 +502,8 @@ def write_report(run_dir: Path, summary: dict, figures: list[tuple[str, str, byt
                  segments=None) -> Path:
     """Write ``report.html`` and ``figures/*.png``.
 
-    *figures*: :meth:`Figures.results` (:func:`add_maps`, :func:`add_charts`).  *segments*:
+    *figures*: :meth:`Figures.results` (:func:`add_maps`, :func:`add_hourly`,
+    :func:`add_routes`, :func:`add_charts`).  *segments*:
     the run's ``segments.parquet`` frame (each segment's year); read from *run_dir* when not
     given. *cfg*: the run's configuration (its inputs are listed)."""
     import geopandas as gpd

@@ -22,7 +22,7 @@ from .manifest import claim_run_dir, write_manifest
 from .network import selected_network
 from .partition import RunContext, partition_done, worker_bvh_builds
 from .standing import standing_done, write_timeline
-from .tasks import map_tasks
+from .tasks import collect_map, submit_standing, submit_tiles
 
 log = logging.getLogger(__name__)
 
@@ -71,6 +71,7 @@ def run_simulation(cfg: Config, year: int, scheduler: str | None = None,
     # the cluster starts (worker processes, their imports) while the inputs are checked
     # and the timeline is written; closed again if those stop the run
     starting = _Starting(cfg, scheduler, n_workers)
+    timeline = None
     try:
         ensure_demo(cfg, year, say=say)
         checksums = ensure_ingested(cfg, say=say)
@@ -81,26 +82,25 @@ def run_simulation(cfg: Config, year: int, scheduler: str | None = None,
         ctx, tiles = _run_context(cfg, year, run_dir)
         routes = cfg.run.routes
         todo = [(t, m) for t in tiles for m in _months(cfg, year) if not partition_done(run_dir, t, m)]
-        # layovers and parked time: one ``standing`` task per tile holding standing points
-        t_tl = time.perf_counter()
-        standing = write_timeline(cfg, year, run_dir, routes=routes)
+        if max_partitions is not None:
+            todo = todo[:max_partitions]
+        # the timeline (layovers and parked time: the standing tasks' points; the trips the
+        # vehicle model drives) is written in a thread of its own, while the cluster starts
+        # and the tiles' tasks begin: none of them needs it
+        timeline = _Background(write_timeline, cfg, year, run_dir, routes=routes, name="timeline")
+        # the radiation table's sun positions are computed (and cached beside the radiation
+        # file, where every worker loads them) while the cluster starts
+        warm = threading.Thread(target=_warm_radiation, args=(ctx.data_dir, year), daemon=True,
+                                name="sun-positions")
+        warm.start()
+        t_wait = time.perf_counter()
+        client, cluster = starting.result()
+        timings["cluster_wait_s"] = time.perf_counter() - t_wait
     except BaseException:
+        if timeline is not None:
+            timeline.wait()
         starting.close()
         raise
-    timings["timeline_s"] = time.perf_counter() - t_tl
-    standing_todo = [t for t in standing if not standing_done(run_dir, t)]
-    total = len(tiles) * len(cfg.run.months) + len(standing)
-    if max_partitions is not None:
-        todo = todo[:max_partitions]
-        standing_todo = standing_todo[:max(0, max_partitions - len(todo))]
-    # the radiation table's sun positions are computed (and cached beside the radiation
-    # file, where every worker loads them) while the cluster starts
-    warm = threading.Thread(target=_warm_radiation, args=(ctx.data_dir, year), daemon=True,
-                            name="sun-positions")
-    warm.start()
-    t_wait = time.perf_counter()
-    client, cluster = starting.result()
-    timings["cluster_wait_s"] = time.perf_counter() - t_wait
     closer = threading.Thread(target=close_client, args=(client, cluster), name="close-cluster")
     froze = False
     try:
@@ -111,9 +111,6 @@ def run_simulation(cfg: Config, year: int, scheduler: str | None = None,
         ctx = dataclasses.replace(ctx, ray_threads=ray_threads)
         say(f"dask dashboard: {client.dashboard_link}" if importlib.util.find_spec("bokeh")
             else "dask dashboard: off (it needs bokeh: pip install 'vipvflow[app]')")
-        n_todo = len(todo) + len(standing_todo)
-        say(f"{len(tiles)} tiles x {len(cfg.run.months)} months + {len(standing)} standing = {total} "
-            f"partitions, {n_todo} to compute ({total - n_todo} already done) with {n_workers_now} workers")
         warm.join()
         # what this process holds by now (the libraries, the inputs' tables) outlives the
         # run: the cyclic collector leaves it alone until the run is done (each of its full
@@ -123,15 +120,26 @@ def run_simulation(cfg: Config, year: int, scheduler: str | None = None,
         if froze:
             gc.freeze()
         t_map = time.perf_counter()
+        futures = submit_tiles(client, ctx, todo)
         # the reduce's modules load while the workers compute (not matplotlib: the workers
         # draw the figures)
         threading.Thread(target=importlib.import_module, args=("vipvflow.outputs.report",),
                          daemon=True, name="import-report").start()
+        standing = timeline.result()
+        timings["timeline_s"] = timeline.seconds
+        standing_todo = [t for t in standing if not standing_done(run_dir, t)]
+        if max_partitions is not None:
+            standing_todo = standing_todo[:max(0, max_partitions - len(todo))]
+        total = len(tiles) * len(cfg.run.months) + len(standing)
+        n_todo = len(todo) + len(standing_todo)
+        say(f"{len(tiles)} tiles x {len(cfg.run.months)} months + {len(standing)} standing = {total} "
+            f"partitions, {n_todo} to compute ({total - n_todo} already done) with {n_workers_now} workers")
+        futures = submit_standing(client, ctx, standing_todo) + futures
         # the trip patterns' consumption (vehicle model, VECTO cycles) is computed with the map
         from .reduce import consumption_tasks
 
         consumption = consumption_tasks(client, cfg, year, run_dir, say=say)
-        results = map_tasks(client, ctx, todo, standing_todo)
+        results = collect_map(client, futures, n_todo)
         timings["map_s"] = time.perf_counter() - t_map
         # the BVH builds of each worker, whose caches of the map are then dropped
         builds = client.run(worker_bvh_builds, release=True)
@@ -180,6 +188,36 @@ def _run_context(cfg: Config, year: int, run_dir: Path) -> tuple[RunContext, lis
         routes=tuple(routes) if routes is not None else None, shapes=shapes,
         route_of_trip=dict(zip(trips["trip_id"], trips["route_id"].astype(str))))
     return ctx, tiles
+
+
+class _Background:
+    """``fn(*args, **kwargs)`` in a thread of its own: :meth:`result` waits for it and returns
+    its value (or raises its error); :attr:`seconds` is how long it took."""
+
+    def __init__(self, fn, *args, name: str = "background", **kwargs):
+        self._out: dict = {}
+        self.seconds = 0.0
+        self._thread = threading.Thread(target=self._call, args=(fn, args, kwargs), daemon=True,
+                                        name=name)
+        self._thread.start()
+
+    def _call(self, fn, args, kwargs) -> None:
+        t = time.perf_counter()
+        try:
+            self._out["value"] = fn(*args, **kwargs)
+        except BaseException as exc:  # noqa: BLE001 - raised again by result()
+            self._out["error"] = exc
+        self.seconds = time.perf_counter() - t
+
+    def wait(self) -> None:
+        """Wait for it, whatever its outcome."""
+        self._thread.join()
+
+    def result(self):
+        self._thread.join()
+        if "error" in self._out:
+            raise self._out["error"]
+        return self._out["value"]
 
 
 class _Starting:

@@ -42,24 +42,33 @@ def _split_tiles(tasks: list[tuple[str, list[str]]]) -> set[str]:
     return {t for t, n in Counter(t for t, _ in tasks).items() if n > 1}
 
 
-def map_tasks(client, ctx: RunContext, todo: list[tuple[str, str]], standing: list[str] = (),
-         every_s: float = 1.0) -> list[dict]:
-    """Compute the partitions *todo* ((tile, month) pairs) and the standing points of the
-    tiles *standing* on the cluster; the partitions' summaries (:func:`run_partition`), in
-    the order they were done.  One ``irradiance-<TILE>`` task per tile computes its months
-    (:func:`tile_task`), in the order of *todo* (the run's: largest tiles first); on a
-    cluster with many task slots for the tiles, a tile's months are split over several
-    ``irradiance-<TILE>-<first month>`` tasks after one ``geometry-<TILE>`` task
-    (:func:`tile_tasks`); the standing tasks (a few large ones) go first; the progress view
-    counts partitions."""
+def submit_tiles(client, ctx: RunContext, todo: list[tuple[str, str]]) -> list:
+    """Submit the partitions *todo* ((tile, month) pairs) to the cluster; their futures.  One
+    ``irradiance-<TILE>`` task per tile computes its months (:func:`tile_task`), in the order
+    of *todo* (the run's: largest tiles first); on a cluster with many task slots for the
+    tiles, a tile's months are split over several ``irradiance-<TILE>-<first month>`` tasks
+    after one ``geometry-<TILE>`` task (:func:`tile_tasks`)."""
     slots = sum(w.get("nthreads", 1) for w in client.scheduler_info()["workers"].values())
     tasks = tile_tasks(todo, slots)
     geometry = {t: client.submit(geometry_task, ctx, t, key=f"geometry-{t}")
                 for t in sorted(_split_tiles(tasks))}
-    futures = [client.submit(run_standing, ctx, tile, key=f"standing-{tile}") for tile in standing]
-    futures += [client.submit(tile_task, ctx, tile, ms, geometry.get(tile), key=key)
-                for (tile, ms), key in zip(tasks, task_keys(tasks))]
-    view = MapProgress(len(todo) + len(standing))
+    return [client.submit(tile_task, ctx, tile, ms, geometry.get(tile), key=key)
+            for (tile, ms), key in zip(tasks, task_keys(tasks))]
+
+
+def submit_standing(client, ctx: RunContext, standing: list[str]) -> list:
+    """Submit the standing points of the tiles *standing* (:func:`run_standing`); their
+    futures.  A few large tasks, submitted once the timeline is written (after the tiles'
+    tasks): they go ahead of the tiles' tasks still waiting for a slot."""
+    return [client.submit(run_standing, ctx, tile, key=f"standing-{tile}", priority=1)
+            for tile in standing]
+
+
+def collect_map(client, futures: list, n_partitions: int, every_s: float = 1.0) -> list[dict]:
+    """The partitions' summaries (:func:`run_partition`) of the map's *futures*
+    (:func:`submit_tiles`, :func:`submit_standing`), in the order they were done; the
+    progress view counts *n_partitions*."""
+    view = MapProgress(n_partitions)
     results = []
     for out in finished_results(client, futures, every_s):
         for res in out if isinstance(out, list) else [out]:
