@@ -123,7 +123,7 @@ def ceiling(probes: list[dict], name: str) -> float:
 def run(tiny: bool = False) -> dict:
     size = "small" if tiny else "full"
     months = [6] if tiny else list(range(1, 13))
-    repeats = 1 if tiny else 3
+    repeats = 1 if tiny else 5
     prepare_demo(size)
     runs: dict = {1: [], 2: [], "1_all_cores": []}
     tables = []
