@@ -220,32 +220,17 @@ class _Background:
         return self._out["value"]
 
 
-class _Starting:
+class _Starting(_Background):
     """:func:`make_client` in a thread of its own: :meth:`result` waits for it (and raises
     its error), :meth:`close` closes what it started."""
 
     def __init__(self, cfg: Config, scheduler: str | None, n_workers: int | None):
-        self._out: dict = {}
-        self._thread = threading.Thread(target=self._start, args=(cfg, scheduler, n_workers),
-                                        daemon=True, name="start-cluster")
-        self._thread.start()
-
-    def _start(self, cfg, scheduler, n_workers) -> None:
-        try:
-            self._out["client"] = make_client(cfg, scheduler, n_workers)
-        except BaseException as exc:  # noqa: BLE001 - raised again by result()
-            self._out["error"] = exc
-
-    def result(self):
-        self._thread.join()
-        if "error" in self._out:
-            raise self._out["error"]
-        return self._out["client"]
+        super().__init__(make_client, cfg, scheduler, n_workers, name="start-cluster")
 
     def close(self) -> None:
-        self._thread.join()
-        if "client" in self._out:
-            close_client(*self._out["client"])
+        self.wait()
+        if "value" in self._out:
+            close_client(*self._out["value"])
 
 
 def _warm_radiation(data_dir: str, year: int) -> None:
