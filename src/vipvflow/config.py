@@ -96,9 +96,20 @@ class CityCfg(_Model):
 class TrajectoryCfg(_Model):
     segment_length_m: float = Field(10.0, ge=0.5, le=1_000)
     roof_height_m: float = Field(3.2, ge=0, le=10)
-    default_elevation_m: float = 300.0
+    # the ground's height above sea level (m) where the city model has neither relief nor a
+    # building within 100 m; null: the radiation file's declared altitude
+    ground_elevation_m: float | None = Field(None, ge=-500, le=9_000)
     timing: Literal["stop_times", "driving_cycle"] = "stop_times"
     cycle: CycleCfg = Field(default_factory=CycleCfg)
+
+    @model_validator(mode="before")
+    @classmethod
+    def _renamed(cls, data):
+        if isinstance(data, dict) and "default_elevation_m" in data:
+            raise ValueError("default_elevation_m is gone (a constant put roads outside the "
+                             "city model at 300 m); the ground comes from the city model, else "
+                             "the radiation file's altitude, else ground_elevation_m")
+        return data
 
 
 
@@ -163,14 +174,20 @@ class RunCfg(_Model):
 
     months: list[int] = Field(default_factory=lambda: list(range(1, 13)), min_length=1)
     routes: list[str] | None = None
-    # GTFS route_type values to simulate (3 bus, 0 tram, 2 rail, 11 trolleybus, extended
-    # 100..1799 such as 700 bus service); null: every route of the feed
-    route_types: list[int] | None = Field(None, min_length=1)
+    # GTFS route_type values to simulate: "bus" (3 bus, 11 trolleybus, extended 700..716 bus
+    # services and 800 trolleybus), "all", or a list (0 tram, 1 subway, 2 rail, 109 suburban
+    # railway, ...: a building model knows no tunnels or viaducts, said at ingest)
+    route_types: Literal["bus", "all"] | list[int] = "bus"
 
-    @field_validator("route_types")
+    @field_validator("route_types", mode="before")
     @classmethod
     def _route_types(cls, v):
-        bad = [t for t in v or [] if not (0 <= t <= 12 or 100 <= t <= 1799)]
+        if v is None:
+            return "all"
+        if isinstance(v, list) and not v:
+            raise ValueError("an empty list keeps no route; use bus, all or a list of GTFS route types")
+        bad = [t for t in v if not isinstance(t, int) or isinstance(t, bool)
+               or not (0 <= t <= 12 or 100 <= t <= 1799)] if isinstance(v, list) else []
         if bad:
             raise ValueError(f"not GTFS route types (0..12 or extended 100..1799): {bad}")
         return v
