@@ -15,6 +15,9 @@ from vipvflow.models.shading import Scene, box_mesh
 from vipvflow.models.sun_sky import RadiationTable
 from vipvflow.simulation.standing import interval_integrals, open_scene, point_geometry
 
+#: the ground height (m) of feeds ingested without a city model or radiation file
+GROUND_M = 0.0
+
 LAT, LON, ALT = 49.61, 6.13, 300.0
 LONG = 3000.0        # half length of an "infinite" wall (m)
 
@@ -132,7 +135,7 @@ def _gtfs(folder):
 @pytest.fixture(scope="module")
 def small_feed(tmp_path_factory):
     d = tmp_path_factory.mktemp("whole_day")
-    ingest_gtfs(_gtfs(d / "feed"), d, TrajectoryCfg(), crs="EPSG:2169")
+    ingest_gtfs(_gtfs(d / "feed"), d, TrajectoryCfg(ground_elevation_m=GROUND_M), crs="EPSG:2169")
     return d
 
 
@@ -292,25 +295,30 @@ def test_driving_only_run_keeps_the_papers_figures(small_run, small_config, tmp_
     assert s["coverage"] == pytest.approx(trips["pv_kwh"].sum() / trips["consumption_kwh"].sum())
 
 
-def test_depot_outside_the_city_model_is_one_clear_error(small_run, small_config):
+def test_depot_outside_the_city_model_stands_in_the_open(small_run, small_config):
+    """A depot where the city model has no building within its buffer (no mesh for its
+    tile) stands in the open with depot_shading: city, as with open: its roof sees the
+    whole sky (sky view factor 1, nothing to reflect), never a missing mesh."""
     from vipvflow.config import load_config
-    from vipvflow.errors import InputError
+    from vipvflow.models.shading import get_scene, modelled_tiles
     from vipvflow.simulation.standing import depot_point
 
     far = {"fleet": {"depot": {"lat": 49.9, "lon": 5.8}}}
     cfg = load_config(small_config, overrides=far)
-    with pytest.raises(InputError, match=r"fleet.depot \(49.9, 5.8\) lies outside the city model"):
-        depot_point(cfg, cfg.data_dir)
-    # in the open it stands anywhere: the roof height of the nearest road, an open field
-    cfg = load_config(small_config, overrides={"fleet": {**far["fleet"], "depot_shading": "open"}})
     x, y, z, tile = depot_point(cfg, cfg.data_dir)
     assert 40000 < x < 110000 and 50000 < y < 140000 and z > 0      # LUREF, Luxembourg
+    assert tile not in modelled_tiles(cfg.data_dir)
+    scene = get_scene(cfg.data_dir, tile)
+    assert scene.n_triangles == 0
+    geom = point_geometry(scene, pd.DataFrame({"point_id": [0], "x": [x], "y": [y], "z": [z]}),
+                          cfg.irradiance)
+    assert geom["svf"].iloc[0] == pytest.approx(1.0) and geom["refl_vf"].iloc[0] == 0.0
 
 
 def test_timeline_of_a_real_feed_without_blocks(shared_data, tmp_path):
     """Cairns (gtfs-kit's sample feed, no block_id: blocks inferred): every block-day of 2014
     is cut into driving, layover and parked time that add up to its window exactly."""
-    ingest_gtfs(shared_data / "gtfs" / "cairns_gtfs_kit" / "cairns_gtfs.zip", tmp_path, TrajectoryCfg())
+    ingest_gtfs(shared_data / "gtfs" / "cairns_gtfs_kit" / "cairns_gtfs.zip", tmp_path, TrajectoryCfg(ground_elevation_m=GROUND_M))
     tl = block_timeline(tmp_path, 2014)
     bd, iv = tl["block_days"], tl["intervals"]
     assert bd["trips"].sum() == len(tl["trip_runs"]) and (bd["overlap_s"] == 0).all()

@@ -179,17 +179,12 @@ def run_standing(ctx, tile: str) -> dict:
 def depot_point(cfg, data_dir) -> tuple | None:
     """The configured depot (``fleet.depot``, WGS84) as ``(x, y, z, tile)`` in the run's CRS:
     the roof height above the road nearest to it; ``None`` when no depot is configured.
-
-    Raises
-    ------
-    InputError
-        With ``depot_shading: city`` when the city model has no mesh at the depot.
-    """
+    With ``depot_shading: city`` a depot where the city model has no building within its
+    buffer stands in the open (:func:`vipvflow.models.shading.get_scene`)."""
     import json
 
     from pyproj import Transformer
 
-    from ..errors import InputError
     from ..inputs.tiles import tile_names
 
     depot = cfg.fleet.depot
@@ -201,10 +196,6 @@ def depot_point(cfg, data_dir) -> tuple | None:
     seg = pd.read_parquet(data.gtfs.segments, columns=["x", "y", "z"])
     near = int(np.argmin(np.hypot(seg["x"].to_numpy() - x, seg["y"].to_numpy() - y)))
     tile = str(tile_names([x], [y], data.tile_size_m())[0])
-    mesh = data.city.mesh(tile)
-    if cfg.fleet.depot_shading == "city" and not mesh.exists():
-        raise InputError(f"{cfg._source}: fleet.depot ({depot.lat}, {depot.lon}) lies outside the city "
-                         f"model (no mesh for tile {tile}); set fleet.depot_shading to open or covered")
     return float(x), float(y), float(seg["z"].to_numpy()[near]), tile
 
 
