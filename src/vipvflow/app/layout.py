@@ -165,7 +165,9 @@ def _controls(model: TripModel, start: dict) -> SimpleNamespace:
     """The PV, route, date and vehicle controls and the text panes, opened on *start*."""
     routes = model.routes()
     route_opts = [(f"{r.route_id}|{r.direction_id}",
-                   f"{r.route_short_name} direction {r.direction_id} ({r.trips} trips)")
+                   f"{r.route_short_name} " + (f"to {r.trip_headsign}" if r.trip_headsign
+                                               else f"direction {r.direction_id}")
+                   + f" ({r.trips} trips)")
                   for r in routes.itertuples()]
     run_pv = model.run_pv_choice
     w = _WIDTH

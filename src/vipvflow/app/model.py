@@ -222,15 +222,33 @@ class TripModel:
                             if (self.run_dir / "route_month.parquet").exists() else pd.DataFrame())
         if len(self.route_month):
             self.route_month["route_id"] = self.route_month["route_id"].astype(str)
-        # routes actually simulated (their segments have geometry)
+        # the routes the run simulated: its run.routes, with trips in its outputs (a route
+        # that shares a shape with a simulated one is not one), on shapes with geometry
         have = set(geo["shape_id"].dropna())
-        self.trips = self.trips[self.trips["shape_id"].isin(have)].reset_index(drop=True)
+        keep = self.trips["shape_id"].isin(have)
+        if self.cfg.run.routes is not None:
+            keep &= self.trips["route_id"].isin({str(r) for r in self.cfg.run.routes})
+        if len(self.route_month):
+            keep &= self.trips["route_id"].isin(set(self.route_month["route_id"]))
+        self.trips = self.trips[keep].reset_index(drop=True)
 
     # ------------------------------------------------------------------ choices
     def routes(self) -> pd.DataFrame:
-        """Route-directions of the run: ``route_id, route_short_name, direction_id, trips``."""
-        return (self.trips.groupby(["route_id", "route_short_name", "direction_id"], sort=True)
-                .size().rename("trips").reset_index())
+        """Route-directions of the run: ``route_id, route_short_name, direction_id, trips`` and
+        ``route_long_name``, ``trip_headsign`` (the direction's most frequent; empty when the
+        feed has none)."""
+        t = self.trips.reindex(columns=[*self.trips.columns.drop(["route_long_name", "trip_headsign"],
+                                                                 errors="ignore"),
+                                        "route_long_name", "trip_headsign"])
+
+        def most(v):
+            v = v.dropna()
+            return v.mode().iloc[0] if len(v) else ""
+
+        return (t.groupby(["route_id", "route_short_name", "direction_id"], sort=True)
+                .agg(trips=("trip_id", "size"), route_long_name=("route_long_name", most),
+                     trip_headsign=("trip_headsign", most))
+                .reset_index())
 
     def departures(self, route_id, direction_id, date) -> pd.DataFrame:
         """Scheduled trips of a route-direction on a service date (``trip_id, start_s``),

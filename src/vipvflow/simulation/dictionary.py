@@ -79,7 +79,12 @@ COLUMNS: dict[str, Column] = {
     "month": Column("date", "month, as its first day (local calendar of the feed)"),
     "hour": Column("h", "local clock hour, 0..23 (hour starting then)"),
     "route_id": Column("", "GTFS route_id"),
-    "route_short_name": Column("", "GTFS route_short_name (the line's public name)"),
+    "route_short_name": Column("", "GTFS route_short_name (the line's public name; its long name, "
+                                   "else its route_id, when the feed gives none); on a segment: "
+                                   "every route that drives it, sorted, joined by ', '"),
+    "route_long_name": Column("", "GTFS route_long_name (empty when the feed gives none)"),
+    "trip_headsign": Column("", "GTFS trip_headsign: where the trip goes (per route and "
+                                "direction: the most frequent)"),
     "direction_id": Column("", "GTFS direction_id (0 or 1)"),
     "service_id": Column("", "GTFS service_id (the trip's calendar)"),
     "block_id": Column("", "GTFS block_id: one vehicle's sequence of trips in a day"),
@@ -131,6 +136,21 @@ COLUMNS: dict[str, Column] = {
     "y_end": Column("m", "segment end, northing"),
     "z_end": Column("m", "roof height at the segment end"),
     "ground_z": Column("m", "ground (terrain) height at the segment start"),
+    "ground_source": Column("", "where ground_z comes from: 'relief' (the city model's TIN), "
+                                "'buildings' (its buildings' ground surfaces within 100 m, blended "
+                                "with the fallback), 'radiation_header' (the CAMS file's altitude) or "
+                                "'configured' (trajectory.ground_elevation_m): the last two are roads "
+                                "more than 100 m from any building of the model"),
+    "in_city_model": Column("", "true when the segment's midpoint lies in the area the city model "
+                                "covers (its buildings' footprints closed by 60 m and widened by 20 m); "
+                                "outside it the road is computed under the open sky"),
+    "in_building": Column("", "true when the segment's midpoint lies inside a building footprint "
+                              "(a straight line between stops of a feed without shapes): its light is "
+                              "taken at light_dx_m, light_dy_m from the midpoint, outside the block, "
+                              "and it is left out of the summary's shading statistics"),
+    "light_dx_m": Column("m", "easting offset of the point the segment's light is taken from "
+                              "(0 unless in_building)"),
+    "light_dy_m": Column("m", "northing offset of that point (0 unless in_building)"),
     "heading_deg": Column("deg", "driving direction, clockwise from grid north"),
     "gradient": Column("m/m", "road gradient dz/ds of the ground (positive uphill)"),
     "length_m": Column("m", "segment length along the shape"),
@@ -182,14 +202,16 @@ _WHOLE_DAY = "pv_kwh_driving pv_kwh_layover pv_kwh_parked pv_kwh_curtailed"
 OUTPUTS: dict[str, Output] = {
     "trip_energy": _out(
         "PV and consumption per trip", "one row per trip and service date",
-        f"trip_id service_date month route_id route_short_name direction_id shape_id service_id "
+        f"trip_id service_date month route_id route_short_name route_long_name trip_headsign "
+        f"direction_id shape_id service_id "
         f"block_id pattern_id start_s seconds {_PVS} consumption_kwh consumption_source "
         f"traction_kwh recuperated_kwh aux_kwh coverage"),
     "segments": _out(
         "The network's segments, their geometry factors and their year (GeoParquet)",
         "one row per segment of the simulated routes (about 10 m of road); totals over the run's months",
         f"segment_id shape_id route_short_name direction_id seg_index tile geometry x y z x_end y_end "
-        f"z_end ground_z heading_deg gradient length_m cum_dist_m tilt_deg azimuth_deg svf refl_vf "
+        f"z_end ground_z ground_source heading_deg gradient length_m cum_dist_m in_city_model "
+        f"in_building light_dx_m light_dy_m tilt_deg azimuth_deg svf refl_vf "
         f"n_passes seconds pv_kwh pv_kwh_unshaded h_total h_total_unshaded g_total_in_service "
         f"g_total_unshaded_in_service shading_loss reflection_gain kwh_per_kwp_year "
         f"irradiation_kwh_m2_year"),
@@ -199,7 +221,8 @@ OUTPUTS: dict[str, Output] = {
         f"{_PVS} {_HS} shading_loss shading_loss_clear reflection_gain"),
     "route_month": _out(
         "Routes per direction and month", "one row per route, direction and month",
-        f"route_id route_short_name direction_id month trips seconds {_PVS} {_WHOLE_DAY} "
+        f"route_id route_short_name route_long_name direction_id trip_headsign month trips seconds "
+        f"{_PVS} {_WHOLE_DAY} "
         f"consumption_kwh coverage shading_loss"),
     "block_day": _out(
         "Vehicles per day", "one row per vehicle block and service date",
@@ -250,7 +273,8 @@ SUMMARY: dict[str, Column] = {
                                                       "calendar year (CAMS radiation file; mean of its "
                                                       "locations); null when the file covers less than 99 %"),
     "service_hours_per_bus_year": Column("h per year", "time a bus spends on its trips in a year"),
-    "shading_loss_allsky": Column("fraction", "1 - (direct + diffuse) / unshaded light on the roofs, all-sky"),
+    "shading_loss_allsky": Column("fraction", "1 - (direct + diffuse) / unshaded light on the roofs, all-sky "
+                                              "(segments inside building footprints left out)"),
     "shading_loss_clearsky": Column("fraction", "the same, clear-sky"),
     "reflection_gain_allsky": Column("fraction", "reflected / unshaded light, all-sky"),
     "net_building_effect_allsky": Column("fraction", "light with buildings / without - 1 (shading and "
@@ -281,6 +305,31 @@ SUMMARY: dict[str, Column] = {
     "layover_hours": Column("h", "fleet time standing at terminals over the simulated months"),
     "parked_hours": Column("h", "fleet time parked at the depot over the simulated months"),
     "layover_aux_kwh": Column("kWh", "auxiliaries and HVAC during the layovers (in the demand)"),
+    # the study area (the city model covers part of the lines)
+    "route_km": Column("km", "length of the simulated routes' segments (each shape once)"),
+    "route_km_in_city_model": Column("km", "of which in the area the city model covers (in_city_model)"),
+    "route_km_in_city_model_share": Column("fraction", "route_km_in_city_model / route_km"),
+    "driving_time_in_city_model_share": Column("fraction", "share of the buses' time on the road spent "
+                                                           "in the city model"),
+    "pv_kwh_driving_in_city_model_share": Column("fraction", "share of the driving PV harvested in the "
+                                                             "city model"),
+    "kwh_per_kwp_driving_in_city_model": Column("kWh/kWp per year", "driving yield of a bus that drove "
+                                                                    "only the modelled streets (the "
+                                                                    "fleet's driving yield x PV per "
+                                                                    "second inside / PV per second)"),
+    "kwh_per_kwp_driving_outside_city_model": Column("kWh/kWp per year", "the same outside the city model "
+                                                                         "(open sky)"),
+    "shading_loss_allsky_in_city_model": Column("fraction", "shading_loss_allsky of the segments in the "
+                                                            "city model (null: none)"),
+    "shading_loss_allsky_outside_city_model": Column("fraction", "the same outside it (no building to "
+                                                                 "shade: about 0)"),
+    "segments_in_buildings": Column("count", "segments whose midpoint lies inside a building footprint "
+                                             "(in_building: lit as the street next to them, left out of "
+                                             "the shading statistics)"),
+    "route_km_in_buildings_share": Column("fraction", "their share of route_km"),
+    "driving_time_in_buildings_share": Column("fraction", "their share of the buses' time on the road"),
+    "ground_sources": Column("count", "segments by the source of their ground height (see "
+                                      "segments.parquet ground_source)"),
     "radiation_gaps_interpolated": Column("count", "gaps in the radiation data within the run's months, "
                                                    "interpolated (each shorter than radiation.max_gap_minutes)"),
     "radiation_gap_minutes_interpolated": Column("min", "minutes of those gaps"),

@@ -579,9 +579,10 @@ def _trip_outputs(cfg: Config, year: int, run_dir: Path, totals: pd.DataFrame, p
     *totals*: the joins here keep their rows' order) and per block-day (driving, layovers,
     parked; the battery's share); writes ``trip_energy.parquet``.  Returns the trips, the
     block-days and the idle buses' days."""
-    trip = totals.merge(trips_meta[["trip_id", "route_id", "route_short_name", "direction_id",
-                                  "shape_id", "service_id", "block_id", "pattern_id", "start_s"]],
-                      on="trip_id", how="left", validate="many_to_one")
+    meta = trips_meta.reindex(columns=["trip_id", "route_id", "route_short_name", "route_long_name",
+                                       "trip_headsign", "direction_id", "shape_id", "service_id",
+                                       "block_id", "pattern_id", "start_s"])
+    trip = totals.merge(meta, on="trip_id", how="left", validate="many_to_one")
     trip["month"] = pd.to_datetime(trip["service_date"]).dt.strftime("%Y-%m")
     cons = trip_consumption(cfg, Path(cfg.data_dir), year, trip["pattern_id"].unique(),
                             vecto_dir=RunDir(run_dir).vecto, say=say, made=consumption)
@@ -612,7 +613,8 @@ def _segment_outputs(cfg: Config, run_dir: Path, sm: pd.DataFrame, geo: pd.DataF
     sm["shading_loss_clear"] = shading_loss(sm["h_direct_clear"], sm["h_diffuse_clear"],
                                             sm["h_total_clear_unshaded"])
     sm["reflection_gain"] = sm["h_reflected"] / sm["h_total_unshaded"].where(sm["h_total_unshaded"] > 0)
-    shape_route = (trips_meta.drop_duplicates("shape_id")[["shape_id", "route_short_name", "direction_id"]])
+    shape_route = shape_routes(trips_meta[trips_meta["trip_id"].isin(totals["trip_id"].unique())])
+    shape_route = shape_route[["shape_id", "route_short_name", "direction_id"]]
     smg = segments[["segment_id", "shape_id", "geometry"]].merge(sm, on="segment_id", how="inner")
     smg = gpd.GeoDataFrame(smg.merge(shape_route, on="shape_id", how="left"),
                            geometry="geometry", crs=segments.crs)
@@ -625,12 +627,36 @@ def _segment_outputs(cfg: Config, run_dir: Path, sm: pd.DataFrame, geo: pd.DataF
     return smg, segments, sm
 
 
+def shape_routes(trips: pd.DataFrame) -> pd.DataFrame:
+    """Per shape, every route that drives it: ``route_short_name`` and ``route_id`` (the
+    routes' names and ids, sorted, joined by ", ": a shape shared by several routes carries
+    them all) and ``direction_id`` (null when its trips run in both directions)."""
+    def joined(v):
+        return ", ".join(sorted({str(x) for x in v.dropna()}))
+
+    g = trips.groupby("shape_id", sort=True)
+    out = pd.DataFrame({"route_short_name": g["route_short_name"].agg(joined).astype("string"),
+                        "route_id": g["route_id"].agg(joined).astype("string")})
+    direction = g["direction_id"].agg(lambda v: v.iloc[0] if v.nunique(dropna=False) == 1 else pd.NA)
+    out["direction_id"] = direction.astype("Int32")
+    return out.reset_index()
+
+
 def _route_month(trip: pd.DataFrame) -> pd.DataFrame:
     """Per route, direction and month: trips, time, kWh, consumption, coverage, shading loss."""
     kwh_cols = [c for c in trip.columns if c.startswith("pv_kwh")] + ["seconds"]
-    rm = (trip.groupby(["route_id", "route_short_name", "direction_id", "month"], sort=True)
+    key = ["route_id", "route_short_name", "direction_id", "month"]
+    rm = (trip.groupby(key, sort=True, dropna=False)
           .agg(trips=("trip_id", "size"), **{c: (c, "sum") for c in kwh_cols + ["consumption_kwh"]})
           .reset_index())
+    # the route's long name and the direction's most frequent headsign
+    names = (trip.groupby(key[:3], sort=True, dropna=False)
+             .agg(route_long_name=("route_long_name", "first"),
+                  trip_headsign=("trip_headsign", lambda v: v.mode().iloc[0] if v.notna().any() else pd.NA))
+             .reset_index())
+    rm = rm.merge(names, on=key[:3], how="left")
+    rm.insert(2, "route_long_name", rm.pop("route_long_name").astype("string"))
+    rm.insert(4, "trip_headsign", rm.pop("trip_headsign").astype("string"))
     rm["coverage"] = rm["pv_kwh"] / rm["consumption_kwh"]
     rm["shading_loss"] = shading_loss(rm["pv_kwh_direct"], rm["pv_kwh_diffuse"], rm["pv_kwh_unshaded"])
     return rm
@@ -720,6 +746,65 @@ def _monthly(cfg: Config, trip: pd.DataFrame, bd: pd.DataFrame, idle: pd.DataFra
     return monthly
 
 
+def _segment_flags(segments: pd.DataFrame) -> pd.DataFrame:
+    """Per segment id: ``length_m``, ``in_city_model``, ``in_building`` and ``ground_source``
+    (segments ingested before these existed: in the model, on the road)."""
+    out = pd.DataFrame({"length_m": segments["length_m"].to_numpy(float)},
+                       index=segments["segment_id"].to_numpy())
+    for col, default in (("in_city_model", True), ("in_building", False)):
+        out[col] = segments[col].to_numpy(bool) if col in segments else default
+    out["ground_source"] = (segments["ground_source"].astype(str).to_numpy()
+                            if "ground_source" in segments else "unknown")
+    return out
+
+
+def _study_area(sm: pd.DataFrame, flags: pd.DataFrame, kwh_per_kwp_driving: float) -> dict:
+    """What of the run lies in the city model: route-km, driving time and PV inside it, the
+    driving yield of the whole lines and of the part inside (a bus driving only the
+    modelled streets: the yield scaled by the PV per second inside over the PV per second
+    of the whole), the shading loss inside, the segments inside building footprints and
+    where the segments' ground heights come from."""
+    sums = sm.groupby("segment_id")[["seconds", "pv_kwh", "h_direct", "h_diffuse",
+                                     "h_total_unshaded"]].sum()
+    f = flags.reindex(sums.index)
+    inside, street = f["in_city_model"].to_numpy(bool), ~f["in_building"].to_numpy(bool)
+    seg = flags[flags.index.isin(sums.index)]
+    km = float(seg["length_m"].sum()) / 1000.0
+    km_in = float(seg.loc[seg["in_city_model"], "length_m"].sum()) / 1000.0
+    pv, t = sums["pv_kwh"].to_numpy(), sums["seconds"].to_numpy()
+
+    def ratio(a, b):
+        return float(a / b) if b > 0 else None
+
+    rate_all = ratio(pv.sum(), t.sum())
+
+    def yield_of(sel):
+        rate = ratio(pv[sel].sum(), t[sel].sum())
+        return None if rate is None or not rate_all else kwh_per_kwp_driving * rate / rate_all
+
+    def loss(sel):
+        h = sums[sel]
+        return (float(shading_loss(h["h_direct"].sum(), h["h_diffuse"].sum(), h["h_total_unshaded"].sum()))
+                if h["h_total_unshaded"].sum() > 0 else None)
+
+    in_bld = ~street
+    return {
+        "route_km": km,
+        "route_km_in_city_model": km_in,
+        "route_km_in_city_model_share": ratio(km_in, km),
+        "driving_time_in_city_model_share": ratio(t[inside].sum(), t.sum()),
+        "pv_kwh_driving_in_city_model_share": ratio(pv[inside].sum(), pv.sum()),
+        "kwh_per_kwp_driving_in_city_model": yield_of(inside),
+        "kwh_per_kwp_driving_outside_city_model": yield_of(~inside),
+        "shading_loss_allsky_in_city_model": loss(inside & street),
+        "shading_loss_allsky_outside_city_model": loss(~inside & street),
+        "segments_in_buildings": int(seg["in_building"].sum()),
+        "route_km_in_buildings_share": ratio(float(seg.loc[seg["in_building"], "length_m"].sum()) / 1000.0, km),
+        "driving_time_in_buildings_share": ratio(t[in_bld].sum(), t.sum()),
+        "ground_sources": {k: int(v) for k, v in seg["ground_source"].value_counts().sort_index().items()},
+    }
+
+
 def _fleet_year(cfg: Config, year: int, run_dir: Path, trip, bd, idle, sm, segments,
                 n_buses: int) -> tuple[pd.DataFrame, dict]:
     """The fleet per month and the fleet-year summary (checked: :func:`_check_totals`)."""
@@ -730,7 +815,13 @@ def _fleet_year(cfg: Config, year: int, run_dir: Path, trip, bd, idle, sm, segme
     # a run over some months states annual figures scaled by 12 / months (flagged in the summary)
     annualise = 12.0 / len(cfg.run.months)
     hours_per_bus = annual.service_hours_per_bus(float(trip["seconds"].sum()), n_buses, annualise)
-    tot = sm[[c for c in sm.columns if c.startswith("h_")]].sum()
+    h_cols = [c for c in sm.columns if c.startswith("h_")]
+    # the light on the roofs: every segment; the shading statistics: the road, without the
+    # segments inside building footprints (they take a nearby street's light: in_building)
+    flags = _segment_flags(segments)
+    street = ~sm["segment_id"].map(flags["in_building"]).fillna(False).to_numpy(bool)
+    tot_all = sm[h_cols].sum()
+    tot = sm.loc[street, h_cols].sum()
     summary = {
         "scenario": cfg.scenario, "year": year, "months": cfg.run.months, "pv_mode": cfg.pv.mode,
         "diffuse_model": cfg.irradiance.diffuse_model,
@@ -743,7 +834,7 @@ def _fleet_year(cfg: Config, year: int, run_dir: Path, trip, bd, idle, sm, segme
         "annualised_from_months": annualise != 1.0,
         "kwh_per_kwp_allsky": float(trip["pv_kwh"].sum() * annualise / (pv.kwp * n_buses)),
         "kwh_per_kwp_clearsky": float(trip["pv_kwh_clear"].sum() * annualise / (pv.kwp * n_buses)),
-        "irradiation_kwh_m2": {k[2:]: float(v) / 1000.0 for k, v in tot.items()},
+        "irradiation_kwh_m2": {k[2:]: float(v) / 1000.0 for k, v in tot_all.items()},
         "shading_loss_allsky": float(shading_loss(tot["h_direct"], tot["h_diffuse"], tot["h_total_unshaded"])),
         "shading_loss_clearsky": float(shading_loss(tot["h_direct_clear"], tot["h_diffuse_clear"],
                                                     tot["h_total_clear_unshaded"])),
@@ -754,8 +845,9 @@ def _fleet_year(cfg: Config, year: int, run_dir: Path, trip, bd, idle, sm, segme
         "reflected_share": float(tot["h_reflected"] / tot["h_total"]),
         **_harvest(cfg, bd, idle, pv.kwp * n_buses, annualise),
         **_economics(cfg, bd, n_buses, annualise),
-        **annual.per_bus_figures(tot, n_buses, annualise, hours_per_bus, data_dir, year),
+        **annual.per_bus_figures(tot_all, n_buses, annualise, hours_per_bus, data_dir, year),
     }
+    summary.update(_study_area(sm, flags, summary["kwh_per_kwp_allsky"]))
     summary.update(_radiation_gaps(data_dir, year, cfg.run.months))
     _check_totals(summary, run_dir)
     return _monthly(cfg, trip, bd, idle, n_buses), summary
