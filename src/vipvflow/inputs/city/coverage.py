@@ -61,14 +61,14 @@ def footprint_polygons(city: CityDir, bounds=None) -> np.ndarray:
 #: footprints closer than this (m) are one block
 _MERGE_M = 0.5
 
-#: the relief's extent: cells of this size (m) holding a TIN triangle's centroid
+#: the relief's extent: cells of this size (m) that a TIN triangle's bounding box meets
 RELIEF_CELL_M = 25.0
 
 
 def relief_cells(city: CityDir, cell_m: float = RELIEF_CELL_M) -> np.ndarray:
     """The relief (TIN) of an ingested city as square cells (shapely boxes, *cell_m* wide)
-    holding its triangles' centroids: the ground the model knows, whether or not a building
-    stands on it (empty without a relief)."""
+    that its triangles' bounding boxes meet: the ground the model knows, whether or not a
+    building stands on it (empty without a relief)."""
     import shapely
 
     if not city.terrain.exists():
@@ -77,23 +77,44 @@ def relief_cells(city: CityDir, cell_m: float = RELIEF_CELL_M) -> np.ndarray:
         v, t = z["tin_vertices"], z["tin_triangles"]
     if not len(t):
         return np.empty(0, object)
-    c = v[t][:, :, :2].mean(axis=1)
-    cells = np.unique(np.floor(c / cell_m).astype(np.int64), axis=0)
+    tri = v[t][:, :, :2]
+    lo = np.floor(tri.min(axis=1) / cell_m).astype(np.int64)
+    hi = np.floor(tri.max(axis=1) / cell_m).astype(np.int64)
+    nx, ny = hi[:, 0] - lo[:, 0] + 1, hi[:, 1] - lo[:, 1] + 1
+    rep = nx * ny                              # the cells each triangle's bounding box meets
+    owner = np.repeat(np.arange(len(tri)), rep)
+    k = np.arange(int(rep.sum())) - np.repeat(np.cumsum(rep) - rep, rep)
+    cells = np.unique(np.column_stack([lo[owner, 0] + k // ny[owner], lo[owner, 1] + k % ny[owner]]),
+                      axis=0)
     return shapely.box(cells[:, 0] * cell_m, cells[:, 1] * cell_m,
                        (cells[:, 0] + 1) * cell_m, (cells[:, 1] + 1) * cell_m)
 
 
+def grown_footprints(footprints: np.ndarray, closing_m: float = CLOSING_M):
+    """The footprints' union grown by *closing_m* (m), simplified: a tile's share of the
+    coverage area, small whatever the number of buildings (the ingest keeps one per tile)."""
+    import shapely
+
+    if not len(footprints):
+        return shapely.Polygon()
+    grown = shapely.union_all(shapely.buffer(footprints, closing_m, quad_segs=4))
+    return shapely.simplify(grown, 1.0)
+
+
 def coverage_area(footprints: np.ndarray, closing_m: float = CLOSING_M, margin_m: float = MARGIN_M,
-                  relief: np.ndarray | None = None):
+                  relief: np.ndarray | None = None, grown: list | None = None):
     """The area the city model covers (a shapely (Multi)Polygon, empty without footprints
     or relief): the footprints' union closed by *closing_m* and widened by *margin_m* (m),
-    together with the relief's extent (:func:`relief_cells`)."""
+    together with the relief's extent (:func:`relief_cells`).  *grown*: the footprints
+    already grown by *closing_m* (:func:`grown_footprints`, per tile) instead of them."""
     import shapely
 
     parts = []
+    grown = list(grown or [])
     if len(footprints):
-        grown = shapely.union_all(shapely.buffer(footprints, closing_m, quad_segs=4))
-        parts.append(shapely.buffer(grown, margin_m - closing_m, quad_segs=4))
+        grown.append(grown_footprints(footprints, closing_m))
+    if grown:
+        parts.append(shapely.buffer(shapely.union_all(grown), margin_m - closing_m, quad_segs=4))
     if relief is not None and len(relief):
         parts.append(shapely.union_all(relief))
     if not parts:
@@ -101,23 +122,36 @@ def coverage_area(footprints: np.ndarray, closing_m: float = CLOSING_M, margin_m
     return shapely.union_all(parts)
 
 
-def write_coverage(city: CityDir, crs: str) -> dict:
+def tile_footprints(surfaces) -> np.ndarray:
+    """The building footprints of one tile's surfaces (a GeoDataFrame with ``surface_type``):
+    its ground surfaces in 2D, else its roofs (as :func:`footprint_polygons`)."""
+    import shapely
+
+    for kind in ("ground", "roof"):
+        g = surfaces.geometry.to_numpy()[surfaces["surface_type"].to_numpy() == kind]
+        if len(g):
+            g = shapely.get_parts(shapely.make_valid(shapely.force_2d(g)))
+            g = g[shapely.get_type_id(g) == 3]
+            return g[shapely.area(g) > 1.0]
+    return np.empty(0, object)
+
+
+def write_coverage(city: CityDir, crs: str, grown: list) -> dict:
     """Write ``coverage.parquet`` (one row: the coverage area, GeoParquet in *crs*) into
-    *city*; return its area (km2) and footprint count for the ingest report."""
+    *city*, from the tiles' grown footprints (*grown*, :func:`grown_footprints`) and the
+    relief; return its area (km2) for the ingest report."""
     import geopandas as gpd
     import shapely
 
     from ...store import atomic_path
 
-    prints = footprint_polygons(city)
     relief = relief_cells(city)
-    area = coverage_area(prints, relief=relief)
+    area = coverage_area(np.empty(0, object), relief=relief, grown=grown)
     gdf = gpd.GeoDataFrame({"closing_m": [CLOSING_M], "margin_m": [MARGIN_M],
-                            "footprints": [len(prints)], "relief_cells": [len(relief)]},
-                           geometry=[area], crs=crs)
+                            "relief_cells": [len(relief)]}, geometry=[area], crs=crs)
     with atomic_path(city.coverage) as tmp:
         gdf.to_parquet(tmp, index=False)
-    return {"coverage_km2": round(float(shapely.area(area)) / 1e6, 4), "footprints": int(len(prints))}
+    return {"coverage_km2": round(float(shapely.area(area)) / 1e6, 4)}
 
 
 def read_coverage(city: CityDir):
