@@ -229,6 +229,50 @@ class FleetCfg(_Model):
     depot_shading: Literal["open", "covered", "city"] = "city"
 
 
+class DepotChargingCfg(_Model):
+    """The depot's chargers: they restore each morning's SoC while the bus is parked."""
+
+    power_kw: float = Field(100.0, gt=0, le=2_000)        # drawn from the grid per bus
+    efficiency: float = Field(0.95, gt=0, le=1)           # battery energy / grid energy
+    # local hours [from, to) the chargers run (to < from: past midnight); null: whenever parked
+    hours: tuple[float, float] | None = None
+    target_soc: float | None = Field(None, ge=0, le=1)    # null: the vehicle's soc_max
+
+    @field_validator("hours")
+    @classmethod
+    def _hours(cls, v):
+        if v is not None and not all(0 <= h <= 24 for h in v):
+            raise ValueError("hours are local clock hours 0..24, e.g. [21, 5]")
+        return v
+
+
+class OpportunityChargingCfg(_Model):
+    """Chargers at terminals (pantographs): a charge during a layover long enough for it."""
+
+    # stop_ids of the terminals with a charger, "all" (every terminal a block lays over
+    # at), or null (no opportunity charging)
+    terminals: list[str] | Literal["all"] | None = None
+    min_layover_min: float = Field(10.0, ge=0)            # a shorter layover is not used
+    connect_min: float = Field(1.0, ge=0)                 # of each layover, docking and undocking
+    power_kw: float = Field(300.0, gt=0, le=2_000)
+    efficiency: float = Field(0.95, gt=0, le=1)
+    target_soc: float | None = Field(None, ge=0, le=1)    # null: the vehicle's soc_max
+
+    @field_validator("terminals", mode="before")
+    @classmethod
+    def _terminals(cls, v):
+        if isinstance(v, list):
+            return [str(t) for t in v]
+        return v
+
+
+class ChargingCfg(_Model):
+    """The charging plan the battery's balance runs under (docs/whole_day.md)."""
+
+    depot: DepotChargingCfg = Field(default_factory=DepotChargingCfg)
+    opportunity: OpportunityChargingCfg = Field(default_factory=OpportunityChargingCfg)
+
+
 class DbCfg(_Model):
     dsn: str | None = None
 
@@ -249,6 +293,7 @@ class Config(_Model):
     run: RunCfg = Field(default_factory=RunCfg)
     radiation: RadiationCfg = Field(default_factory=RadiationCfg)
     fleet: FleetCfg = Field(default_factory=FleetCfg)
+    charging: ChargingCfg = Field(default_factory=ChargingCfg)
     dask: DaskCfg = Field(default_factory=DaskCfg)
     db: DbCfg = Field(default_factory=DbCfg)
 
