@@ -26,11 +26,15 @@ def _cached(stamp: Path, fp: dict) -> bool:
 
 #: written beside the demo inputs: the year, seed and size they were generated for
 DEMO_MARKER = "demo_generated.json"
+#: the demo generator's version: inputs of an older generator are made again (2: termini
+#: among buildings)
+DEMO_VERSION = 2
 
 
 def mark_demo(folder, year: int, seed: int, size: str) -> None:
     """Record what the demo inputs in *folder* were generated for (see :func:`ensure_demo`)."""
-    _stamp(Path(folder) / DEMO_MARKER, {"year": year, "seed": seed, "size": size})
+    _stamp(Path(folder) / DEMO_MARKER, {"year": year, "seed": seed, "size": size,
+                                        "generator": DEMO_VERSION})
 
 
 def _read_marker(path: Path) -> dict | None:
@@ -56,13 +60,13 @@ def ensure_demo(cfg: Config, year: int, say=print) -> None:
     inputs = [*cfg.inputs.citygml, cfg.inputs.gtfs, *cfg.inputs.cams]
     folder = Path(cfg.inputs.gtfs).parent
     marker = folder / DEMO_MARKER
-    want = {"year": year, "seed": cfg.demo.seed, "size": cfg.demo.size}
+    want = {"year": year, "seed": cfg.demo.seed, "size": cfg.demo.size, "generator": DEMO_VERSION}
     if all(Path(p).exists() for p in inputs):
         if _cached(marker, want):
             return
         made = _read_marker(marker)
-        if made and made.get("year") != year and {k: made.get(k) for k in ("seed", "size")} == {
-                "seed": cfg.demo.seed, "size": cfg.demo.size}:
+        if made and made.get("year") != year and {k: made.get(k) for k in ("seed", "size", "generator")} == {
+                "seed": cfg.demo.seed, "size": cfg.demo.size, "generator": DEMO_VERSION}:
             # the demo of another year is kept: a run for a year its timetable does not
             # serve stops with the calendar's range (make a new one with `demo-data --year`)
             say(f"the demo inputs in {folder} are for {made['year']} (new ones: vipvflow "
