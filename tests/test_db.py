@@ -223,9 +223,9 @@ def test_mirror_equals_the_files(dsn, run_dir):
     assert {r[2] for r in wgs} == {4326}
 
     summary = json.loads((run_dir / "summary.json").read_text())
-    got = query(dsn, "SELECT pv_kwh_allsky, trips, summary FROM vipvflow.fleet_summary "
+    got = query(dsn, "SELECT pv_kwh_driving, trips, summary FROM vipvflow.fleet_summary "
                      "JOIN vipvflow.runs USING (run_id) WHERE run_id = %s", (rid,))
-    assert got == [(summary["pv_kwh_allsky"], summary["trips"], summary)]
+    assert got == [(summary["pv_kwh_driving"], summary["trips"], summary)]
 
 
 def test_mirroring_twice_leaves_the_same_rows(dsn, run_dir):

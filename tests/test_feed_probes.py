@@ -448,13 +448,13 @@ def test_totals_zero_or_undefined_stop(tmp_path):
     from vipvflow.errors import InputError
     from vipvflow.simulation.reduce import _check_totals
 
-    ok = {"passes": 10, "pv_kwh_allsky": 5.0, "fleet_demand_mwh": 1.0, "coverage": 0.1,
+    ok = {"passes": 10, "pv_kwh_driving": 5.0, "fleet_demand_in_service_mwh": 1.0, "coverage": 0.1,
           "irradiation_kwh_m2": {"total_unshaded": 3.0}}
     _check_totals(ok, tmp_path)
-    with pytest.raises(InputError, match="pv_kwh_allsky is 0.0: no PV energy over 10 passes"):
-        _check_totals({**ok, "pv_kwh_allsky": 0.0}, tmp_path)
-    with pytest.raises(InputError, match="pv_kwh_allsky is nan"):
-        _check_totals({**ok, "pv_kwh_allsky": float("nan")}, tmp_path)
+    with pytest.raises(InputError, match="pv_kwh_driving is 0.0: no PV energy over 10 passes"):
+        _check_totals({**ok, "pv_kwh_driving": 0.0}, tmp_path)
+    with pytest.raises(InputError, match="pv_kwh_driving is nan"):
+        _check_totals({**ok, "pv_kwh_driving": float("nan")}, tmp_path)
     with pytest.raises(InputError, match=r"undefined figures in the summary: coverage, "
                                          r"irradiation_kwh_m2.total_unshaded"):
         _check_totals({**ok, "coverage": float("inf"),

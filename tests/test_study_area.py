@@ -214,17 +214,20 @@ def test_console_line_of_a_partial_year_compares_like_with_like():
     said so (it printed June's PV against the year's demand)."""
     from vipvflow.simulation.run import _summary_line
 
-    s = {"months": [6], "kwh_per_kwp_allsky": 600.0, "kwh_per_kwp_clearsky": 700.0,
+    s = {"months": [6], "kwh_per_kwp_usable": 1000.0, "kwh_per_kwp_driving": 600.0,
+         "kwh_per_kwp_driving_clearsky": 700.0,
          "kwh_per_kwp_in_service": 900.0, "kwh_per_kwp_whole_day": 1200.0,
          "shading_loss_allsky": 0.1, "pv_kwh_usable": 3000.0, "pv_kwh_curtailed": 100.0,
-         "coverage": 0.04, "fleet_demand_mwh": 900.0, "avoided_charging_cycles_per_bus": 20.0,
+         "coverage": 0.04, "fleet_demand_in_service_mwh": 900.0, "grid_kwh_avoided": 3100.0,
+         "grid_kwh_avoided_depot": 100.0, "grid_kwh_avoided_opportunity": 3000.0,
+         "block_days": 20, "block_days_infeasible": 0, "avoided_charging_cycles_per_bus": 20.0,
          "payback_years": 8.0, "route_km_in_city_model_share": 0.25, "route_km": 40.0,
          "pv_kwh_driving_in_city_model_share": 0.2, "kwh_per_kwp_driving_in_city_model": 500.0,
          "shading_loss_allsky_in_city_model": 0.2, "segments_in_buildings": 3,
          "route_km_in_buildings_share": 0.001}
     line = _summary_line(s)
     assert "annualised from June" in line
-    assert "in June the battery takes 3.0 MWh" in line and "of 75.0 MWh" in line
+    assert "in June the batteries take 3.0 MWh" in line and "of the 75.0 MWh" in line
     assert "In the city model: 25 % of 40.0 route-km" in line
     assert "3 segments" in line and "inside building footprints" in line
 

@@ -129,8 +129,8 @@ FLEET_MONTH = Table(
     "fleet_month", "monthly.parquet", ("month",), [
         ("month", "date"), ("trips", "bigint"),
         *_cols(["pv_kwh", "pv_kwh_clear", "pv_kwh_unshaded", "pv_kwh_clear_unshaded",
-                "consumption_kwh", "avoided_charging_cycles", "kwh_per_kwp_allsky",
-                "kwh_per_kwp_clearsky"], _F),
+                "consumption_kwh", "avoided_charging_cycles", "kwh_per_kwp_driving",
+                "kwh_per_kwp_driving_clearsky"], _F),
     ])
 
 HOURLY_PATTERN = Table(
@@ -144,11 +144,14 @@ FLEET_SUMMARY = Table(
         ("scenario", "text"), ("year", "integer"), ("pv_mode", "text"), ("diffuse_model", "text"),
         ("routes", "bigint"), ("trips", "bigint"), ("buses", "bigint"), ("segments", "bigint"),
         ("passes", "bigint"), ("kwp_per_bus", _F),
-        *_cols(["pv_kwh_allsky", "pv_kwh_clearsky", "pv_kwh_allsky_unshaded",
-                "kwh_per_kwp_allsky", "kwh_per_kwp_clearsky", "shading_loss_allsky",
+        *_cols(["pv_kwh_driving", "pv_kwh_driving_clearsky", "pv_kwh_driving_unshaded",
+                "pv_kwh_usable", "pv_kwh_curtailed", "kwh_per_kwp_usable", "kwh_per_kwp_driving",
+                "kwh_per_kwp_driving_clearsky", "shading_loss_allsky",
                 "shading_loss_clearsky", "unshaded_to_ghi_allsky", "unshaded_to_ghi_clearsky",
-                "reflected_share", "coverage", "fleet_demand_mwh",
-                "avoided_charging_cycles_per_bus", "payback_years"], _F),
+                "reflected_share", "coverage", "coverage_driving", "fleet_demand_in_service_mwh",
+                "fleet_demand_driving_mwh", "grid_kwh_avoided", "avoided_charging_cycles_per_bus",
+                "payback_years"], _F),
+        ("block_days_infeasible", "bigint"),
     ])
 
 #: tables filled from the run's files, in load order

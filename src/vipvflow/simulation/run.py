@@ -258,28 +258,40 @@ def _period(months: list[int]) -> str:
 
 
 def _summary_line(s: dict) -> str:
-    """The run's headline: yields (per year; a partial year's annualised, said so), then the
-    energies of the run's own months side by side (PV taken, demand, coverage of the same
-    months), the part of the lines inside the city model and what the shading statistics
-    left out."""
-    def yield_of(key):
-        return "not computed" if s.get(key) is None else f"{s[key]:.0f} kWh/kWp"
+    """The run's headline: the yield the batteries take (per year; a partial year's
+    annualised, said so) with the harvested yields beside it, then the energies of the run's
+    own months side by side (PV taken and curtailed, the demand it covers, grid energy
+    avoided), the charging plan's infeasible block-days, the part of the lines inside the
+    city model and what the shading statistics left out."""
+    def kwp(key):
+        return "n/a" if s.get(key) is None else f"{s[key]:.0f}"
 
     months = s.get("months") or list(range(1, 13))
     partial = len(months) < 12
     scale = len(months) / 12.0 if partial else 1.0         # annual figures back to the months
     period = _period(months)
-    line = (f"annual yield (all-sky{', annualised from ' + period if partial else ''}) driving "
-            f"{s['kwh_per_kwp_allsky']:.0f} kWh/kWp ({s['kwh_per_kwp_clearsky']:.0f} clear-sky), "
-            f"in service {yield_of('kwh_per_kwp_in_service')}, "
-            f"whole day {yield_of('kwh_per_kwp_whole_day')}; "
+    harvested = ", ".join(f"{label} {kwp(key)}" for label, key in (
+        ("driving", "kwh_per_kwp_driving"), ("in service", "kwh_per_kwp_in_service"),
+        ("whole day", "kwh_per_kwp_whole_day")) if s.get(key) is not None)
+    line = (f"annual yield the batteries take {kwp('kwh_per_kwp_usable')} kWh/kWp "
+            f"({'annualised from ' + period + '; ' if partial else ''}harvested: {harvested} "
+            f"kWh/kWp; driving clear-sky {kwp('kwh_per_kwp_driving_clearsky')}); "
             f"shading loss {100 * s['shading_loss_allsky']:.1f} % on the road; "
-            f"in {period} the battery takes {s['pv_kwh_usable'] / 1000:.1f} MWh "
+            f"in {period} the batteries take {s['pv_kwh_usable'] / 1000:.1f} MWh "
             f"({s['pv_kwh_curtailed'] / 1000:.1f} MWh curtailed): "
-            f"PV covers {100 * s['coverage']:.2f} % of {s['fleet_demand_mwh'] * scale:.1f} MWh; "
+            f"PV covers {100 * s['coverage']:.2f} % of the {s['fleet_demand_in_service_mwh'] * scale:.1f} "
+            f"MWh the buses use in service (trips and layovers); "
+            f"grid energy avoided {s['grid_kwh_avoided'] / 1000:.1f} MWh (depot "
+            f"{s['grid_kwh_avoided_depot'] / 1000:.1f}, terminals {s['grid_kwh_avoided_opportunity'] / 1000:.1f}); "
             f"{s['avoided_charging_cycles_per_bus']:.1f} charging cycles avoided per bus"
-            f"{' (annualised)' if partial else ''}; "
-            f"payback {s['payback_years']:.1f} years")
+            f"{' (annualised)' if partial else ''}; payback {s['payback_years']:.1f} years")
+    n_bad, n_days = s.get("block_days_infeasible", 0), s.get("block_days", 0)
+    if n_bad:
+        first = "; ".join(s.get("infeasible_block_days_first") or [])
+        line += (f". The charging plan cannot serve {n_bad} of {n_days} block-days (the battery "
+                 f"would fall below its minimum; first: {first}): see block_day.parquet")
+    elif n_days:
+        line += f". The charging plan serves all {n_days} block-days"
     share = s.get("route_km_in_city_model_share")
     if share is not None and share < 1.0:
         inside = s.get("kwh_per_kwp_driving_in_city_model")
