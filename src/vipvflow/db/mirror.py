@@ -91,6 +91,15 @@ def citus_mode(conn, log=print) -> bool:
     return True
 
 
+def _citus_layout(conn) -> str:
+    """The log's words for the Citus layout: the nodes that hold shards."""
+    workers = conn.execute("SELECT count(*) FROM pg_dist_node WHERE noderole = 'primary' AND "
+                           "isactive AND groupid <> 0").fetchone()[0]
+    nodes = f"{workers} worker(s)" if workers else "the coordinator alone (no workers registered)"
+    return (f"Citus on {nodes}: segment tables distributed by tile, trip tables by route, "
+            "small tables replicated")
+
+
 def setup_schema(conn, citus: bool) -> None:
     """Create (idempotently) the schema, distribute it under Citus, create the views."""
     import psycopg
@@ -393,9 +402,8 @@ def mirror_run(dsn: str, run_dir, log=print, force: bool = False,
     where = describe_dsn(dsn)
     try:
         citus = citus_mode(conn, log)
-        log(f"mirror {run_id} into {where}: "
-            + ("Citus (segment tables distributed by tile, trip tables by route)" if citus
-               else "plain PostGIS tables (no Citus)"))
+        log(f"mirror {run_id} into {where}: " + (_citus_layout(conn) if citus
+                                                 else "plain PostGIS tables (no Citus)"))
         setup_schema(conn, citus)
         with conn.transaction():
             conn.execute(
@@ -403,7 +411,7 @@ def mirror_run(dsn: str, run_dir, log=print, force: bool = False,
                 "status, mirrored_at, manifest, config, summary) "
                 "VALUES (%s, %s, %s, %s, %s, 'loading', now(), %s, %s, %s) "
                 "ON CONFLICT (run_id) DO UPDATE SET crs_epsg = EXCLUDED.crs_epsg, "
-                "status = 'loading', mirrored_at = now(), manifest = EXCLUDED.manifest, "
+                "status = 'loading', mirrored_at = EXCLUDED.mirrored_at, manifest = EXCLUDED.manifest, "
                 "config = EXCLUDED.config, summary = EXCLUDED.summary",
                 (run_id, manifest.get("scenario"), manifest.get("year"),
                  manifest.get("config_digest"), epsg, psycopg.types.json.Jsonb(manifest),

@@ -213,9 +213,12 @@ def citus_statements(distributed: set[str] = frozenset()) -> list[str]:
             out.append(f"SELECT create_reference_table('{t.qualified}')")
         else:
             assert t.distribute_by in t.key, f"{t.name}: distribution column not in the key"
-            colo = f", colocate_with => '{SCHEMA}.{t.colocate_with}'" if t.colocate_with else ""
+            # a group's first table starts its own colocation group: Citus would otherwise
+            # put every table distributed by a text column in one group (tile and route
+            # shards side by side, as if their keys were related)
+            colo = f"'{SCHEMA}.{t.colocate_with}'" if t.colocate_with else "'none'"
             out.append(f"SELECT create_distributed_table('{t.qualified}', "
-                       f"'{t.distribute_by}'{colo})")
+                       f"'{t.distribute_by}', colocate_with => {colo})")
     return out
 
 
