@@ -469,9 +469,12 @@ def _connect_socket(server: LocalServer, database: str, timeout_s: float = 30):
             time.sleep(0.2)
 
 
-def create_database(server: LocalServer, database: str) -> None:
+def create_database(server: LocalServer, database: str, postgis: bool = True) -> None:
     """Create *database* (when missing) with PostGIS; on a Citus cluster on every node, with
-    the citus extension first, and register the coordinator and the workers in it."""
+    the citus extension first, and register the coordinator and the workers in it.
+
+    *postgis* False leaves PostGIS to the mirror (which creates it on the coordinator; Citus
+    creates it on the workers)."""
     from psycopg import sql
 
     citus = bool(server.workers)
@@ -483,7 +486,7 @@ def create_database(server: LocalServer, database: str) -> None:
         with _connect_socket(node, database) as conn:
             have = {r[0] for r in conn.execute("SELECT extname FROM pg_extension")}
             # (a worker that holds Citus metadata refuses CREATE EXTENSION, even IF NOT EXISTS)
-            for ext in ("citus", "postgis") if citus else ("postgis",):
+            for ext in ("citus",) * citus + ("postgis",) * postgis:
                 if ext not in have:
                     conn.execute(sql.SQL("CREATE EXTENSION {}").format(sql.Identifier(ext)))
     if not citus:
