@@ -333,6 +333,18 @@ def _forget(conn, table: S.Table, run_id: str, citus: bool) -> None:
                      (run_id, table.name))
 
 
+def _add_columns(conn, table: S.Table, extra: dict[str, str]) -> None:
+    """Add the file's columns the table lacks, in one statement (on Citus each ALTER TABLE
+    runs on every shard: the columns already there are not asked for again)."""
+    have = {r[0] for r in conn.execute(
+        "SELECT attname FROM pg_attribute WHERE attrelid = %s::regclass AND attnum > 0 "
+        "AND NOT attisdropped", (table.qualified,))}
+    missing = [(n, t) for n, t in extra.items() if n not in have]
+    if missing:
+        conn.execute(f"ALTER TABLE {table.qualified} "
+                     + ", ".join(f"ADD COLUMN IF NOT EXISTS {_ident(n)} {t}" for n, t in missing))
+
+
 def mirror_table(conn, run_dir: Path, table: S.Table, run_id: str, citus: bool, force: bool,
                  log, on_partition) -> int:
     """Load one table of a run, partition by partition, skipping the ones already there."""
@@ -348,9 +360,7 @@ def mirror_table(conn, run_dir: Path, table: S.Table, run_id: str, citus: bool, 
                 f": replacing the run's rows")
         _forget(conn, table, run_id, citus)
         done = {}
-    for name, sql_type in extra.items():
-        conn.execute(f"ALTER TABLE {table.qualified} ADD COLUMN IF NOT EXISTS "
-                     f"{_ident(name)} {sql_type}")
+    _add_columns(conn, table, extra)
     parts = partitions(data, table.partition_by)
     todo = [p for p in parts if p[0] not in done]
     loaded = 0
