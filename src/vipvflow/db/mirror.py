@@ -96,8 +96,8 @@ def _citus_layout(conn) -> str:
     workers = conn.execute("SELECT count(*) FROM pg_dist_node WHERE noderole = 'primary' AND "
                            "isactive AND groupid <> 0").fetchone()[0]
     nodes = f"{workers} worker(s)" if workers else "the coordinator alone (no workers registered)"
-    return (f"Citus on {nodes}: segment tables distributed by tile, trip tables by route, "
-            "small tables replicated")
+    return (f"Citus on {nodes}: segment tables distributed by tile, trips and bus-days by "
+            "block, small tables replicated")
 
 
 def setup_schema(conn, citus: bool) -> None:
@@ -307,7 +307,9 @@ def load_partition(conn, table: S.Table, run_id: str, label: str, value, rows: p
     rows = rows.add_column(0, "run_id", pa.array([run_id] * rows.num_rows, pa.string()))
     payload = memoryview(to_csv(rows))
     with conn.transaction():
-        if citus:  # reference-table writes after multi-shard ones in one transaction
+        if citus:  # one connection per worker for the delete, the copy and the progress row
+            # (Citus's advice when a transaction writes a reference table after multi-shard
+            # statements; parallel mode was no faster on the demo run)
             conn.execute("SET LOCAL citus.multi_shard_modify_mode TO 'sequential'")
         args = (run_id, value) if table.partition_by else (run_id,)
         conn.execute(_delete_sql(table), args)
