@@ -103,9 +103,9 @@ def how_to_get(pg: PgInstall) -> str:
     """One line: how a user gets Citus for this server."""
     return (f"Citus is not installed for PostgreSQL {pg.version} ({pg.pkglibdir}/citus.so): "
             f"install Citus's package postgresql-{pg.major}-citus-13.x (from Citus's package "
-            "repository, on a machine with internet access), or build it from the Citus source "
-            "with `vipvflow db citus --source citus-13.x.tar.gz` as root (`make citus` does it "
-            "with ../shared/vendor/citus)")
+            "repository, on a machine with internet access), or build it from Citus's source "
+            "as root: `vipvflow db citus --source citus-13.x.tar.gz` (in a clone: `make citus "
+            "CITUS_SOURCE=...`)")
 
 
 def find_tarball(source: str | Path) -> Path:
