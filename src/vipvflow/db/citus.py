@@ -14,7 +14,8 @@ access to those folders (root). The build:
   :func:`patch_source`) in that unpacked copy;
 - runs ``./configure --without-libcurl`` (no usage statistics sent to Citus's servers: the
   cluster stays offline) and ``make`` without LLVM bitcode (the server's JIT inlining of
-  Citus code is not needed; it halves the build), then ``make install DESTDIR=<stage>``;
+  Citus code is not needed; measured in one run on the loaded 2-core machine: 161 s without,
+  322 s with it), then ``make install DESTDIR=<stage>``;
 - keeps the staged files under ``<cache>/citus/<tarball>-pg<version>-<digest>/``, so a second
   install (another machine state, a reinstalled server package) copies them without building.
 
