@@ -8,9 +8,11 @@ load with the type its Parquet column has, so the mirror never drops data silent
 
 With the Citus extension the segment-level tables are distributed by ``tile`` (colocated:
 a segment and its months live on the same worker, as the simulation's partitions do), the
-trip-level ones by ``route_id`` and ``block_day`` by ``block_id``; the small per-run tables
-are reference tables (a copy on every worker, cheap to join). Without Citus the same tables
-are plain PostGIS tables.
+trips and the bus-days by ``block_id`` (colocated: a bus's trips and its days on the same
+worker; a trip crosses many tiles, and there are many more blocks than routes); the small
+tables (runs, progress, fleet and route months, the hourly pattern, the summary) are
+reference tables (a copy on every node, cheap to join). Without Citus the same tables are
+plain PostGIS tables.
 """
 from __future__ import annotations
 
@@ -103,27 +105,28 @@ SEGMENT_MONTH = Table(
     drop=("geometry",), extra_indexes=(("run_id", "month"), ("run_id", "route_short_name", "month")))
 
 TRIP_ENERGY = Table(
-    "trip_energy", "trip_energy.parquet", ("route_id", "trip_id", "service_date"), [
+    "trip_energy", "trip_energy.parquet", ("block_id", "trip_id", "service_date"), [
         ("route_id", "text"), ("trip_id", "text"), ("service_date", "date"), ("month", "date"),
         ("route_short_name", "text"), ("direction_id", "integer"), ("shape_id", "text"),
         ("service_id", "text"), ("block_id", "text"), ("pattern_id", "bigint"), ("start_s", _F),
         ("seconds", _F), *_cols(_PV, _F),
         *_cols(["consumption_kwh", "traction_kwh", "recuperated_kwh", "aux_kwh", "coverage"], _F),
-    ], partition_by="month", distribute_by="route_id",
-    extra_indexes=(("run_id", "month"), ("run_id", "block_id", "service_date")))
+    ], partition_by="month", distribute_by="block_id",
+    extra_indexes=(("run_id", "month"), ("run_id", "route_id", "month"),
+                   ("run_id", "block_id", "service_date")))
 
 ROUTE_MONTH = Table(
     "route_month", "route_month.parquet", ("route_id", "direction_id", "month"), [
         ("route_id", "text"), ("direction_id", "integer"), ("month", "date"),
         ("route_short_name", "text"), ("trips", "bigint"), ("seconds", _F), *_cols(_PV, _F),
         ("consumption_kwh", _F), ("coverage", _F), ("shading_loss", _F),
-    ], partition_by="month", distribute_by="route_id", colocate_with="trip_energy")
+    ], partition_by="month")
 
 BLOCK_DAY = Table(
     "block_day", "block_day.parquet", ("block_id", "service_date"), [
         ("block_id", "text"), ("service_date", "date"), ("trips", "bigint"), ("pv_kwh", _F),
         ("pv_kwh_clear", _F), ("consumption_kwh", _F), ("first_departure_s", _F),
-    ], distribute_by="block_id")
+    ], distribute_by="block_id", colocate_with="trip_energy")
 
 FLEET_MONTH = Table(
     "fleet_month", "monthly.parquet", ("month",), [
@@ -216,9 +219,12 @@ def citus_statements(distributed: set[str] = frozenset()) -> list[str]:
             out.append(f"SELECT create_reference_table('{t.qualified}')")
         else:
             assert t.distribute_by in t.key, f"{t.name}: distribution column not in the key"
-            colo = f", colocate_with => '{SCHEMA}.{t.colocate_with}'" if t.colocate_with else ""
+            # a group's first table starts its own colocation group: Citus would otherwise
+            # put every table distributed by a text column in one group (tile and route
+            # shards side by side, as if their keys were related)
+            colo = f"'{SCHEMA}.{t.colocate_with}'" if t.colocate_with else "'none'"
             out.append(f"SELECT create_distributed_table('{t.qualified}', "
-                       f"'{t.distribute_by}'{colo})")
+                       f"'{t.distribute_by}', colocate_with => {colo})")
     return out
 
 
