@@ -79,6 +79,7 @@ def ensure_ingested(cfg: Config, say=print) -> dict:
     from ..inputs.cams import ingest_cams
     from ..inputs.city import ingest_city
     from ..inputs.gtfs import ingest_gtfs
+    from ..models.mesh import MESH_FORMAT
 
     data_dir = Path(cfg.data_dir)
     city_files = [Path(p) for p in cfg.inputs.citygml]
@@ -91,8 +92,10 @@ def ensure_ingested(cfg: Config, say=print) -> dict:
     if gtfs is None or not cams_files:
         raise InputError(f"{cfg._source}: inputs.gtfs and inputs.cams are required")
 
+    # the tile meshes' format: a city ingested by an older vipvflow is ingested again
     city_fp = _fingerprint(city_files, {"city": cfg.city.model_dump(mode="json"),
-                                        "crs": cfg.inputs.citygml_crs})
+                                        "crs": cfg.inputs.citygml_crs,
+                                        "mesh_format": MESH_FORMAT})
     data = DataDir(data_dir)
     stamp = data.city.stamp
     if city_files and not _cached(stamp, city_fp):
