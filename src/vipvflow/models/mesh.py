@@ -159,10 +159,10 @@ class TileMesh:
             raise ValueError("TileMesh.merge: no mesh")
         parts, shift = [], 0
         for m in meshes:
-            part = m.trimesh.copy()
-            part.face_attributes["surface_index"] = (m.surface_index + shift).astype(np.int32)
-            part.metadata = {}
-            parts.append(part)
+            face = dict(m.trimesh.face_attributes)
+            face["surface_index"] = (m.surface_index + shift).astype(np.int32)
+            parts.append(trimesh.Trimesh(vertices=m.vertices, faces=m.triangles, face_attributes=face,
+                                         process=False, validate=False))
             shift += len(m.surface_ids)
         first = meshes[0]
         if sum(len(p.faces) for p in parts) == 0:
