@@ -27,7 +27,6 @@ from .models.params import CycleCfg, IrradianceCfg, PVSystem
 from .store import TILE_SIZE_M
 
 
-
 def _conf_dir() -> Path:
     """The folder of the shipped YAML files: ``$VIPVFLOW_CONF_DIR``; else the package
     ``vipvflow.conf`` (a wheel's copy, or the repository's ``conf/`` in an editable install);

@@ -17,6 +17,8 @@ file's ``vipvflow:columns`` key), each dataset folder swapped in as a whole.
 """
 from __future__ import annotations
 
+import json
+import uuid
 from pathlib import Path
 
 import numpy as np
@@ -30,15 +32,17 @@ DATASETS = {"segments": "segments.parquet", "segment_month": "segment_month.parq
 
 
 def tile_groups(segments, per_partition: int = SEGMENTS_PER_PARTITION) -> dict[str, int]:
-    """The partition of each tile: tiles in the Hilbert order of their segments' centre,
-    cut into groups of about *per_partition* segments (whole tiles)."""
+    """The partition of each tile: tiles in the Hilbert order of their segments' mean
+    midpoint (*segments*: ``tile, x, y, x_end, y_end``), cut into groups of about
+    *per_partition* segments (whole tiles)."""
     import geopandas as gpd
+    import pandas as pd
 
     counts = segments.groupby("tile").size()
-    centre = segments.geometry.centroid
-    xy = np.column_stack([centre.x, centre.y])
-    mean = (gpd.GeoDataFrame({"tile": segments["tile"].to_numpy(), "x": xy[:, 0], "y": xy[:, 1]})
-            .groupby("tile")[["x", "y"]].mean().loc[counts.index])
+    mid = pd.DataFrame({"tile": segments["tile"].to_numpy(),
+                        "x": (segments["x"].to_numpy() + segments["x_end"].to_numpy()) / 2,
+                        "y": (segments["y"].to_numpy() + segments["y_end"].to_numpy()) / 2})
+    mean = mid.groupby("tile")[["x", "y"]].mean().loc[counts.index]
     points = gpd.GeoSeries(gpd.points_from_xy(mean["x"], mean["y"]), index=mean.index)
     order = points.hilbert_distance().sort_values(kind="stable").index
     group, filled, out = 0, 0, {}
@@ -55,40 +59,62 @@ def write_datasets(run_dir, per_partition: int = SEGMENTS_PER_PARTITION) -> dict
     ``segments.parquet`` and ``segment_month.parquet``; return the partitions of each."""
     import dask.dataframe as dd
     import dask_geopandas  # noqa: F401  (registers the GeoDataFrame backend of dask)
-    import geopandas as gpd
     import pandas as pd
     import pyarrow as pa
     import pyarrow.parquet as pq
+    import pyproj
 
     run = RunDir(run_dir)
-    segments = gpd.read_parquet(run.output(DATASETS["segments"]))
+    segments = pd.read_parquet(run.output(DATASETS["segments"]),
+                               columns=["tile", "x", "y", "x_end", "y_end"])
     groups = tile_groups(segments, per_partition)
     out = {}
     for name, source in DATASETS.items():
-        frame = segments if name == "segments" else gpd.read_parquet(run.output(source))
-        if "month" in frame:
-            frame["month"] = pd.to_datetime(frame["month"])
-        meta = pq.read_schema(run.output(source)).metadata or {}
-        custom = {k: v for k, v in meta.items() if k.startswith(b"vipvflow:")}
-        part = frame["tile"].map(groups).to_numpy()
+        # the rows as Arrow (geometry as WKB); each partition becomes a GeoDataFrame in its
+        # own task, so one partition's geometries are decoded at a time
+        table = pq.read_table(run.output(source))
+        meta = table.schema.metadata or {}
+        crs = pyproj.CRS.from_json_dict(json.loads(meta[b"geo"])["columns"]["geometry"]["crs"])
+        part = pd.Series(table.column("tile").to_numpy(zero_copy_only=False)).map(groups).to_numpy()
         order = np.argsort(part, kind="stable")
-        frame = frame.iloc[order].reset_index(drop=True)
+        table = table.take(order)           # once, in partition order: each partition a slice
         bounds = np.searchsorted(part[order], np.arange(max(groups.values()) + 2))
-        pieces = [frame.iloc[a:b] for a, b in zip(bounds[:-1], bounds[1:])]
+        pieces = [(int(a), int(b)) for a, b in zip(bounds[:-1], bounds[1:])]
+        custom = {k: v for k, v in meta.items() if k.startswith(b"vipvflow:")}
         final = run.dataset(name)
         stage = staging_dir(final)
-        ddf = dd.from_map(_piece, pieces, meta=frame.iloc[:0], enforce_metadata=False)
+        rows = _Rows(table, crs)
+        ddf = dd.from_map(rows, pieces, meta=rows((0, 0)), enforce_metadata=False)
         # month a date, as in the single file (pandas holds dates as timestamps)
         ddf.to_parquet(stage, write_index=False, custom_metadata=custom, overwrite=False,
-                       schema={"month": pa.date32()} if "month" in frame else "infer",
+                       schema={"month": pa.date32()} if "month" in table.column_names else "infer",
                        compute_kwargs={"scheduler": "sync"})
         swap_dir(stage, final)
         out[name] = len(pieces)
+        del table, ddf
     return out
 
 
-def _piece(frame):
-    return frame
+class _Rows:
+    """``rows((a, b))``: rows a:b of an Arrow table of a run output as a GeoDataFrame
+    (columns in the file's order).  Named for Dask by a random token: hashing the table to
+    name the tasks cost more than writing it."""
+
+    def __init__(self, table, crs):
+        self.table, self.crs, self.token = table, crs, uuid.uuid4().hex
+
+    def __dask_tokenize__(self):
+        return self.token
+
+    def __call__(self, rows):
+        import geopandas as gpd
+        import pandas as pd
+
+        df = self.table.slice(rows[0], rows[1] - rows[0]).to_pandas()
+        if "month" in df:
+            df["month"] = pd.to_datetime(df["month"])
+        df["geometry"] = gpd.GeoSeries.from_wkb(df["geometry"].to_numpy(), crs=self.crs)
+        return gpd.GeoDataFrame(df, geometry="geometry", crs=self.crs)
 
 
 def read_dataset(run_dir, name: str):
