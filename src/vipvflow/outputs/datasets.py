@@ -69,13 +69,20 @@ def write_datasets(run_dir, per_partition: int = SEGMENTS_PER_PARTITION) -> dict
                                columns=["tile", "x", "y", "x_end", "y_end"])
     groups = tile_groups(segments, per_partition)
     out = {}
+    if not groups:                          # a run without segments: no dataset
+        return out
     for name, source in DATASETS.items():
         # the rows as Arrow (geometry as WKB); each partition becomes a GeoDataFrame in its
         # own task, so one partition's geometries are decoded at a time
         table = pq.read_table(run.output(source))
         meta = table.schema.metadata or {}
-        crs = pyproj.CRS.from_json_dict(json.loads(meta[b"geo"])["columns"]["geometry"]["crs"])
-        part = pd.Series(table.column("tile").to_numpy(zero_copy_only=False)).map(groups).to_numpy()
+        crs_json = json.loads(meta[b"geo"])["columns"]["geometry"].get("crs")
+        crs = pyproj.CRS.from_json_dict(crs_json) if crs_json else None
+        part = pd.Series(table.column("tile").to_numpy(zero_copy_only=False)).map(groups)
+        if part.isna().any():
+            raise ValueError(f"{run.output(source)}: rows of tiles without segments in "
+                             f"{run.output(DATASETS['segments'])}")
+        part = part.to_numpy(np.int64)
         order = np.argsort(part, kind="stable")
         table = table.take(order)           # once, in partition order: each partition a slice
         bounds = np.searchsorted(part[order], np.arange(max(groups.values()) + 2))
