@@ -10,6 +10,7 @@ import geopandas as gpd
 import numpy as np
 import pyarrow.parquet as pq
 import pytest
+import trimesh
 from embreex import rtcore_scene
 from embreex.mesh_construction import TriangleMesh
 
@@ -17,6 +18,7 @@ from vipvflow.cli import main
 from vipvflow.config import CityCfg
 from vipvflow.errors import InputError
 from vipvflow.inputs.city import SURFACE_TYPES, ingest_city, load_tile_mesh
+from vipvflow.models.mesh import FACE_ATTRIBUTES
 from vipvflow.inputs.city.synthetic import write_synthetic_city
 from vipvflow.inputs.tiles import tile_bounds, tile_names
 
@@ -61,7 +63,10 @@ def test_contract_files(small_city):
         c = gdf.geometry.centroid
         assert (tile_names(c.x.to_numpy(), c.y.to_numpy(), 200) == name).all()
         mesh = load_tile_mesh(d / "tiled", name)
-        assert mesh.vertices.dtype == np.float64 and mesh.triangles.dtype == np.int32
+        assert isinstance(mesh.trimesh, trimesh.Trimesh)
+        assert mesh.vertices.dtype == np.float64 and mesh.triangles.dtype.kind == "i"
+        assert set(mesh.trimesh.face_attributes) == set(FACE_ATTRIBUTES)
+        assert entry["n_degenerate_triangles"] == mesh.check()["degenerate_triangles"]
         assert mesh.surface_index.dtype == np.int32 and mesh.albedo.dtype == np.float32
         assert mesh.normals.dtype == np.float32 and mesh.surface_type.dtype == np.int8
         assert mesh.n_triangles == entry["n_triangles"] and mesh.buffer_m == 60

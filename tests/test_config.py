@@ -80,7 +80,7 @@ def test_cli_bad_config_is_one_line(tmp_path, capsys):
 
 
 def test_scenarios_by_name_from_any_directory(tmp_path, monkeypatch):
-    """The shipped scenarios by name, and the repository's former conf/<name>.yaml paths;
+    """The shipped scenarios by name, and the repository's conf/<name>.yaml paths from anywhere;
     a local file of that name wins."""
     from vipvflow.config import scenario_path, shipped_scenarios
 

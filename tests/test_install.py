@@ -33,8 +33,9 @@ def installed(tmp_path_factory) -> dict:
     entry (no network, no editable vipvflow: that one's .pth file is not read)."""
     tmp = tmp_path_factory.mktemp("install")
     src = tmp / "src_copy"
-    shutil.copytree(ROOT / "src", src / "src",
-                    ignore=shutil.ignore_patterns("__pycache__", "*.egg-info"))
+    for folder in ("src", "conf"):
+        shutil.copytree(ROOT / folder, src / folder,
+                        ignore=shutil.ignore_patterns("__pycache__", "*.egg-info"))
     for name in ["pyproject.toml", "README.md", "LICENSE"]:
         shutil.copy(ROOT / name, src / name)
     env = {k: v for k, v in os.environ.items() if not k.startswith("PYTHON")}
@@ -65,6 +66,20 @@ def test_wheel_carries_configuration_and_licence(installed):
     text = zipfile.ZipFile(installed["wheel"]).read(meta).decode()
     assert "License-Expression: MIT" in text
     assert "Provides-Extra: db" in text and "Provides-Extra: app" in text
+
+
+def test_the_wheel_names_every_package_and_conf_has_one_copy():
+    """pyproject.toml lists the packages by hand (conf/ is mapped in as ``vipvflow.conf``):
+    every package under src/ is in the list, and the shipped YAML files exist once, in conf/."""
+    import tomllib
+
+    setup = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]
+    found = {".".join(p.parent.relative_to(ROOT / "src").parts)
+             for p in (ROOT / "src").rglob("__init__.py")}
+    assert set(setup["packages"]) == found | {"vipvflow.conf"}
+    assert setup["package-dir"]["vipvflow.conf"] == "conf"
+    assert sorted(p.name for p in (ROOT / "conf").glob("*.yaml")) == sorted(SHIPPED + ["paper.yaml"])
+    assert not list((ROOT / "src").rglob("*.yaml"))
 
 
 def test_installed_config_from_another_directory(installed, tmp_path):

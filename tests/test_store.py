@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 
 import numpy as np
 import pandas as pd
@@ -27,7 +28,7 @@ def _named_by_store(data_dir, run_dir) -> set:
     city, gtfs, rad = data.city, data.gtfs, data.radiation
     names = {city.tiles_json, city.report, city.stamp, city.terrain, city.coverage, gtfs.feed_json, gtfs.stamp,
              rad.table, rad.report, rad.stamp, run.manifest, run.config_stamp, run.report,
-             run.output("summary.json")}
+             run.output("summary.json"), run.output("city.glb")}
     names |= {city.mesh(t) for t in tiles} | {city.surface_part(t) for t in tiles}
     names |= {gtfs.table(n) for n in GTFS_TABLES}
     names |= {run.output(f"{name}.parquet") for name in OUTPUTS}
@@ -46,12 +47,15 @@ def test_every_file_of_a_run_is_one_the_store_names(small_run):
     data = DataDir(open_run(run.root).data_dir)
     named = _named_by_store(data.root, run.root)
     written = {p for root in (data.root, run.root) for p in root.rglob("*") if p.is_file()}
-    # figures, VECTO files and the sun caches are named by the modules that draw or compute them,
-    # in the folders the store gives them
+    # figures, VECTO files, the datasets' partitions and the sun caches are named by the modules
+    # that draw or compute them, in the folders the store gives them
+    datasets = {run.dataset("segments"), run.dataset("segment_month")}
     free = [p for p in written
-            if run.figures in p.parents or run.vecto in p.parents
+            if run.figures in p.parents or run.vecto in p.parents or p.parent in datasets
             or (p.parent == data.radiation.root and p.name.startswith("sun_"))]
     assert all(p.suffix == ".png" for p in free if run.figures in p.parents)
+    parts = [p.name for p in free if p.parent in datasets]
+    assert parts and all(re.fullmatch(r"part\.\d+\.parquet", n) for n in parts), parts
     unnamed = sorted(str(p) for p in written - named - set(free))
     assert unnamed == [], "files the store does not name (or temporaries left):\n" + "\n".join(unnamed)
     # and the run wrote what the store promises: every partition of every tile it computed

@@ -2,9 +2,10 @@
 
 ``default.yaml`` holds every default; a scenario YAML (``demo.yaml``, ``luxembourg.yaml`` or
 a user's file) overrides any part of it.  Catalog entries (vehicles in ``vehicles.yaml``, PV
-systems in ``pv_systems.yaml``) are chosen by name.  The shipped files live inside the package
-(``src/vipvflow/conf/``, found with importlib.resources), so an installed vipvflow has them;
-``$VIPVFLOW_CONF_DIR`` replaces that folder.  A wrong key or value raises :class:`ConfigError`
+systems in ``pv_systems.yaml``) are chosen by name.  The shipped files live in the repository's
+top-level ``conf/``, installed as the package data of ``vipvflow.conf`` (pyproject.toml maps that
+package to ``conf/``), so an installed vipvflow has them; ``$VIPVFLOW_CONF_DIR`` replaces that
+folder.  A wrong key or value raises :class:`ConfigError`
 naming the file, the key and the reason.
 """
 from __future__ import annotations
@@ -13,7 +14,7 @@ import copy
 import hashlib
 import json
 import os
-from importlib import resources
+from importlib.util import find_spec
 from pathlib import Path
 from typing import Any, Literal
 
@@ -25,7 +26,22 @@ from .errors import ConfigError
 from .models.params import CycleCfg, IrradianceCfg, PVSystem
 from .store import TILE_SIZE_M
 
-CONF_DIR = Path(os.environ.get("VIPVFLOW_CONF_DIR") or str(resources.files("vipvflow") / "conf"))
+
+def _conf_dir() -> Path:
+    """The folder of the shipped YAML files: ``$VIPVFLOW_CONF_DIR``; else the package
+    ``vipvflow.conf`` (a wheel's copy, or the repository's ``conf/`` in an editable install);
+    else, in a source tree on ``sys.path`` without an install, ``conf/`` beside ``src/``."""
+    if os.environ.get("VIPVFLOW_CONF_DIR"):
+        return Path(os.environ["VIPVFLOW_CONF_DIR"])
+    spec = find_spec("vipvflow.conf")
+    if spec is not None and spec.submodule_search_locations:
+        for folder in spec.submodule_search_locations:
+            if (Path(folder) / "default.yaml").is_file():
+                return Path(folder)
+    return Path(__file__).resolve().parents[2] / "conf"
+
+
+CONF_DIR = _conf_dir()
 _NOT_SCENARIOS = {"default", "vehicles", "pv_systems"}
 
 
@@ -36,7 +52,7 @@ def shipped_scenarios() -> list[str]:
 
 def scenario_path(name: str | Path) -> Path:
     """The scenario file *name* stands for: an existing file as given; else a shipped scenario
-    by name (``demo``, ``demo.yaml``, or the repository's former ``conf/demo.yaml``); else
+    by name (``demo``, ``demo.yaml``, or ``conf/demo.yaml`` from outside the repository); else
     *name* unchanged (reading it then reports the missing file)."""
     path = Path(name)
     if path.is_file():

@@ -249,6 +249,14 @@ class RunDir:
         return sorted(self.part_dir(kind).glob(pattern))
 
     figures = _Entry("figures", "The report's PNG figures.")
+    geoparquet = _Entry("geoparquet", "The segment results as partitioned GeoParquet datasets "
+                        "(``geoparquet/<name>/part.<i>.parquet``, spatial partitions).")
+
+    def dataset(self, name: str) -> Path:
+        """``geoparquet/<name>/``: ``segments`` or ``segment_month`` as a dataset of
+        spatial partitions (:mod:`vipvflow.outputs.datasets`)."""
+        return self.geoparquet / name
+
     vecto = _Entry("vecto", "VECTO driving cycles and job files of the run's patterns.")
     report = _Entry("report.html")
 

@@ -1,4 +1,5 @@
-"""``vipvflow export dynamizer``: a run's results as CityGML 3.0 Dynamizers."""
+"""``vipvflow export dynamizer|gltf``: a run's results as CityGML 3.0 Dynamizers, or as a
+3D model (glTF binary) of its buildings and segments."""
 from __future__ import annotations
 
 import argparse
@@ -40,6 +41,27 @@ def register(sub):
     d.add_argument("--segments", type=int, default=None, metavar="N",
                    help="export only the first N selected segments")
     d.set_defaults(func=run)
+    g = kinds.add_parser(
+        "gltf", help="3D model (glTF 2.0 binary) of the run's buildings and yield-coloured segments",
+        description="Write the buildings of the run's tiles (one mesh per building) and its route "
+        "segments (quads at the bus roof's height, coloured by annual PV yield) as a glTF 2.0 "
+        "binary file any 3D viewer opens; coordinates are the model's CRS shifted to a local "
+        "origin, stated in the file's extras. A run writes its own city.glb; see docs/outputs.md.")
+    g.add_argument("run_dir", metavar="RUN_DIR", help="run directory, e.g. out/demo/2024")
+    g.add_argument("--out", "-o", required=True, metavar="CITY.glb", help="file to write")
+    g.set_defaults(func=run_gltf)
+
+
+def run_gltf(args):
+    from ..outputs.gltf import write_gltf
+    from ..simulation.rundir import open_run
+
+    run = open_run(args.run_dir, needs=("city/tiles.json",))
+    res = write_gltf(run.path, args.out, data_dir=run.data_dir)
+    print(f"wrote {res['path']} ({res['path'].stat().st_size:,} bytes): {res['buildings']:,} "
+          f"buildings of {len(res['tiles'])} tiles, {res['segments']:,} segments; "
+          f"{res['crs']} minus origin {', '.join(f'{v:.0f}' for v in res['origin'])}")
+    return 0
 
 
 def run(args):

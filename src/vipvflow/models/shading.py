@@ -262,10 +262,9 @@ def box_mesh(boxes, albedo_wall: float = 0.3, albedo_roof: float = 0.15, name: s
     """
     b = np.asarray(boxes, np.float64).reshape(-1, 6)
     if len(b) == 0:
-        return TileMesh(vertices=np.zeros((0, 3)), triangles=np.zeros((0, 3), np.int32),
-                        surface_index=np.zeros(0, np.int32), surface_ids=np.array([], dtype=str),
-                        albedo=np.zeros(0, np.float32), normals=np.zeros((0, 3), np.float32),
-                        surface_type=np.zeros(0, np.int8), name=name)
+        return TileMesh(np.zeros((0, 3)), np.zeros((0, 3), np.int64), name=name,
+                        surface_index=np.zeros(0, np.int32), albedo=np.zeros(0, np.float32),
+                        normals=np.zeros((0, 3), np.float32), surface_type=np.zeros(0, np.int8))
     x0, y0, z0, x1, y1, z1 = b.T
     corners = np.stack([np.stack([x0, y0, z0], 1), np.stack([x1, y0, z0], 1),
                         np.stack([x1, y1, z0], 1), np.stack([x0, y1, z0], 1),

@@ -615,13 +615,14 @@ FIGURE_ORDER = ("monthly_yield", "battery_month", "soc_day", "ranking", "map_yie
 
 
 def write_report(run_dir: Path, summary: dict, figures: list[tuple[str, str, bytes]], cfg=None,
-                 segments=None) -> Path:
+                 segments=None, model: dict | None = None) -> Path:
     """Write ``report.html`` and ``figures/*.png``.
 
     *figures*: :meth:`Figures.results` (:func:`add_maps`, :func:`add_hourly`,
     :func:`add_routes`, :func:`add_charts`).  *segments*:
     the run's ``segments.parquet`` frame (each segment's year); read from *run_dir* when not
-    given. *cfg*: the run's configuration (its inputs are listed)."""
+    given. *cfg*: the run's configuration (its inputs are listed). *model*: the extras of the
+    run's ``city.glb`` (:func:`vipvflow.outputs.gltf.write_gltf`), linked with its counts."""
     import geopandas as gpd
 
     if segments is None:
@@ -649,6 +650,7 @@ p{{line-height:1.45;max-width:900px}}</style></head><body>
 <h2>The charging plan</h2>{_plan_note(cfg, summary)}
 <h2>Summary</h2>{summary_table(summary)}
 <h2>Inputs</h2>{_inputs_table(cfg, crs, len(tiles) if tiles else None)}
+{_model_3d(model)}
 {''.join(parts)}</body></html>"""
     return write_text(doc, RunDir(run_dir).report)
 
@@ -679,6 +681,23 @@ def _plan_note(cfg, summary: dict) -> str:
     parts.append("ranking.parquet ranks the blocks and routes by the grid energy PV avoids per "
                  "kWp, with the payback of one bus's system.")
     return "<p>" + " ".join(parts) + "</p>"
+
+
+def _model_3d(model: dict | None) -> str:
+    """The report's link to ``city.glb`` (nothing when the run has none)."""
+    if not model:
+        return ""
+    scale = model.get("colour") or {}
+    origin = ", ".join(f"{v:.0f}" for v in model.get("origin", []))
+    return (f"<h2>3D model</h2><p><a href='city.glb'>city.glb</a> (glTF 2.0 binary; any glTF "
+            f"viewer, Blender, or <code>trimesh.load</code>): the {model['buildings']:,} buildings "
+            f"of the run's {len(model.get('tiles', [])):,} tiles and its {model['segments']:,} "
+            f"route segments coloured by annual PV yield ({html.escape(str(scale.get('column')))}, "
+            f"viridis from {scale.get('min', 0):.0f} to {scale.get('max', 0):.0f} "
+            f"{html.escape(str(scale.get('unit', '')))}). Coordinates: "
+            f"{html.escape(str(model.get('crs')))} minus the origin ({origin}) m, stated in the "
+            "file's extras. Again or elsewhere: <code>vipvflow export gltf RUN_DIR --out "
+            "city.glb</code>.</p>")
 
 
 def _model_note(summary: dict) -> str:

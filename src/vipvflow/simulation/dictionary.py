@@ -513,6 +513,33 @@ def render_markdown() -> str:
         "`parts/geometry/tile=<TILE>.parquet`, the horizon profiles in `parts/horizon/`; the web "
         "app reads them, they are not documented here.",
         "",
+        "## `geoparquet/segments/`, `geoparquet/segment_month/`: the same rows as datasets of "
+        "spatial partitions",
+        "",
+        "The rows of `segments.parquet` and `segment_month.parquet` (same columns) as partitioned "
+        "GeoParquet datasets (`part.<i>.parquet`, written by dask-geopandas): a partition is a "
+        "group of whole tiles of the run, consecutive in the Hilbert order of the tiles (about "
+        "2,000 segments), the same groups in both; each file's GeoParquet metadata holds its "
+        "own bbox, so Dask opens each dataset as one GeoDataFrame with `spatial_partitions` "
+        "(the columns' units as JSON in each file's `vipvflow:columns`):",
+        "",
+        "```python",
+        "import dask_geopandas",
+        "sm = dask_geopandas.read_parquet(\"out/demo/2024/geoparquet/segment_month\")  # sm.spatial_partitions",
+        "```",
+        "",
+        "## `city.glb`: the run in 3D",
+        "",
+        "glTF 2.0 binary (any glTF viewer, Blender, `trimesh.load`): the buildings of the run's "
+        "tiles, one mesh per building (node `building <building_id>`), and the route segments "
+        "as one mesh (node `segments`; each segment a 2.5 m quad at roof height on the right of "
+        "its direction of travel, faces `2k` and `2k+1` for `segment_ids[k]` of the mesh's "
+        "extras) coloured by `kwh_per_kwp_year` (viridis, lowest to highest). Coordinates: the "
+        "city's CRS minus a local origin (m, x east, y north, z up; the node `city` turns them "
+        "into glTF's y-up); the scene's extras state `crs`, `origin`, `buildings`, `segments`, "
+        "`tiles` and the colour scale. `vipvflow export gltf RUN_DIR --out FILE.glb` writes it "
+        "again or elsewhere.",
+        "",
     ]
     for name, spec in OUTPUTS.items():
         lines += [f"## `{name}.parquet`: {spec.title}", "", f"{spec.rows[0].upper()}{spec.rows[1:]}.", "",

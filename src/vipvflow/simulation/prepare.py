@@ -83,6 +83,7 @@ def ensure_ingested(cfg: Config, say=print) -> dict:
     from ..inputs.cams import ingest_cams
     from ..inputs.city import ingest_city
     from ..inputs.gtfs import ingest_gtfs
+    from ..models.mesh import MESH_FORMAT
 
     data_dir = Path(cfg.data_dir)
     city_files = [Path(p) for p in cfg.inputs.citygml]
@@ -96,9 +97,11 @@ def ensure_ingested(cfg: Config, say=print) -> dict:
         raise InputError(f"{cfg._source}: inputs.gtfs and inputs.cams are required")
 
     # the ingests' format versions: a data dir ingested before (city: no meshes for the
-    # tiles within the buffer, no coverage area; GTFS: no ground sources) is ingested again
+    # tiles within the buffer, no coverage area, an older mesh file; GTFS: no ground sources)
+    # is ingested again
     city_fp = _fingerprint(city_files, {"city": cfg.city.model_dump(mode="json"),
-                                        "crs": cfg.inputs.citygml_crs, "format": 2})
+                                        "crs": cfg.inputs.citygml_crs, "format": 2,
+                                        "mesh_format": MESH_FORMAT})
     data = DataDir(data_dir)
     stamp = data.city.stamp
     if city_files and not _cached(stamp, city_fp):

@@ -600,7 +600,8 @@ def _soc_traces(bd: pd.DataFrame, with_pv: dict, no_pv: dict, trip_t0, trip_t1, 
 def reduce_run(cfg: Config, year: int, run_dir: Path, say=print, client=None, cluster_done=None,
                timings: dict | None = None, consumption: Consumption | None = None) -> dict:
     """Write trip_energy, segments, segment_month, route_month, block_day, monthly, hourly
-    outputs, ``summary.json`` and ``report.html``; return the summary.
+    outputs, ``summary.json``, ``city.glb``, the ``geoparquet/`` datasets and ``report.html``;
+    return the summary.
 
     The partitions are read and summed by tasks on the cluster of *client* (its workers see
     *run_dir* at the same path), or in this process without one (:func:`partial_sums`);
@@ -609,7 +610,8 @@ def reduce_run(cfg: Config, year: int, run_dir: Path, say=print, client=None, cl
     (the run shuts its cluster down then, while this process writes the report).  The
     seconds of each step are added to *timings* (``reduce_<step>_s``).  *consumption*: the
     trip patterns' consumption already submitted to the cluster (:func:`consumption_tasks`)."""
-    from ..outputs import report
+    from ..outputs import gltf, report
+    from ..outputs.datasets import write_datasets
 
     clock = _Clock(timings)
     parts = partial_sums(run_dir, client)
@@ -627,6 +629,10 @@ def reduce_run(cfg: Config, year: int, run_dir: Path, say=print, client=None, cl
     _, segments, sm = _segment_outputs(cfg, run_dir, parts["segment_month"], parts["geometry"],
                                        totals, n_buses, trips_meta)
     report.add_maps(figures, run_dir, cfg)
+    # beside the figures, from the files just written: city.glb and the GeoParquet datasets
+    model = _Aside(client, "city-glb", gltf.write_gltf, str(run_dir),
+                   str(RunDir(run_dir).output("city.glb")), str(cfg.data_dir))
+    datasets = _Aside(client, "geoparquet-datasets", write_datasets, str(run_dir))
     clock("segments")
     trip, bd, idle, traces = _trip_outputs(cfg, year, run_dir, totals, placed, trips_meta, say,
                                            consumption)
@@ -648,12 +654,26 @@ def reduce_run(cfg: Config, year: int, run_dir: Path, say=print, client=None, cl
     report.add_charts(figures, summary, monthly)
     clock("fleet")
     drawn = figures.results()
+    glb = model.result()
+    datasets.result()
     clock("figures")
     if cluster_done is not None:
         cluster_done()
-    report.write_report(run_dir, summary, drawn, cfg=cfg, segments=segments)
+    report.write_report(run_dir, summary, drawn, cfg=cfg, segments=segments, model=glb)
     clock("report")
     return summary
+
+
+class _Aside:
+    """``fn(*args)`` on a worker of *client* while the reduce goes on (like the report's
+    figures), or at once here without one; :meth:`result` waits for its result."""
+
+    def __init__(self, client, key: str, fn, *args):
+        self._client = client
+        self._job = client.submit(fn, *args, pure=False, key=key) if client is not None else fn(*args)
+
+    def result(self):
+        return self._client.gather(self._job) if self._client is not None else self._job
 
 
 class _Clock:

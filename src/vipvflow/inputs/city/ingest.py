@@ -85,6 +85,7 @@ class IngestReport:
     coverage: dict = field(default_factory=dict)           # the area the model covers (coverage.py)
     triangles: int = 0
     terrain_triangles: int = 0
+    degenerate_triangles: int = 0                          # in the tile meshes, found by trimesh (kept)
     elapsed_s: float = 0.0
     report_path: str = ""
 
@@ -303,19 +304,24 @@ def _write_tile(name: str, spool: Path, city_dir: Path, cfg: CityCfg, crs: str):
     n_own = int(own.sum())
     # -- surfaces (own) -> GeoParquet (a tile reached only by the buffer has none: no file)
     grown = _write_surfaces(chunk.take(np.arange(n_own)), name, city_dir, crs) if n_own else None
-    # -- mesh (own + buffer)
-    vo = _offsets(chunk.vsz)
-    tri_owner = np.repeat(np.arange(chunk.n, dtype=np.int32), chunk.tsz)
-    triangles = (chunk.T + vo[:-1][tri_owner][:, None]).astype(np.int32)
+    # -- mesh: the tile's own surfaces, then those of its buffer, merged and checked by trimesh
     bounds = np.array(tile_bounds(name, cfg.tile_size_m))
-    mesh = TileMesh(vertices=chunk.V, triangles=triangles, surface_index=tri_owner,
-                    surface_ids=chunk.sid, albedo=chunk.albedo[tri_owner],
-                    normals=chunk.normal[tri_owner].astype(np.float32),
-                    surface_type=chunk.code[tri_owner], bounds=bounds,
-                    buffer_m=float(cfg.buffer_m), name=name)
+    parts = [_surface_mesh(chunk.take(idx), name, bounds, cfg.buffer_m)
+             for idx in (np.arange(n_own), np.arange(n_own, chunk.n))]
+    mesh = TileMesh.merge(parts)
+    counts = mesh.check(f"tile {name}")
     mesh.save(CityDir(city_dir).mesh(name))
     return {"bounds": bounds.tolist(), "n_surfaces": n_own,
-            "n_buffer_surfaces": int(chunk.n - n_own), "n_triangles": int(len(triangles))}, grown
+            "n_buffer_surfaces": int(chunk.n - n_own), "n_triangles": counts["triangles"],
+            "n_degenerate_triangles": counts["degenerate_triangles"]}, grown
+
+
+def _surface_mesh(chunk: _Chunk, name: str, bounds: np.ndarray, buffer_m: float) -> TileMesh:
+    """The triangles of the surfaces of *chunk* as one mesh (each surface's albedo, type and
+    normal on its triangles)."""
+    return TileMesh.build(chunk.V, chunk.T, (chunk.vsz, chunk.tsz), chunk.sid, bounds=bounds,
+                          buffer_m=float(buffer_m), name=name, albedo=chunk.albedo,
+                          normals=chunk.normal.astype(np.float32), surface_type=chunk.code)
 
 
 def ingest_city(paths, data_dir, city_cfg: CityCfg | None = None, crs: str | None = None,
@@ -481,6 +487,7 @@ def _sum_up(report: IngestReport, counts: _Counts, ignored: Counter, tiles: dict
     report.buildings_by_lod = dict(counts.lods)
     report.tiles = len(tiles)
     report.triangles = int(sum(t["n_triangles"] for t in tiles.values()))
+    report.degenerate_triangles = int(sum(t["n_degenerate_triangles"] for t in tiles.values()))
     report.terrain_triangles = terrain_triangles
 
 

@@ -1,0 +1,134 @@
+"""The run's segment results as partitioned GeoParquet datasets with spatial partitions.
+
+``segments.parquet`` and ``segment_month.parquet`` are single files (what QGIS, DuckDB, the
+web app and the database mirror read).  Beside them the reduce writes the same rows as two
+datasets a Dask GIS user opens as one GeoDataFrame each::
+
+    import dask_geopandas
+    sm = dask_geopandas.read_parquet("out/demo/2024/geoparquet/segment_month")
+    sm.spatial_partitions          # one box per partition, from each file's GeoParquet bbox
+
+A partition is a group of whole tiles of the run, consecutive in the Hilbert order of the
+tiles' centres (a compact patch of the city), of about :data:`SEGMENTS_PER_PARTITION`
+segments; both datasets use the same groups, so partition ``i`` of ``segments`` and of
+``segment_month`` cover the same streets.  Written by dask-geopandas (``to_parquet``: per file
+the GeoParquet metadata with its own bbox; the data dictionary's columns as JSON in each
+file's ``vipvflow:columns`` key), each dataset folder swapped in as a whole.
+"""
+from __future__ import annotations
+
+import json
+import uuid
+from pathlib import Path
+
+import numpy as np
+
+from ..store import RunDir, staging_dir, swap_dir
+
+#: segments per partition the tiles are grouped to (a tile is never split)
+SEGMENTS_PER_PARTITION = 2000
+#: the datasets: name -> the run output holding the same rows
+DATASETS = {"segments": "segments.parquet", "segment_month": "segment_month.parquet"}
+
+
+def tile_groups(segments, per_partition: int = SEGMENTS_PER_PARTITION) -> dict[str, int]:
+    """The partition of each tile: tiles in the Hilbert order of their segments' mean
+    midpoint (*segments*: ``tile, x, y, x_end, y_end``), cut into groups of about
+    *per_partition* segments (whole tiles)."""
+    import geopandas as gpd
+    import pandas as pd
+
+    counts = segments.groupby("tile").size()
+    mid = pd.DataFrame({"tile": segments["tile"].to_numpy(),
+                        "x": (segments["x"].to_numpy() + segments["x_end"].to_numpy()) / 2,
+                        "y": (segments["y"].to_numpy() + segments["y_end"].to_numpy()) / 2})
+    mean = mid.groupby("tile")[["x", "y"]].mean().loc[counts.index]
+    points = gpd.GeoSeries(gpd.points_from_xy(mean["x"], mean["y"]), index=mean.index)
+    order = points.hilbert_distance().sort_values(kind="stable").index
+    group, filled, out = 0, 0, {}
+    for tile in order:
+        if filled and filled + counts[tile] > per_partition:
+            group, filled = group + 1, 0
+        out[tile] = group
+        filled += int(counts[tile])
+    return out
+
+
+def write_datasets(run_dir, per_partition: int = SEGMENTS_PER_PARTITION) -> dict:
+    """Write ``geoparquet/segments/`` and ``geoparquet/segment_month/`` from the run's
+    ``segments.parquet`` and ``segment_month.parquet``; return the partitions of each."""
+    import dask.dataframe as dd
+    import dask_geopandas  # noqa: F401  (registers the GeoDataFrame backend of dask)
+    import pandas as pd
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+    import pyproj
+
+    run = RunDir(run_dir)
+    segments = pd.read_parquet(run.output(DATASETS["segments"]),
+                               columns=["tile", "x", "y", "x_end", "y_end"])
+    groups = tile_groups(segments, per_partition)
+    out = {}
+    if not groups:                          # a run without segments: no dataset
+        return out
+    for name, source in DATASETS.items():
+        # the rows as Arrow (geometry as WKB); each partition becomes a GeoDataFrame in its
+        # own task, so one partition's geometries are decoded at a time
+        table = pq.read_table(run.output(source))
+        meta = table.schema.metadata or {}
+        crs_json = json.loads(meta[b"geo"])["columns"]["geometry"].get("crs")
+        crs = pyproj.CRS.from_json_dict(crs_json) if crs_json else None
+        part = pd.Series(table.column("tile").to_numpy(zero_copy_only=False)).map(groups)
+        if part.isna().any():
+            raise ValueError(f"{run.output(source)}: rows of tiles without segments in "
+                             f"{run.output(DATASETS['segments'])}")
+        part = part.to_numpy(np.int64)
+        order = np.argsort(part, kind="stable")
+        table = table.take(order)           # once, in partition order: each partition a slice
+        bounds = np.searchsorted(part[order], np.arange(max(groups.values()) + 2))
+        pieces = [(int(a), int(b)) for a, b in zip(bounds[:-1], bounds[1:])]
+        custom = {k: v for k, v in meta.items() if k.startswith(b"vipvflow:")}
+        final = run.dataset(name)
+        stage = staging_dir(final)
+        rows = _Rows(table, crs)
+        ddf = dd.from_map(rows, pieces, meta=rows((0, 0)), enforce_metadata=False)
+        # month a date, as in the single file (pandas holds dates as timestamps)
+        ddf.to_parquet(stage, write_index=False, custom_metadata=custom, overwrite=False,
+                       schema={"month": pa.date32()} if "month" in table.column_names else "infer",
+                       compute_kwargs={"scheduler": "sync"})
+        swap_dir(stage, final)
+        out[name] = len(pieces)
+        del table, ddf
+    return out
+
+
+class _Rows:
+    """``rows((a, b))``: rows a:b of an Arrow table of a run output as a GeoDataFrame
+    (columns in the file's order).  Named for Dask by a random token: hashing the table to
+    name the tasks cost more than writing it."""
+
+    def __init__(self, table, crs):
+        self.table, self.crs, self.token = table, crs, uuid.uuid4().hex
+
+    def __dask_tokenize__(self):
+        return self.token
+
+    def __call__(self, rows):
+        import geopandas as gpd
+        import pandas as pd
+
+        df = self.table.slice(rows[0], rows[1] - rows[0]).to_pandas()
+        if "month" in df:
+            df["month"] = pd.to_datetime(df["month"])
+        df["geometry"] = gpd.GeoSeries.from_wkb(df["geometry"].to_numpy(), crs=self.crs)
+        return gpd.GeoDataFrame(df, geometry="geometry", crs=self.crs)
+
+
+def read_dataset(run_dir, name: str):
+    """The dataset *name* (``segments`` or ``segment_month``) of a run as a dask-geopandas
+    GeoDataFrame with its ``spatial_partitions``."""
+    import dask_geopandas
+
+    if name not in DATASETS:
+        raise ValueError(f"no dataset {name!r}: {', '.join(DATASETS)}")
+    return dask_geopandas.read_parquet(Path(RunDir(run_dir).dataset(name)))
