@@ -553,7 +553,8 @@ def _battery_day(cfg: Config, run_dir: Path, bd: pd.DataFrame, idx, trip: pd.Dat
     before = np.column_stack([with_pv["soc_start"], with_pv["soc_after_layover"][:, :-1]])
     r = row.reindex(pd.MultiIndex.from_frame(trip[key])).to_numpy()
     soc_dep = before[r, np.clip(position, 0, K - 1)]
-    fail = pd.to_datetime(with_pv["fail_utc"], unit="s", utc=True)
+    # to the second (interpolated within a trip: finer would be false precision)
+    fail = pd.to_datetime(np.round(with_pv["fail_utc"]), unit="s", utc=True)
     grid_pv = with_pv["depot_grid_kwh"] + with_pv["opportunity_grid_kwh"]
     grid_nopv = no_pv["depot_grid_kwh"] + no_pv["opportunity_grid_kwh"]
     return {
