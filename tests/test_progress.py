@@ -166,10 +166,13 @@ def test_simulate_into_a_log_reads_line_by_line(small_config, tmp_path):
     path.write_text(yaml.safe_dump(conf))
     log = tmp_path / "log"
     env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(ROOT / "src"), os.environ.get("PYTHONPATH", "")])}
+    with socket.socket() as s:           # a free port for the dashboard (--dashboard-port)
+        s.bind(("", 0))
+        port = s.getsockname()[1]
     with open(log, "w") as fh:
         res = subprocess.run([sys.executable, "-m", "vipvflow.cli", "simulate", "--config", str(path),
-                              "--year", "2024", "--workers", "1"], stdout=fh, stderr=subprocess.STDOUT,
-                             env=env, cwd=tmp_path, timeout=600)
+                              "--year", "2024", "--workers", "1", "--dashboard-port", str(port)],
+                             stdout=fh, stderr=subprocess.STDOUT, env=env, cwd=tmp_path, timeout=600)
     text = log.read_text()
     assert res.returncode == 0, text
     assert "\r" not in text
@@ -177,7 +180,7 @@ def test_simulate_into_a_log_reads_line_by_line(small_config, tmp_path):
     n = int(re.search(r"= (\d+) partitions", text).group(1))
     assert any(l.startswith(f"map: {n} of {n} partitions (100 %)") and "M passes/s" in l for l in lines)
     assert any(re.match(r"reduce: \d+ files, .*last ", l) for l in lines)
-    assert re.search(r"^dask dashboard: http://\S+:\d+/status$", text, flags=re.M)
+    assert re.search(rf"^dask dashboard: http://\S+:{port}/status$", text, flags=re.M)
     quiet = subprocess.run([sys.executable, "-m", "vipvflow.cli", "simulate", "--config", str(path),
                             "--year", "2024", "--workers", "1", "--quiet"], capture_output=True,
                            text=True, env=env, cwd=tmp_path, timeout=600)

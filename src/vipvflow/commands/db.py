@@ -6,17 +6,22 @@ import sys
 
 def register(sub):
     p = sub.add_parser("db", help="start / stop a local PostgreSQL+PostGIS server",
-                       description="A throwaway PostgreSQL + PostGIS cluster in one folder, "
-                       "listening on 127.0.0.1 with trust authentication (as the postgres "
-                       "system user when run as root). `start` prints the DSN to pass to "
-                       "`vipvflow mirror --db`.")
+                       description="A throwaway PostgreSQL + PostGIS cluster in one folder "
+                       "(DIR/pgdata, DIR/socket, DIR/postgresql.log), run as the postgres system "
+                       "user when started as root. Authentication: on TCP it listens on "
+                       "127.0.0.1 only and asks for the password of role postgres "
+                       "(scram-sha-256), generated on the first start, printed once on stderr "
+                       "and kept in DIR/pgpass (mode 0600); the unix socket in DIR/socket "
+                       "(folder mode 0700) trusts the server's own user. `start` prints the "
+                       "DSN to pass to `vipvflow mirror --db` on stdout: it names DIR/pgpass "
+                       "(?passfile=) and holds no password.")
     actions = p.add_subparsers(dest="action", metavar="ACTION", required=True)
     start = actions.add_parser("start", help="create (first time) and start the server; print its DSN")
     start.add_argument("--dir", required=True, help="folder of the cluster (e.g. data/pg)")
     start.add_argument("--port", type=int, default=None, help="TCP port (default: a free one)")
     start.set_defaults(func=run_start)
     stop = actions.add_parser("stop", help="stop the server")
-    stop.add_argument("--dir", required=True)
+    stop.add_argument("--dir", required=True, help="folder of the cluster given to start")
     stop.set_defaults(func=run_stop)
 
 
