@@ -61,7 +61,9 @@ def test_outputs_written(small_run):
         if (small_run.parents[2].parent / "demo_small_inputs.json").exists() else None
     assert trips["consumption_kwh"].gt(0).all() and trips["pv_kwh"].ge(0).all()
     html = (small_run / "report.html").read_text()
-    assert html.count("data:image/png;base64") == 6
+    from vipvflow.outputs.report import FIGURE_ORDER
+
+    assert html.count("data:image/png;base64") == len(FIGURE_ORDER)
     del layout
 
 
