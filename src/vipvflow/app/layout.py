@@ -335,7 +335,7 @@ def _views(model: TripModel) -> SimpleNamespace:
     seg_r = f_map.segment("x", "y", "x_end", "y_end", source=src_seg, line_width=6,
                           color={"field": "total", "transform": mapper})
     stop_r = f_map.scatter("x", "y", source=src_stop, size="size", fill_color={"field": "total", "transform": mapper},
-                           line_color="#d62728", line_width=2, fill_alpha=0.9)
+                           line_color="#d62728", line_width=1.2, fill_alpha=0.8)
     f_map.add_layout(ColorBar(color_mapper=mapper, orientation="horizontal", height=10,
                               title="W/m2 while passing, with the buildings",
                               title_text_font_size="8pt", major_label_text_font_size="8pt"), "below")
@@ -384,10 +384,12 @@ def _monthly_figure(src_mon: ColumnDataSource):
                color="#ff7f0e", legend_label="all-sky")
     f_mon.vbar(x=dodge("month", 0.18, range=f_mon.x_range), top="clearsky", width=0.34, source=src_mon,
                color="#1f77b4", legend_label="clear-sky")
-    f_mon.scatter(x=dodge("month", -0.18, range=f_mon.x_range), y="allsky_unshaded", source=src_mon,
-                  marker="dash", size=30, color="black", legend_label="without buildings")
-    f_mon.scatter(x=dodge("month", 0.18, range=f_mon.x_range), y="clearsky_unshaded", source=src_mon,
-                  marker="dash", size=30, color="black")
+    # the energy without buildings: a mark as wide as its bar, whatever the plot's width
+    for offset, column_name, label in ((-0.18, "allsky_unshaded", {"legend_label": "without buildings"}),
+                                       (0.18, "clearsky_unshaded", {})):
+        f_mon.segment(x0=dodge("month", offset - 0.17, range=f_mon.x_range), y0=column_name,
+                      x1=dodge("month", offset + 0.17, range=f_mon.x_range), y1=column_name,
+                      source=src_mon, color="black", line_width=2, **label)
     f_mon.add_tools(HoverTool(tooltips=[("month", "@month"), ("all-sky", "@allsky{0,0} kWh"),
                                         ("clear-sky", "@clearsky{0,0} kWh"),
                                         ("shading loss", "@shading_loss{0.0%}")]))
@@ -395,7 +397,11 @@ def _monthly_figure(src_mon: ColumnDataSource):
     f_mon.legend.location = "top_left"
     f_mon.legend.background_fill_alpha = 0.75
     f_mon.legend.label_text_font_size = "8.5pt"
-    f_mon.xaxis.major_label_text_font_size = "11pt"
+    f_mon.xaxis.major_label_text_font_size = "10pt"
+    # month names slanted when the plot is too narrow for them side by side (a phone)
+    f_mon.js_on_change("inner_width", CustomJS(args={"axis": f_mon.xaxis[0]}, code=(
+        "const slant = cb_obj.inner_width < 60 * cb_obj.x_range.factors.length; "
+        "axis.major_label_orientation = slant ? 0.9 : 'horizontal';")))
     return f_mon
 
 
@@ -515,7 +521,7 @@ def _wire(model: TripModel, c: SimpleNamespace, v: SimpleNamespace):
                                "time": st["time"].to_numpy(), "total": st["total"].to_numpy(),
                                "dwell_s": st["dwell_s"].to_numpy(),
                                "energy_wh": 1000.0 * st["energy_kwh"].to_numpy(),
-                               "size": 6.0 + 2.0 * np.sqrt(st["dwell_s"].to_numpy())}
+                               "size": 4.0 + np.sqrt(st["dwell_s"].to_numpy())}
             # one scale for the light with and without buildings: the shade shows as dark
             v.mapper.high = max(float(s["unshaded"].max()) if len(s) else 0.0, 1.0)
             cyc = res.cycle
