@@ -196,6 +196,27 @@ def test_report_reads(small_run):
         assert (small_run / "figures" / f"{name}.png").stat().st_size > 10_000, name
 
 
+def test_report_carries_its_own_data_dictionary(small_run):
+    """report.html explains every column of every output file and every summary key itself
+    (a pip install has no docs/): no link to docs/outputs.md, the links go to its section."""
+    import html as h
+
+    from vipvflow.simulation.dictionary import SUMMARY
+
+    text = (small_run / "report.html").read_text(encoding="utf-8")
+    assert "docs/outputs.md" not in text
+    assert 'id="data-dictionary"' in text and text.count("href='#data-dictionary'") >= 1
+    dictionary = text.split('id="data-dictionary"', 1)[1]
+    for name, spec in OUTPUTS.items():
+        assert f"<code>{name}.parquet</code>" in dictionary, name
+        for c in spec.columns:
+            e = describe(name, c)
+            assert f"<tr><td><code>{c}</code></td><td>{h.escape(e.unit)}</td><td>{h.escape(e.meaning)}</td></tr>" \
+                in dictionary, (name, c)
+    assert all(f"<code>{k}</code>" in dictionary for k in SUMMARY)
+    assert "timestamp (UTC)" in dictionary and "date32" in dictionary
+
+
 def test_monthly_chart_stacks_driving_in_service_and_whole_day(small_run):
     """The monthly chart's bars: driving, then terminals on top (in service), then parked
     time (whole day), each month's stack summing to the monthly table's whole-day yield, in

@@ -591,5 +591,34 @@ def render_markdown() -> str:
     return "\n".join(lines)
 
 
+def render_html() -> str:
+    """The data dictionary as HTML for the report (the report carries its own: a pip install
+    has no docs/ folder): an introduction, then each output file's columns and
+    ``summary.json``'s keys, each in a ``<details>`` block."""
+    import html
+
+    def row(name: str, e: Column) -> str:
+        return (f"<tr><td><code>{html.escape(name)}</code></td><td>{html.escape(e.unit)}</td>"
+                f"<td>{html.escape(e.meaning)}</td></tr>")
+
+    parts = ["<p>Every Parquet file of the run carries the unit and meaning of each column (Arrow "
+             "field metadata <code>unit</code>, <code>description</code>; for other readers JSON in "
+             "the key-value metadata <code>vipvflow:columns</code>). Dates (<code>service_date</code>, "
+             "<code>month</code>: a day of the feed's local calendar, a month as its first day) are "
+             "Parquet <code>date32</code>; instants (<code>*_utc</code>) are timestamps in "
+             "microseconds with time zone UTC. <code>fraction</code> is 0..1; W/m2 irradiance, "
+             "Wh/m2 and kWh/m2 irradiation.</p>"]
+    for name, spec in OUTPUTS.items():
+        rows = "".join(row(c, describe(name, c)) for c in spec.columns)
+        parts.append(f"<details><summary><code>{name}.parquet</code>: {html.escape(spec.title)} "
+                     f"({html.escape(spec.rows)})</summary><table class='dictionary'>"
+                     f"<tr><th>column</th><th>unit</th><th>meaning</th></tr>{rows}</table></details>")
+    rows = "".join(row(k, e) for k, e in SUMMARY.items())
+    parts.append("<details><summary><code>summary.json</code>: the fleet-year (yearly figures scaled "
+                 "by 12 / months when the run covers fewer)</summary><table class='dictionary'>"
+                 f"<tr><th>key</th><th>unit</th><th>meaning</th></tr>{rows}</table></details>")
+    return "\n".join(parts)
+
+
 if __name__ == "__main__":
     print(render_markdown(), end="")
