@@ -100,6 +100,43 @@ def test_trip_model_components_equal_the_runs(trip_model, small_run):
         1 - (ref["pv_kwh_direct"] + ref["pv_kwh_diffuse"]) / ref["pv_kwh_unshaded"], abs=0.01)
 
 
+@pytest.mark.parametrize("mode", ["paper", "pvlib"])
+def test_trip_shading_loss_is_the_runs_definition_in_both_pv_models(trip_model, small_run, mode):
+    """The app's shading loss of a trip is the run's: 1 - (direct + diffuse) / unshaded light
+    on the roof (models.irradiance.shading_loss on irradiation), whatever the PV model; the
+    run (paper mode, linear) gives the same from its trip's energies."""
+    from vipvflow.app.model import PVChoice
+    from vipvflow.models.irradiance import shading_loss
+
+    res, date = _midday_trip(trip_model)
+    r = trip_model.routes().iloc[0]
+    got = trip_model.trip(r.route_id, int(r.direction_id), date, "12:00",
+                          pv=PVChoice(technology="c-Si", mode=mode, kwp=3.5)).numbers
+    s = res.segments
+    light = {c: float((s[c] * s["dt_s"]).sum()) / 3600.0 for c in ("direct", "diffuse", "unshaded")}
+    expected = float(shading_loss(light["direct"], light["diffuse"], light["unshaded"]))
+    assert got["shading_loss"] == pytest.approx(expected, rel=1e-9)
+    assert got["h_unshaded"] == pytest.approx(light["unshaded"], rel=1e-9)
+    assert 0.01 < expected < 0.9
+    te = pd.read_parquet(Path(small_run) / "trip_energy.parquet")
+    ref = te[(te["trip_id"] == res.trip_id) & (pd.to_datetime(te["service_date"]) == date)].iloc[0]
+    assert trip_model.cfg.pv.mode == "paper"
+    run = float(shading_loss(ref["pv_kwh_direct"], ref["pv_kwh_diffuse"], ref["pv_kwh_unshaded"]))
+    assert got["shading_loss"] == pytest.approx(run, abs=0.01)
+
+
+def test_a_trip_in_the_dark_says_the_sun_is_below_the_horizon(trip_model):
+    """A December trip at 06:00 in Luxembourg (sunrise after 08:00): no light, no 'nan'."""
+    from vipvflow.app.layout import numbers_html
+
+    r = trip_model.routes().iloc[0]
+    res = trip_model.trip(r.route_id, int(r.direction_id), "2024-12-16", "06:00")
+    n = res.numbers
+    assert res.departure.hour < 8 and not n["sun_up"] and n["h_unshaded"] == 0 and n["pv_kwh"] == 0
+    text = numbers_html(res)
+    assert "sun below the horizon" in text and "nan" not in text.lower()
+
+
 def test_trip_model_agrees_with_ray_cast_run(trip_model, small_run):
     """The same scheduled trip, recomputed from horizons (rays where they cannot tell), against the
     simulation's result: unshaded energy equal, sun visibility from horizons equal to
@@ -325,3 +362,172 @@ def test_app_in_browser(chromium, app_url, trip_model, tmp_path):
     outside = [u for u in requests if not (u.startswith(host + "/") or u.startswith("ws://127.0.0.1"))]
     assert not outside, outside
     assert shot.stat().st_size > 10_000
+
+
+#: the app's controls (their css classes) and figures (their names)
+CONTROLS = ["pv-tech", "pv-mode", "pv-kwp", "pv-area", "pv-pr", "pv-losses", "route-select",
+            "date-picker", "depart-slider", "aux-kw", "soc-min", "controls-toggle"]
+FIGURES = ["irradiance", "route-map", "driving-cycle", "soc", "monthly"]
+
+#: page boxes of every figure's canvas and frame, and of the legends and colour bars in it
+_BOXES_JS = """() => {
+  const doc = Bokeh.documents[0];
+  const out = {};
+  for (const name of %s) {
+    const fig = doc.get_model_by_name(name);
+    const view = Bokeh.index.find_one(fig);
+    const c = view.canvas_view.el.getBoundingClientRect();
+    const f = view.frame.bbox;
+    const legends = [];
+    for (const m of [...fig.center, ...fig.below, ...fig.above, ...fig.right, ...fig.left]) {
+      if (m.type != "Legend" && m.type != "ColorBar") continue;
+      const b = Bokeh.index.find_one(m).bbox;
+      legends.push({type: m.type, left: c.left + b.left, right: c.left + b.right,
+                    top: c.top + b.top, bottom: c.top + b.bottom});
+    }
+    out[name] = {canvas: {left: c.left, right: c.right, top: c.top, bottom: c.bottom},
+                 frame: {left: c.left + f.left, right: c.left + f.right, top: c.top + f.top,
+                         bottom: c.top + f.bottom}, legends};
+  }
+  return out;
+}""" % json.dumps(FIGURES)
+
+#: what the page shows of the trip: the settings of the numbers, the first time of the
+#: irradiance and the driving cycle (ms, Bokeh's datetime axis), the slider's value
+_SHOWN_JS = """() => {
+  const doc = Bokeh.documents[0];
+  const text = doc.get_model_by_name("numbers").text;
+  const attr = (k) => { const m = text.match(new RegExp('data-' + k + '="([^"]*)"')); return m ? m[1] : null; };
+  const seg = doc.get_model_by_name("trip-segments").data.time;
+  const cyc = doc.get_model_by_name("trip-cycle").data.time;
+  return {slider: doc.get_model_by_name("depart").value, requested: attr("requested"),
+          departure: attr("departure"), t0: Number(attr("t0")),
+          irradiance_t0: seg.length ? Number(seg[0]) : null, cycle_t0: cyc.length ? Number(cyc[0]) : null};
+}"""
+
+
+def _hhmm(minutes: int) -> str:
+    return f"{minutes // 60:02d}:{minutes % 60:02d}"
+
+
+def _inside(box, left, right, what, slack=0.5):
+    assert box["left"] >= left - slack and box["right"] <= right + slack, (what, box, left, right)
+
+
+def test_app_fits_400_1280_and_1920_px(chromium, app_url, artifacts):
+    """At a phone's 400 px, a laptop's 1,280 and a monitor's 1,920: nothing wider than the
+    window, every control and every figure inside it, every legend and colour bar inside
+    its figure (legends inside the plotting frame); the controls fold away and come back."""
+    playwright = pytest.importorskip("playwright.sync_api")
+    errors = []
+    with playwright.sync_playwright() as p:
+        browser = p.chromium.launch(executable_path=str(chromium), args=CHROMIUM_ARGS)
+        try:
+            for width in (400, 1280, 1920):
+                page = browser.new_page(viewport={"width": width, "height": 900})
+                page.on("pageerror", lambda e: errors.append(str(e)))
+                page.goto(app_url)
+                page.wait_for_selector("#pv-kwh", timeout=60_000)
+                page.wait_for_timeout(500)
+                scroll, inner = page.evaluate("() => [document.documentElement.scrollWidth, window.innerWidth]")
+                assert scroll <= inner == width, (width, scroll, inner)
+                for name in CONTROLS:
+                    box = page.locator(f".{name}").bounding_box()
+                    assert box is not None and box["width"] > 50, (width, name, box)
+                    _inside({"left": box["x"], "right": box["x"] + box["width"]}, 0, width, (width, name))
+                boxes = page.evaluate(_BOXES_JS)
+                for name, b in boxes.items():
+                    _inside(b["canvas"], 0, width, (width, name))
+                    for lg in b["legends"]:
+                        _inside(lg, b["canvas"]["left"], b["canvas"]["right"], (width, name, lg["type"]))
+                        assert b["canvas"]["top"] - 0.5 <= lg["top"] and lg["bottom"] <= b["canvas"]["bottom"] + 0.5
+                        if lg["type"] == "Legend":
+                            _inside(lg, b["frame"]["left"], b["frame"]["right"], (width, name, "frame"))
+                            assert b["frame"]["top"] - 0.5 <= lg["top"] and lg["bottom"] <= b["frame"]["bottom"] + 0.5
+                    assert len([lg for lg in b["legends"] if lg["type"] == "Legend"]) == (
+                        0 if name == "driving-cycle" else 1), (name, b["legends"])
+                page.screenshot(path=str(artifacts / f"app_{width}.png"), full_page=True)
+                # the controls fold away: the views take the width, and come back
+                toggle = page.locator(".controls-toggle button")
+                toggle.click()
+                expect_hidden = page.locator(".app-controls")
+                expect_hidden.wait_for(state="hidden", timeout=10_000)
+                assert toggle.inner_text() == "Show controls"
+                toggle.click()
+                page.locator(".app-controls").wait_for(state="visible", timeout=10_000)
+                page.close()
+        finally:
+            browser.close()
+    assert not errors, errors
+
+
+def test_72_departure_keys_end_consistent_at_the_sliders_time(chromium, app_url, trip_model):
+    """72 presses of the arrow key on the departure slider (12:00 -> 18:00): within 2 s of
+    the last, the numbers, the irradiance plot and the driving cycle all show the trip of
+    the slider's time; on the way, every frame shown is one departure (never the irradiance
+    of one trip beside the cycle of another)."""
+    playwright = pytest.importorskip("playwright.sync_api")
+    with playwright.sync_playwright() as p:
+        browser = p.chromium.launch(executable_path=str(chromium), args=CHROMIUM_ARGS)
+        try:
+            page = browser.new_page(viewport={"width": 1280, "height": 900})
+            page.goto(app_url)
+            page.wait_for_selector("#pv-kwh", timeout=60_000)
+            first = page.evaluate(_SHOWN_JS)
+            assert first["slider"] == 12 * 60 and first["requested"] == "12:00"
+            handle = page.locator(".depart-slider .noUi-handle")
+            handle.focus()
+            frames = []
+            for i in range(72):
+                page.keyboard.press("ArrowRight")
+                if i % 6 == 5:
+                    frames.append(page.evaluate(_SHOWN_JS))
+            want = 18 * 60
+            page.wait_for_function(
+                """([js, want]) => { const s = eval(js)();
+                     return s.slider == want && s.requested == want_hhmm(want)
+                         && Math.abs(s.irradiance_t0 - s.t0) < 1 && Math.abs(s.cycle_t0 - s.t0) < 1; }"""
+                .replace("want_hhmm(want)", f"'{_hhmm(want)}'"),
+                arg=[_SHOWN_JS, want], timeout=2_000)
+            last = page.evaluate(_SHOWN_JS)
+        finally:
+            browser.close()
+    for f in frames + [last]:
+        assert abs(f["irradiance_t0"] - f["t0"]) < 1 and abs(f["cycle_t0"] - f["t0"]) < 1, f
+    # the trip shown is the model's: the next scheduled departure at or after 18:00
+    r = last
+    start = default_start(trip_model)
+    res = trip_model.trip(start["route_id"], start["direction_id"], start["date"], want)
+    assert r["departure"] == res.departure.strftime("%H:%M") and res.departure.strftime("%H:%M") >= "18:00"
+
+
+def default_start(model):
+    from vipvflow.app.layout import default_view
+
+    return default_view(model)
+
+
+def test_controls_that_do_not_apply_are_disabled_and_the_shading_loss_stays(chromium, app_url):
+    """In pvlib mode the performance ratio (the paper model's) is disabled and the DC losses
+    enabled, and the other way round; the trip's shading loss (on light) is the same."""
+    playwright = pytest.importorskip("playwright.sync_api")
+    from playwright.sync_api import expect
+
+    state_js = """() => { const d = Bokeh.documents[0];
+        return {pr: d.get_model_by_name("pv-pr").disabled, losses: d.get_model_by_name("pv-losses").disabled,
+                tech: d.get_model_by_name("pv-tech").disabled}; }"""
+    with playwright.sync_playwright() as p:
+        browser = p.chromium.launch(executable_path=str(chromium), args=CHROMIUM_ARGS)
+        try:
+            page = browser.new_page(viewport={"width": 1280, "height": 900})
+            page.goto(app_url)
+            page.wait_for_selector("#pv-kwh", timeout=60_000)
+            assert page.evaluate(state_js) == {"pr": False, "losses": True, "tech": True}
+            loss = page.locator(".shading-loss").inner_text()
+            kwh = page.locator("#pv-kwh").inner_text()
+            page.locator(".pv-mode select").select_option(label="pvlib: PVWatts + cell temperature")
+            expect(page.locator("#pv-kwh")).not_to_have_text(kwh, timeout=30_000)
+            assert page.evaluate(state_js) == {"pr": True, "losses": False, "tech": False}
+            assert page.locator(".shading-loss").inner_text() == loss
+        finally:
+            browser.close()

@@ -85,3 +85,87 @@ def test_unknown_scenario_is_one_line(argv, capsys, tmp_path, monkeypatch):
     assert err.startswith(f"vipvflow {argv[0]}: error: nosuch: file not found")
     assert "demo, luxembourg, paper" in err
     assert list(tmp_path.iterdir()) == []
+
+
+def all_parsers(parser, path=("vipvflow",)):
+    """(path, parser) of the command and every subcommand, at any depth."""
+    yield path, parser
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            for name, child in action.choices.items():
+                yield from all_parsers(child, path + (name,))
+
+
+def test_every_option_and_subcommand_has_help_text():
+    missing = []
+    for path, parser in all_parsers(build_parser()):
+        for action in parser._actions:
+            if isinstance(action, argparse._HelpAction):
+                continue
+            if isinstance(action, argparse._SubParsersAction):
+                helps = {c.dest: c.help for c in action._choices_actions}
+                missing += [" ".join(path + (name,)) for name in action.choices if not helps.get(name)]
+            elif not action.help or action.help == argparse.SUPPRESS:
+                missing.append(f"{' '.join(path)} {'/'.join(action.option_strings) or action.dest}")
+    assert not missing, missing
+
+
+def test_db_help_states_the_servers_authentication():
+    """``vipvflow db --help`` says what the server it starts really does: each pg_hba method
+    of :data:`vipvflow.db.server.HBA` (password on TCP, trust on the private socket), the
+    password file and where the server listens."""
+    from vipvflow.db import server
+
+    text = subprocess.run([sys.executable, "-m", "vipvflow.cli", "db", "--help"], capture_output=True,
+                          text=True, check=True).stdout
+    flat = " ".join(text.split())
+    methods = {line.split()[-1] for line in server.HBA.splitlines() if line and not line.startswith("#")}
+    assert methods == {"trust", "scram-sha-256"}
+    assert "scram-sha-256" in flat and f"DIR/{server.PASSFILE}" in flat and "127.0.0.1 only" in flat
+    assert "socket" in flat and "trusts the server's own user" in flat
+    assert "trust authentication" not in flat
+
+
+def _one_line_error(args):
+    res = subprocess.run([sys.executable, "-m", "vipvflow.cli", *args], capture_output=True,
+                         text=True, timeout=120)
+    assert res.returncode == 2 and res.stdout == "", (res.stdout, res.stderr)
+    lines = res.stderr.splitlines()
+    assert len(lines) == 1 and "Traceback" not in res.stderr, res.stderr
+    return lines[0]
+
+
+def test_app_on_a_busy_port_says_so_in_one_line_with_a_free_port(tmp_path):
+    import re
+    import socket
+
+    with socket.socket() as busy:
+        busy.bind(("127.0.0.1", 0))
+        busy.listen()
+        port = busy.getsockname()[1]
+        line = _one_line_error(["app", str(tmp_path), "--port", str(port)])
+        assert f"port {port} on 127.0.0.1 is in use" in line
+        other = int(re.search(r"try --port (\d+)", line).group(1))
+        with socket.socket() as s:
+            s.bind(("127.0.0.1", other))          # the suggested port is free
+    for bad in ("70000", "0", "http"):
+        line = _one_line_error(["app", str(tmp_path), "--port", bad])
+        assert line.startswith("vipvflow app: error: argument --port:") and "try 5006" in line
+    line = _one_line_error(["app", str(tmp_path), "--host", "no-such-host.invalid"])
+    assert "--host no-such-host.invalid: not an address of this machine" in line
+    # a usage error of any command is one line too, naming the help
+    line = _one_line_error(["simulate"])
+    assert line == "vipvflow simulate: error: the following arguments are required: --year (see vipvflow simulate --help)"
+
+
+def test_simulate_dashboard_port_option():
+    from vipvflow.commands.simulate import scenario
+
+    parser = build_parser()
+    assert scenario(parser.parse_args(["simulate", "--year", "2024"])).dask.dashboard_port == 8787
+    args = parser.parse_args(["simulate", "--year", "2024", "--dashboard-port", "8799"])
+    assert scenario(args).dask.dashboard_port == 8799
+    assert scenario(parser.parse_args(["simulate", "--year", "2024", "--dashboard-port", "0"])
+                    ).dask.dashboard_port is None                 # any free port
+    line = _one_line_error(["simulate", "--year", "2024", "--dashboard-port", "99999"])
+    assert "--dashboard-port: '99999' is not a port number (0..65535): try 8787" in line

@@ -54,6 +54,47 @@ def test_months_are_the_first_day_of_the_simulated_month(small_run):
     assert smg.crs.to_epsg() == 2169 and isinstance(smg["month"].iloc[0], datetime.date)
 
 
+def test_instants_are_utc_timestamps_and_dates_are_date32(small_run):
+    """The schema of every output file: a column the dictionary calls an instant is a
+    timestamp with time zone UTC, one it calls a date a ``date32``, and no other column
+    holds a time (no float Unix seconds, no naive or nanosecond timestamp for a day); the
+    instants are where they should be (a block-day's window holds its first departure)."""
+    from vipvflow.simulation.dictionary import DATE, INSTANT
+
+    seen = {DATE: set(), INSTANT: set()}
+    for name in OUTPUTS:
+        schema = pq.read_schema(small_run / f"{name}.parquet")
+        for field in schema:
+            unit = describe(name, field.name).unit
+            if unit == INSTANT:
+                assert field.type == pa.timestamp("us", tz="UTC"), (name, field.name, field.type)
+            elif unit == DATE:
+                assert field.type == pa.date32(), (name, field.name, field.type)
+            else:
+                assert not pa.types.is_temporal(field.type), (name, field.name, field.type)
+                assert not field.name.endswith("_utc") and "date" not in field.name, (name, field.name)
+            if unit in seen:
+                seen[unit].add(field.name)
+    assert {"window_start_utc", "window_end_utc", "first_departure_utc", "last_arrival_utc",
+            "infeasible_at_utc"} <= seen[INSTANT]
+    assert seen[DATE] == {"service_date", "month"}
+    bd = pd.read_parquet(small_run / "block_day.parquet")
+    assert str(bd["window_start_utc"].dtype) == "datetime64[us, UTC]"
+    assert (bd["window_start_utc"] <= bd["first_departure_utc"]).all()
+    assert (bd["first_departure_utc"] < bd["last_arrival_utc"]).all()
+    assert (bd["last_arrival_utc"] <= bd["window_end_utc"]).all()
+    # the window is the block-day's seconds; it starts on its service date (local calendar,
+    # Luxembourg: UTC+2 in June, so at 22:00 UTC the day before at the latest)
+    seconds = (bd["window_end_utc"] - bd["window_start_utc"]).dt.total_seconds()
+    np.testing.assert_allclose(seconds, bd["window_s"])
+    local = bd["window_start_utc"].dt.tz_convert("Europe/Luxembourg")
+    assert (local.dt.date >= bd["service_date"]).all()
+    # a block-day the plan serves never fails; one whose SoC falls below soc_min says when
+    crossed = bd[~bd["feasible"] & (bd["depot_short_kwh"] == 0)]
+    assert crossed["infeasible_at_utc"].notna().all()
+    assert bd.loc[bd["feasible"], "infeasible_at_utc"].isna().all()
+
+
 def test_writer_keeps_undocumented_columns_and_geometry(tmp_path):
     """A column nobody documented is written without metadata, not refused; a GeoDataFrame
     keeps its CRS and reads back with dates."""
@@ -153,6 +194,27 @@ def test_report_reads(small_run):
     assert f"{100 * s['shading_loss_allsky']:.1f}</td><td>%" in html
     for name in ("map_yield", "map_shading", "monthly_yield", "hourly_pattern", "routes", "avoided_cycles"):
         assert (small_run / "figures" / f"{name}.png").stat().st_size > 10_000, name
+
+
+def test_report_carries_its_own_data_dictionary(small_run):
+    """report.html explains every column of every output file and every summary key itself
+    (a pip install has no docs/): no link to docs/outputs.md, the links go to its section."""
+    import html as h
+
+    from vipvflow.simulation.dictionary import SUMMARY
+
+    text = (small_run / "report.html").read_text(encoding="utf-8")
+    assert "docs/outputs.md" not in text
+    assert 'id="data-dictionary"' in text and text.count("href='#data-dictionary'") >= 1
+    dictionary = text.split('id="data-dictionary"', 1)[1]
+    for name, spec in OUTPUTS.items():
+        assert f"<code>{name}.parquet</code>" in dictionary, name
+        for c in spec.columns:
+            e = describe(name, c)
+            assert f"<tr><td><code>{c}</code></td><td>{h.escape(e.unit)}</td><td>{h.escape(e.meaning)}</td></tr>" \
+                in dictionary, (name, c)
+    assert all(f"<code>{k}</code>" in dictionary for k in SUMMARY)
+    assert "timestamp (UTC)" in dictionary and "date32" in dictionary
 
 
 def test_monthly_chart_stacks_driving_in_service_and_whole_day(small_run):

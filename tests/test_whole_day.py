@@ -227,7 +227,7 @@ def test_small_run_splits_every_block_day(small_run, small_config):
     assert s["pv_kwh_whole_day"] == pytest.approx(parts)
     assert s["pv_kwh_usable"] + s["pv_kwh_curtailed"] == pytest.approx(s["pv_kwh_whole_day"])
     assert s["pv_kwh_usable"] == pytest.approx(bd["pv_kwh_usable"].sum())
-    days = bd.groupby("service_date").size()
+    days = bd.groupby(pd.to_datetime(bd["service_date"])).size()      # dates (date32) as days
     assert s["idle_bus_days"] == int((s["buses"] - days.reindex(pd.date_range("2024-06-01", "2024-06-30"),
                                                                    fill_value=0)).sum())
     # one month run: the annual figures are the month's x 12, coverage on what the battery takes

@@ -46,8 +46,17 @@ typical use:
 """
 
 
+class Parser(argparse.ArgumentParser):
+    """argparse's parser, whose usage errors are one line (what is wrong, where the help is)
+    rather than the usage text and then the error; its subcommands' parsers are of this
+    class too."""
+
+    def error(self, message: str):
+        self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = Parser(
         prog="vipvflow", description=DESCRIPTION,
         formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--version", action="version", version=f"vipvflow {__version__}")

@@ -1,12 +1,15 @@
 """Progress of the long stages (demo generation, CityGML ingest, the map, the reduce).
 
 On a terminal a :mod:`tqdm` bar (rate, ETA); when the stream is not a terminal (``make
-simulate > log``) a plain line every ``every_s`` seconds and one at the end, so a log reads
-line by line without carriage returns; nothing with ``--quiet`` (:func:`set_quiet`).
+simulate > log``), or a terminal that reports no width (0 columns: some CI runners, ``docker
+exec`` without a tty size, serial consoles; a bar there is drawn as blank lines), a plain
+line every ``every_s`` seconds and one at the end, so a log reads line by line without
+carriage returns; nothing with ``--quiet`` (:func:`set_quiet`).
 """
 from __future__ import annotations
 
 import gzip
+import io
 import sys
 import time
 import zipfile
@@ -57,7 +60,7 @@ class Progress:
         self.t0 = self._last = time.perf_counter()
         self.enabled = not _QUIET
         self.bar = None
-        if self.enabled and _isatty(self.stream):
+        if self.enabled and _isatty(self.stream) and terminal_columns(self.stream) != 0:
             from tqdm import tqdm
 
             self.bar = tqdm(total=total, desc=desc, unit=unit, file=self.stream, leave=True,
@@ -133,6 +136,22 @@ def _isatty(stream) -> bool:
         return bool(stream.isatty())
     except (AttributeError, ValueError):
         return False
+
+
+def terminal_columns(stream) -> int | None:
+    """The width of the terminal *stream* writes to: its window size, else ``$COLUMNS``
+    when the terminal reports 0 columns; ``None`` when it cannot be asked (no file
+    descriptor), 0 when it has no width."""
+    import os
+
+    try:
+        columns = os.get_terminal_size(stream.fileno()).columns
+    except (AttributeError, OSError, ValueError, io.UnsupportedOperation):
+        return None
+    if columns > 0:
+        return columns
+    env = os.environ.get("COLUMNS", "")
+    return int(env) if env.isdigit() and int(env) > 0 else 0
 
 
 class MapProgress(Progress):

@@ -10,15 +10,17 @@ from __future__ import annotations
 import html
 import json
 import logging
-from functools import lru_cache
+import threading
+from concurrent.futures import ThreadPoolExecutor
+from functools import lru_cache, partial
 from types import SimpleNamespace
 
 import numpy as np
 import pandas as pd
 from bokeh.layouts import column, row
-from bokeh.models import (ColorBar, ColumnDataSource, CustomJSTickFormatter, DatePicker, Div,
-                          FactorRange, HoverTool, Legend, LinearColorMapper, RadioButtonGroup,
-                          Select, Slider, Span, Spinner)
+from bokeh.models import (ColorBar, ColumnDataSource, CustomJS, CustomJSTickFormatter, DataRange1d,
+                          DatePicker, Div, FactorRange, HoverTool, Legend, LinearColorMapper,
+                          RadioButtonGroup, Select, Slider, Span, Spinner, Toggle)
 from bokeh.palettes import Category10_5, Viridis256
 from bokeh.plotting import figure
 from bokeh.transform import dodge
@@ -106,14 +108,35 @@ def _footprint_patches(model: TripModel, margin_m: float = 200.0) -> tuple[list,
     return _footprints(str(model.data_dir), tuple(sorted(g["tile"].dropna().unique())), bounds)
 
 
+def _pct(value: float, decimals: int = 1) -> str:
+    return f"{100 * value:.{decimals}f} %"
+
+
 def numbers_html(res, fleet: dict | None = None) -> str:
-    """The trip's numbers as HTML (ids and classes are the app's stable test interface)."""
+    """The trip's numbers as HTML (ids and classes are the app's stable test interface).
+
+    ``#trip-numbers`` carries the settings the numbers belong to as ``data-*`` attributes,
+    and ``data-t0``: the trip's departure in the time axis of the plots (ms after the epoch
+    of local time, as Bokeh's datetime axes hold it), so a page can check that the trip,
+    the irradiance plot and the driving cycle show the same departure.  A trip with the sun
+    below the horizon says so where the shading loss would be (no light: nothing to lose)."""
     n = res.numbers
     share = 100.0 * n["share"]
+    t0 = int(round(pd.Timestamp(res.departure).value / 1e6))
     attrs = {"route": res.route_id, "direction": res.direction_id,
              "date": res.date.strftime("%Y-%m-%d"), "requested": res.requested,
-             "trip": res.trip_id, "departure": res.departure.strftime("%H:%M")}
+             "trip": res.trip_id, "departure": res.departure.strftime("%H:%M"), "t0": t0}
     data = " ".join(f'data-{k}="{html.escape(str(v))}"' for k, v in attrs.items())
+    if n.get("sun_up", True) and np.isfinite(n["shading_loss"]):
+        light = (f'unshaded {n["pv_kwh_unshaded"]:.3f} kWh; shading loss '
+                 f'<span class="shading-loss">{_pct(n["shading_loss"])}</span> of the light on the roof '
+                 f'({n["h_direct"] + n["h_diffuse"]:.0f} of {n["h_unshaded"]:.0f} Wh/m2 direct and diffuse)')
+    else:
+        light = '<span class="shading-loss sun-down">sun below the horizon</span>: no light on the roof'
+    stops = ""
+    if n.get("stops"):
+        stops = (f'<tr><td>At stops</td><td>{1000 * n["stop_pv_kwh"]:.0f} Wh</td>'
+                 f'<td>{n["stops"]} stops, {n["stop_s"] / 60:.1f} min standing (circles on the map)</td></tr>')
     fleet_html = ""
     if fleet:
         run = fleet.get("run") or {}
@@ -122,9 +145,11 @@ def numbers_html(res, fleet: dict | None = None) -> str:
             headline = (f'the run: PV the batteries take covers <b><span class="fleet-coverage">'
                         f'{100 * run["coverage"]:.2f}</span> %</b> of the fleet\'s demand in service '
                         f'(trips and layovers; summary.json coverage); ')
+        loss = fleet["shading_loss"]
+        loss_text = f"shading loss {_pct(loss)}" if np.isfinite(loss) else "no light"
         fleet_html = (f'<div class="fleet">Fleet: {headline}driving, simulated months (rescaled): '
                       f'<b>{fleet["allsky"]:,.0f}</b> kWh PV all-sky, {fleet["clearsky"]:,.0f} clear-sky, '
-                      f'shading loss {100 * fleet["shading_loss"]:.1f} %, '
+                      f'{loss_text}, '
                       f'{100 * fleet["share"]:.2f} % of the trips\' {fleet["consumption"]:,.0f} kWh '
                       f'(coverage_driving)</div>')
     return (
@@ -133,8 +158,8 @@ def numbers_html(res, fleet: dict | None = None) -> str:
         f'departs <b>{res.departure:%H:%M}</b> (asked {res.requested}: {html.escape(res.note)})</div>'
         f'<table class="trip-table">'
         f'<tr><td>PV energy</td><td><span id="pv-kwh" class="pv-kwh">'
-        f'{n["pv_kwh"]:.{DECIMALS["pv_kwh"]}f}</span> kWh</td>'
-        f'<td>unshaded {n["pv_kwh_unshaded"]:.3f} kWh, shading loss {100 * n["shading_loss"]:.1f} %</td></tr>'
+        f'{n["pv_kwh"]:.{DECIMALS["pv_kwh"]}f}</span> kWh</td><td>{light}</td></tr>'
+        f'{stops}'
         f'<tr><td>Consumed</td><td><span id="consumption-kwh" class="consumption-kwh">'
         f'{n["consumption_kwh"]:.{DECIMALS["consumption_kwh"]}f}</span> kWh</td>'
         f'<td>{n["distance_km"]:.2f} km in {n["duration_min"]:.0f} min</td></tr>'
@@ -149,224 +174,384 @@ def numbers_html(res, fleet: dict | None = None) -> str:
         f'occlusion rays for the reflectors)</div></div>')
 
 
+def route_label(r, ambiguous: bool = False) -> str:
+    """How the route picker names a route-direction: its public name and where it goes
+    (``S5 to Ostheim``), its long name where it says more, the trips; the route_id when
+    two routes share a public name."""
+    short, long_name = str(r.route_short_name), str(r.route_long_name or "")
+    head = f"to {r.trip_headsign}" if r.trip_headsign else f"direction {r.direction_id}"
+    extra = [long_name] if long_name and long_name != short else []
+    if ambiguous:
+        extra.append(f"route_id {r.route_id}")
+    extra.append(f"{r.trips} trips")
+    return f"{short} {head} ({'; '.join(extra)})"
+
+
+#: the app's look: a column of controls beside the views on a wide screen, above them on a
+#: narrow one; the views side by side as the width allows (each at least MIN_VIEW_PX)
+MIN_VIEW_PX = 340
+CONTROLS_PX = 300
+_WRAP = {"flex-wrap": "wrap", "align-items": "flex-start"}
+
+
 def build_document(model: TripModel, doc) -> None:
-    """Fill a Bokeh document with the app for *model* (a FunctionHandler target)."""
+    """Fill a Bokeh document with the app for *model* (a FunctionHandler target).
+
+    Every view fits the window from a phone's 400 px to a wide monitor: the figures stretch
+    to the width they get (at least :data:`MIN_VIEW_PX`) and wrap below each other, the
+    controls are a column that moves above the views on a narrow screen and folds away
+    ("Hide controls").  A change of any control asks :class:`Recompute` for the views:
+    requests coalesce, a result computed for values changed meanwhile is dropped, so the
+    trip, the irradiance, the driving cycle and the SoC always show one departure."""
     start = default_view(model)
     c = _controls(model, start)
     v = _views(model)
     v.f_mon = _monthly_figure(v.src_mon)
-    refresh = _wire(model, c, v)
-    refresh()
-    w = _WIDTH
+    compute, apply = _wire(model, c, v)
+    recompute = Recompute(doc, compute, apply)
+    for widget in (c.tech, c.mode, c.route, c.date, c.aux, c.kwp, c.area, c.pr, c.losses, c.depart, c.soc):
+        widget.on_change("value", recompute.request)
+    c.size_by.on_change("active", recompute.request)
+    apply(compute())                          # the first view, before the page shows
     controls = column(c.tech, c.mode, c.size_by, c.kwp, c.area, c.pr, c.losses, c.route, c.date,
-                      c.depart, c.aux, c.soc, width=w + 20)
-    doc.add_root(column(_header(model), row(controls, column(c.numbers, c.error, v.f_map),
-                                            column(v.f_irr, v.f_cyc, v.f_soc)),
-                        row(Div(width=w + 20), v.f_mon)))
+                      c.depart, c.aux, c.soc, width=CONTROLS_PX, css_classes=["app-controls"],
+                      name="controls", styles={"max-width": "100%"})
+    toggle = Toggle(label="Hide controls", active=True, width=130, css_classes=["controls-toggle"],
+                    name="controls-toggle")
+    toggle.js_on_change("active", CustomJS(args={"panel": controls, "button": toggle}, code=(
+        "panel.visible = button.active; "
+        "button.label = button.active ? 'Hide controls' : 'Show controls';")))
+    for f in (v.f_irr, v.f_map, v.f_cyc, v.f_soc, v.f_mon):
+        f.sizing_mode = "stretch_width"
+        f.min_width = MIN_VIEW_PX
+    # each figure in a box of its own: the row would otherwise align the figures as one
+    # line of plots (each as tall as the tallest) however they wrap
+    boxes = [column(f, sizing_mode="stretch_width", min_width=MIN_VIEW_PX)
+             for f in (v.f_irr, v.f_map, v.f_cyc, v.f_soc, v.f_mon)]
+    views = row(*boxes, sizing_mode="stretch_width", styles=_WRAP, name="views")
+    content = column(c.numbers, c.error, views, sizing_mode="stretch_width", min_width=MIN_VIEW_PX)
+    main = row(controls, content, sizing_mode="stretch_width", styles=_WRAP)
+    doc.add_root(column(_header(model), toggle, main, sizing_mode="stretch_width",
+                        styles={"padding": "0 6px", "box-sizing": "border-box"}))
     doc.title = "vipvflow app"
-
-
-#: width of the control column (px)
-_WIDTH = 300
 
 
 def _controls(model: TripModel, start: dict) -> SimpleNamespace:
     """The PV, route, date and vehicle controls and the text panes, opened on *start*."""
     routes = model.routes()
-    route_opts = [(f"{r.route_id}|{r.direction_id}",
-                   f"{r.route_short_name} " + (f"to {r.trip_headsign}" if r.trip_headsign
-                                               else f"direction {r.direction_id}")
-                   + f" ({r.trips} trips)")
-                  for r in routes.itertuples()]
+    shared = routes.groupby("route_short_name")["route_id"].transform("nunique") > 1
+    route_opts = [(f"{r.route_id}|{r.direction_id}", route_label(r, bool(a)))
+                  for r, a in zip(routes.itertuples(), shared)]
     run_pv = model.run_pv_choice
-    w = _WIDTH
+    wide = {"sizing_mode": "stretch_width"}
     tech = Select(title="PV technology", value=run_pv.technology, options=list(TECHNOLOGIES),
-                  width=w, css_classes=["pv-tech"])
-    mode = Select(title="PV model", value=run_pv.mode, width=w, css_classes=["pv-mode"],
-                  options=[("paper", "paper: kWp x POA x PR"), ("pvlib", "pvlib: PVWatts + cell temperature")])
-    size_by = RadioButtonGroup(labels=["size by kWp", "size by area"], active=0, width=w)
-    kwp = Spinner(title="peak power (kWp)", value=run_pv.kwp, low=0.1, high=20, step=0.1, width=w,
-                  css_classes=["pv-kwp"])
+                  css_classes=["pv-tech"], name="pv-tech", **wide)
+    mode = Select(title="PV model", value=run_pv.mode, css_classes=["pv-mode"], name="pv-mode",
+                  options=[("paper", "paper: kWp x POA x PR"), ("pvlib", "pvlib: PVWatts + cell temperature")],
+                  **wide)
+    size_by = RadioButtonGroup(labels=["size by kWp", "size by area"], active=0, name="size-by", **wide)
+    kwp = Spinner(title="peak power (kWp)", value=run_pv.kwp, low=0.1, high=20, step=0.1,
+                  css_classes=["pv-kwp"], name="pv-kwp", **wide)
     area = Spinner(title="module area (m2)", value=round(run_pv.kwp / TECHNOLOGIES[run_pv.technology]["efficiency"], 1),
-                   low=1, high=60, step=0.5, width=w, disabled=True, css_classes=["pv-area"])
+                   low=1, high=60, step=0.5, disabled=True, css_classes=["pv-area"], name="pv-area", **wide)
     pr = Slider(title="performance ratio (paper model)", value=run_pv.performance_ratio, start=0.5,
-                end=0.95, step=0.01, width=w, css_classes=["pv-pr"])
+                end=0.95, step=0.01, css_classes=["pv-pr"], name="pv-pr", **wide)
     losses = Slider(title="DC system losses % (pvlib model)", value=run_pv.losses_percent, start=0,
-                    end=40, step=0.5, width=w, css_classes=["pv-losses"])
+                    end=40, step=0.5, css_classes=["pv-losses"], name="pv-losses", **wide)
     route = Select(title="route and direction", value=f"{start['route_id']}|{start['direction_id']}",
-                   options=route_opts, width=w, css_classes=["route-select"])
+                   options=route_opts, css_classes=["route-select"], name="route", **wide)
     date = DatePicker(title="date", value=start["date"],
-                      min_date=f"{model.year}-01-01", max_date=f"{model.year}-12-31", width=w,
-                      css_classes=["date-picker"])
+                      min_date=f"{model.year}-01-01", max_date=f"{model.year}-12-31",
+                      css_classes=["date-picker"], name="date", **wide)
     depart = Slider(title="departure: next scheduled trip at or after", value=start["depart"], start=0,
-                    end=24 * 60 - 5, step=5, width=w, css_classes=["depart-slider"],
-                    format=CustomJSTickFormatter(code=_HHMM))
+                    end=24 * 60 - 5, step=5, css_classes=["depart-slider"], name="depart",
+                    format=CustomJSTickFormatter(code=_HHMM), **wide)
     aux = Spinner(title="auxiliary base load (kW; HVAC on top)", value=model.vehicle.aux_base_kw,
-                  low=0, high=40, step=0.5, width=w, css_classes=["aux-kw"])
-    soc = Slider(title="SoC limit (min); the trip departs at its SoC in the run's balance",
-                 value=model.vehicle.soc_min, start=0, end=0.9, step=0.01, width=w,
-                 css_classes=["soc-min"])
-    numbers = Div(text="", width=560, css_classes=["numbers-div"],
-                  stylesheets=[":host .trip-table td { padding: 2px 10px 2px 0; }"
+                  low=0, high=40, step=0.5, css_classes=["aux-kw"], name="aux", **wide)
+    soc = Slider(title="SoC limit (min)", value=model.vehicle.soc_min, start=0, end=0.9, step=0.01,
+                 css_classes=["soc-min"], name="soc-min", **wide)
+    numbers = Div(text="", css_classes=["numbers-div"], name="numbers", sizing_mode="stretch_width",
+                  stylesheets=[":host .trip-table td { padding: 2px 10px 2px 0; vertical-align: top; }"
                                ":host .pv-kwh, :host .pv-share { font-size: 1.4em; font-weight: bold; color: #b35900; }"
+                               ":host .sun-down { font-weight: bold; }"
                                ":host .compute, :host .fleet { color: #555; margin-top: 4px; }"])
-    error = Div(text="", width=560, css_classes=["app-error"])
+    error = Div(text="", css_classes=["app-error"], sizing_mode="stretch_width")
+    c = SimpleNamespace(tech=tech, mode=mode, size_by=size_by, kwp=kwp, area=area, pr=pr, losses=losses,
+                        route=route, date=date, depart=depart, aux=aux, soc=soc, numbers=numbers, error=error)
+    applicable(c)
+    return c
 
-    return SimpleNamespace(tech=tech, mode=mode, size_by=size_by, kwp=kwp, area=area, pr=pr, losses=losses, route=route, date=date, depart=depart, aux=aux, soc=soc, numbers=numbers, error=error)
+
+def applicable(c: SimpleNamespace) -> None:
+    """Disable the controls that do not apply to the chosen PV model and sizing: the
+    performance ratio is the paper model's, the DC losses pvlib's; kWp or area; the
+    technology matters to pvlib (temperature coefficient) and to sizing by area (efficiency)."""
+    paper = c.mode.value == "paper"
+    by_area = c.size_by.active == 1
+    c.pr.disabled = not paper
+    c.losses.disabled = paper
+    c.kwp.disabled = by_area
+    c.area.disabled = not by_area
+    c.tech.disabled = paper and not by_area
 
 
 def _views(model: TripModel) -> SimpleNamespace:
     """The data sources and the irradiance, map, driving-cycle and SoC figures."""
     src_seg = ColumnDataSource(data={k: [] for k in ("time", "direct", "diffuse", "reflected",
                                                      "total", "unshaded", "x", "y", "x_end",
-                                                     "y_end", "energy_wh")})
-    src_cyc = ColumnDataSource(data={"time": [], "speed_kmh": [], "soc": [], "soc_pv": []})
+                                                     "y_end", "energy_wh")}, name="trip-segments")
+    src_stop = ColumnDataSource(data={k: [] for k in ("x", "y", "time", "total", "dwell_s",
+                                                      "energy_wh", "size")}, name="trip-stops")
+    src_cyc = ColumnDataSource(data={"time": [], "speed_kmh": [], "soc": [], "soc_pv": []},
+                               name="trip-cycle")
     src_mon = ColumnDataSource(data={k: [] for k in ("month", "allsky", "clearsky", "allsky_unshaded",
                                                      "clearsky_unshaded", "shading_loss")})
     g = model.geometry
     src_bg = ColumnDataSource(data={"x": g["x"], "y": g["y"], "x_end": g["x_end"], "y_end": g["y_end"]})
+    tools = "pan,wheel_zoom,box_zoom,reset,save"
 
-    f_irr = figure(title="Irradiance on the roof along the trip", x_axis_type="datetime",
-                   height=300, width=620, y_axis_label="W/m2", tools="pan,wheel_zoom,box_zoom,reset,save")
+    # irradiance along the trip: the legend inside, in the headroom the y range keeps for it
+    f_irr = figure(title="Light on the roof along the trip (W/m2)", x_axis_type="datetime",
+                   height=320, y_axis_label="W/m2", tools=tools, name="irradiance",
+                   y_range=DataRange1d(start=0, range_padding=0.8, only_visible=True))
     items = []
     for name, color in zip(("total", "direct", "diffuse", "reflected"), Category10_5):
         items.append((name, [f_irr.line("time", name, source=src_seg, color=color, line_width=1.6)]))
-    items.append(("unshaded", [f_irr.line("time", "unshaded", source=src_seg, color="black",
-                                          line_dash="dashed", line_width=1.2)]))
-    f_irr.add_layout(Legend(items=items, click_policy="hide", location="top_left"), "right")
+    items.append(("without buildings", [f_irr.line("time", "unshaded", source=src_seg, color="black",
+                                                   line_dash="dashed", line_width=1.2)]))
+    f_irr.add_layout(Legend(items=items, click_policy="hide", location="top_left", ncols=3,
+                            label_text_font_size="8.5pt", background_fill_alpha=0.75,
+                            padding=4, spacing=2, margin=4))
 
-    mapper = LinearColorMapper(palette=Viridis256, low=0, high=1)
-    f_map = figure(title="Route, coloured by PV energy per segment (Wh)", match_aspect=True,
-                   height=420, width=560, x_axis_label=f"easting (m), {_crs_name(model)}", y_axis_label="northing (m)",
-                   tools="pan,wheel_zoom,box_zoom,reset,save")
+    # the route: each segment coloured by the irradiance while the bus passes (W/m2, on the
+    # scale of the light without buildings), the stops' dwells as circles apart
+    mapper = LinearColorMapper(palette=Viridis256, low=0, high=1000)
+    f_map = figure(title="Route: light on the roof (W/m2)", match_aspect=True,
+                   height=440, x_axis_label=f"easting (m), {_crs_name(model)}", y_axis_label="northing (m)",
+                   tools=tools, name="route-map")
     bx, by = _footprint_patches(model)
     f_map.patches(bx, by, fill_color="#dedede", line_color="#b4b4b4", line_width=0.5)
-    f_map.segment("x", "y", "x_end", "y_end", source=src_bg, color="#9e9e9e", line_width=2)
+    bg = f_map.segment("x", "y", "x_end", "y_end", source=src_bg, color="#9e9e9e", line_width=2)
     seg_r = f_map.segment("x", "y", "x_end", "y_end", source=src_seg, line_width=6,
-                          color={"field": "energy_wh", "transform": mapper})
-    f_map.add_layout(ColorBar(color_mapper=mapper, title="Wh"), "right")
+                          color={"field": "total", "transform": mapper})
+    stop_r = f_map.scatter("x", "y", source=src_stop, size="size", fill_color={"field": "total", "transform": mapper},
+                           line_color="#d62728", line_width=1.2, fill_alpha=0.8)
+    f_map.add_layout(ColorBar(color_mapper=mapper, orientation="horizontal", height=10,
+                              title="W/m2 while passing, with the buildings",
+                              title_text_font_size="8pt", major_label_text_font_size="8pt"), "below")
+    f_map.add_layout(Legend(items=[("this trip's segments (colour: W/m2)", [seg_r]),
+                                   ("stops: dwell, circle area ~ time standing", [stop_r]),
+                                   ("the run's other roads", [bg])],
+                            location="top_left", label_text_font_size="8.5pt", background_fill_alpha=0.75,
+                            padding=4, spacing=1, margin=4))
     f_map.add_tools(HoverTool(renderers=[seg_r], tooltips=[("time", "@time{%H:%M:%S}"),
-                                                           ("PV", "@energy_wh{0.00} Wh"),
-                                                           ("total", "@total{0} W/m2")],
+                                                           ("light", "@total{0} W/m2"),
+                                                           ("PV", "@energy_wh{0.00} Wh")],
+                              formatters={"@time": "datetime"}))
+    f_map.add_tools(HoverTool(renderers=[stop_r], tooltips=[("stop at", "@time{%H:%M:%S}"),
+                                                            ("standing", "@dwell_s{0} s"),
+                                                            ("light", "@total{0} W/m2"),
+                                                            ("PV", "@energy_wh{0.00} Wh")],
                               formatters={"@time": "datetime"}))
 
-    f_cyc = figure(title="Driving cycle", x_axis_type="datetime", height=250, width=620,
-                   y_axis_label="speed (km/h)", tools="pan,wheel_zoom,box_zoom,reset,save")
+    f_cyc = figure(title="Driving cycle", x_axis_type="datetime", height=240,
+                   y_axis_label="speed (km/h)", tools=tools, name="driving-cycle")
     f_cyc.line("time", "speed_kmh", source=src_cyc, color="#1f77b4")
 
-    f_soc = figure(title="Battery state of charge", x_axis_type="datetime", height=250, width=620,
-                   y_axis_label="SoC", tools="pan,wheel_zoom,box_zoom,reset,save")
+    f_soc = figure(title="Battery state of charge", x_axis_type="datetime", height=240,
+                   y_axis_label="SoC", tools=tools, name="soc")
     f_soc.line("time", "soc", source=src_cyc, color="#7f7f7f", line_width=2, legend_label="without PV")
     f_soc.line("time", "soc_pv", source=src_cyc, color="#ff7f0e", line_width=2, legend_label="with PV")
     soc_min_line = Span(location=model.vehicle.soc_min, dimension="width", line_color="red",
                         line_dash="dotted")
     f_soc.add_layout(soc_min_line)
     f_soc.legend.location = "bottom_left"
+    f_soc.legend.background_fill_alpha = 0.75
+    f_soc.legend.label_text_font_size = "8.5pt"
 
-    return SimpleNamespace(src_seg=src_seg, src_cyc=src_cyc, src_mon=src_mon, f_irr=f_irr, f_map=f_map, mapper=mapper, f_cyc=f_cyc, f_soc=f_soc, soc_min_line=soc_min_line)
+    return SimpleNamespace(src_seg=src_seg, src_stop=src_stop, src_cyc=src_cyc, src_mon=src_mon,
+                           f_irr=f_irr, f_map=f_map, mapper=mapper, f_cyc=f_cyc, f_soc=f_soc,
+                           soc_min_line=soc_min_line)
 
 
 def _monthly_figure(src_mon: ColumnDataSource):
-    """Monthly PV energy of the route-direction: all-sky and clear-sky bars, unshaded marks."""
-    f_mon = figure(title="Monthly PV energy of the route-direction (run, rescaled to this PV)",
-                   x_range=FactorRange(), height=330, width=560, y_axis_label="kWh",
-                   tools="save,reset")
+    """Monthly PV energy of the route-direction: all-sky and clear-sky bars, unshaded marks;
+    the legend inside, above the bars (the y range keeps room for it)."""
+    f_mon = figure(title="Monthly PV of the route (run, this PV)",
+                   x_range=FactorRange(), height=330, y_axis_label="kWh", tools="save,reset",
+                   y_range=DataRange1d(start=0, range_padding=0.4), name="monthly")
     f_mon.vbar(x=dodge("month", -0.18, range=f_mon.x_range), top="allsky", width=0.34, source=src_mon,
                color="#ff7f0e", legend_label="all-sky")
     f_mon.vbar(x=dodge("month", 0.18, range=f_mon.x_range), top="clearsky", width=0.34, source=src_mon,
                color="#1f77b4", legend_label="clear-sky")
-    f_mon.scatter(x=dodge("month", -0.18, range=f_mon.x_range), y="allsky_unshaded", source=src_mon,
-                  marker="dash", size=30, color="black", legend_label="without buildings")
-    f_mon.scatter(x=dodge("month", 0.18, range=f_mon.x_range), y="clearsky_unshaded", source=src_mon,
-                  marker="dash", size=30, color="black")
+    # the energy without buildings: a mark as wide as its bar, whatever the plot's width
+    for offset, column_name, label in ((-0.18, "allsky_unshaded", {"legend_label": "without buildings"}),
+                                       (0.18, "clearsky_unshaded", {})):
+        f_mon.segment(x0=dodge("month", offset - 0.17, range=f_mon.x_range), y0=column_name,
+                      x1=dodge("month", offset + 0.17, range=f_mon.x_range), y1=column_name,
+                      source=src_mon, color="black", line_width=2, **label)
     f_mon.add_tools(HoverTool(tooltips=[("month", "@month"), ("all-sky", "@allsky{0,0} kWh"),
                                         ("clear-sky", "@clearsky{0,0} kWh"),
                                         ("shading loss", "@shading_loss{0.0%}")]))
-    # the legend in one row above the plot, never over the bars; month names on the axis
     f_mon.legend.orientation = "horizontal"
-    f_mon.add_layout(f_mon.legend[0], "above")
-    f_mon.xaxis.major_label_text_font_size = "11pt"
-    f_mon.y_range.start = 0
-
+    f_mon.legend.location = "top_left"
+    f_mon.legend.background_fill_alpha = 0.75
+    f_mon.legend.label_text_font_size = "8.5pt"
+    f_mon.xaxis.major_label_text_font_size = "10pt"
+    # month names slanted when the plot is too narrow for them side by side (a phone)
+    f_mon.js_on_change("inner_width", CustomJS(args={"axis": f_mon.xaxis[0]}, code=(
+        "const slant = cb_obj.inner_width < 60 * cb_obj.x_range.factors.length; "
+        "axis.major_label_orientation = slant ? 0.9 : 'horizontal';")))
     return f_mon
 
 
-def _wire(model: TripModel, c: SimpleNamespace, v: SimpleNamespace):
-    """Connect the controls to the model; returns the function that recomputes the views."""
-    run_pv = model.run_pv_choice
-    tech, mode, size_by, kwp, area, pr, losses = c.tech, c.mode, c.size_by, c.kwp, c.area, c.pr, c.losses
-    route, date, depart, aux, soc, numbers, error = c.route, c.date, c.depart, c.aux, c.soc, c.numbers, c.error
-    src_seg, src_cyc, src_mon, mapper, soc_min_line = v.src_seg, v.src_cyc, v.src_mon, v.mapper, v.soc_min_line
-    f_mon = v.f_mon
+#: one thread computes the trips of every session in turn (the model's caches are not shared
+#: between threads); the page's event loop stays free to take the next control change
+_EXECUTOR = ThreadPoolExecutor(max_workers=1, thread_name_prefix="vipvflow-app")
+_MODEL_LOCK = threading.Lock()
 
-    def pv_choice() -> PVChoice:
-        return PVChoice(technology=tech.value, mode=mode.value, kwp=float(kwp.value),
-                        area_m2=float(area.value) if size_by.active == 1 else None,
-                        performance_ratio=float(pr.value), losses_percent=float(losses.value),
-                        inverter_efficiency=run_pv.inverter_efficiency)
 
-    def selected():
-        rid, d = route.value.rsplit("|", 1)
-        return rid, int(d)
+class Recompute:
+    """The views' recomputation for one page, without a queue.
 
-    def update_monthly(pv: PVChoice):
-        rid, d = selected()
-        mon = model.monthly(rid, d, pv)
-        mon["month"] = month_labels(mon["month"])
-        f_mon.x_range.factors = list(mon["month"])
-        src_mon.data = {k: list(mon[k]) for k in src_mon.data}
-        fleet = model.monthly(None, None, pv)
-        if len(fleet):
-            tot = fleet[["allsky", "clearsky", "allsky_unshaded", "consumption"]].sum()
-            return {"run": model.summary, "allsky": tot["allsky"], "clearsky": tot["clearsky"],
-                    "shading_loss": float((fleet["shading_loss"] * fleet["allsky_unshaded"]).sum()
-                                          / max(tot["allsky_unshaded"], 1e-12)),
-                    "share": tot["allsky"] / tot["consumption"] if tot["consumption"] else np.nan,
-                    "consumption": tot["consumption"]}
-        return None
+    :meth:`request` (a control's change) asks for it; requests that come while one waits
+    (:data:`COALESCE_MS`) or computes are one request.  The computation reads the controls'
+    values when it starts and runs in the app's computing thread; when it is done, its result
+    is shown only if no control changed meanwhile: otherwise it is dropped and the latest
+    values are computed at once.  Each result is shown as one document change, so the
+    trip's numbers, the irradiance, the map, the driving cycle and the SoC always belong to
+    the same settings.
+    """
 
-    def recompute(attr, old, new):
-        refresh()
+    #: ms a first request waits for the ones that follow it (a key held down, a drag)
+    COALESCE_MS = 40
 
-    def refresh():
+    def __init__(self, doc, compute, apply):
+        self.doc, self.compute, self.apply = doc, compute, apply
+        self.asked = 0            # requests so far
+        self.busy = False         # a computation is running
+        self.waiting = False      # a start is scheduled
+        self.shown = 0            # results shown
+        self.dropped = 0          # results dropped as stale
+
+    def request(self, attr, old, new) -> None:
+        """Ask for the views of the controls' current values (a Bokeh ``on_change`` callback)."""
+        self.asked += 1
+        if not self.busy and not self.waiting:
+            self.waiting = True
+            self.doc.add_timeout_callback(self._start, self.COALESCE_MS)
+
+    def _start(self) -> None:
+        self.waiting = False
+        if self.busy:
+            return
+        self.busy = True
+        ticket = self.asked
+        job = self.compute(prepare_only=True)          # the controls' values, read now
+        future = _EXECUTOR.submit(job)
+        future.add_done_callback(lambda f: self._back(ticket, f))
+
+    def _back(self, ticket: int, future) -> None:       # in the computing thread
         try:
-            pv = pv_choice()
-            rid, d = selected()
-            lo = float(soc.value)
-            res = model.trip(rid, d, date.value, depart=int(depart.value), pv=pv,
-                             aux_kw=float(aux.value), soc_min=lo)
-            s = res.segments
-            src_seg.data = {"time": s["time"].to_numpy(), "direct": s["direct"].to_numpy(),
-                            "diffuse": s["diffuse"].to_numpy(), "reflected": s["reflected"].to_numpy(),
-                            "total": s["total"].to_numpy(), "unshaded": s["unshaded"].to_numpy(),
-                            "x": s["x"].to_numpy(), "y": s["y"].to_numpy(),
-                            "x_end": s["x_end"].to_numpy(), "y_end": s["y_end"].to_numpy(),
-                            "energy_wh": 1000.0 * s["energy_kwh"].to_numpy()}
-            # colour scale to the 98th percentile: segments with a stop inside (long dwell)
-            # would otherwise flatten the rest
-            mapper.high = max(float(np.quantile(1000.0 * s["energy_kwh"], 0.98)), 1e-3)
-            c = res.cycle
-            src_cyc.data = {"time": c["time"].to_numpy(), "speed_kmh": c["speed_kmh"].to_numpy(),
-                            "soc": c["soc"].to_numpy(), "soc_pv": c["soc_pv"].to_numpy()}
-            soc_min_line.location = float(lo)
-            fleet = update_monthly(pv)
-            numbers.text = numbers_html(res, fleet)
-            error.text = ""
-        except Exception as exc:  # show it in the page; the session stays usable
+            self.doc.add_next_tick_callback(partial(self._done, ticket, future))
+        except Exception:  # noqa: BLE001 - the page was closed meanwhile
+            pass
+
+    def _done(self, ticket: int, future) -> None:
+        self.busy = False
+        if ticket != self.asked:                        # stale: the controls moved on
+            self.dropped += 1
+            self._start()
+            return
+        self.shown += 1
+        self.apply(future.result())
+
+
+def _wire(model: TripModel, c: SimpleNamespace, v: SimpleNamespace):
+    """The computation of the views and how its result is shown: ``compute()`` reads the
+    controls and computes (``compute(prepare_only=True)``: reads them and returns the job,
+    to run in another thread); ``apply(result)`` shows a result as one document change."""
+    run_pv = model.run_pv_choice
+
+    def settings() -> dict:
+        rid, d = c.route.value.rsplit("|", 1)
+        return {"pv": PVChoice(technology=c.tech.value, mode=c.mode.value, kwp=float(c.kwp.value),
+                               area_m2=float(c.area.value) if c.size_by.active == 1 else None,
+                               performance_ratio=float(c.pr.value), losses_percent=float(c.losses.value),
+                               inverter_efficiency=run_pv.inverter_efficiency),
+                "route_id": rid, "direction_id": int(d), "date": c.date.value,
+                "depart": int(c.depart.value), "aux_kw": float(c.aux.value), "soc_min": float(c.soc.value)}
+
+    def job(p: dict):
+        try:
+            with _MODEL_LOCK:
+                res = model.trip(p["route_id"], p["direction_id"], p["date"], depart=p["depart"],
+                                 pv=p["pv"], aux_kw=p["aux_kw"], soc_min=p["soc_min"])
+                mon = model.monthly(p["route_id"], p["direction_id"], p["pv"])
+                fleet = model.monthly(None, None, p["pv"])
+            return {"settings": p, "trip": res, "monthly": mon, "fleet": fleet}
+        except Exception as exc:  # noqa: BLE001 - shown in the page; the session stays usable
             log.exception("recompute failed")
-            error.text = f'<div id="app-error" style="color:#b00">{html.escape(str(exc))}</div>'
+            return {"settings": p, "error": exc}
 
-    def on_size(attr, old, new):
-        kwp.disabled = size_by.active == 1
-        area.disabled = size_by.active == 0
-        refresh()
+    def compute(prepare_only: bool = False):
+        p = settings()
+        return partial(job, p) if prepare_only else job(p)
 
-    for widget in (tech, mode, route, date, aux):
-        widget.on_change("value", recompute)
-    for widget in (kwp, area, pr, losses, depart, soc):
-        widget.on_change("value_throttled", recompute)
-    size_by.on_change("active", on_size)
-    return refresh
+    def apply(result: dict) -> None:
+        doc = c.numbers.document
+        if doc is not None:
+            doc.hold("combine")          # every change below reaches the page as one message
+        try:
+            applicable(c)
+            if "error" in result:
+                c.error.text = f'<div id="app-error" style="color:#b00">{html.escape(str(result["error"]))}</div>'
+                return
+            res = result["trip"]
+            s = res.segments
+            v.src_seg.data = {"time": s["time"].to_numpy(), "direct": s["direct"].to_numpy(),
+                              "diffuse": s["diffuse"].to_numpy(), "reflected": s["reflected"].to_numpy(),
+                              "total": s["total"].to_numpy(), "unshaded": s["unshaded"].to_numpy(),
+                              "x": s["x"].to_numpy(), "y": s["y"].to_numpy(),
+                              "x_end": s["x_end"].to_numpy(), "y_end": s["y_end"].to_numpy(),
+                              "energy_wh": 1000.0 * s["energy_kwh"].to_numpy()}
+            st = s[s["stop"]]
+            v.src_stop.data = {"x": (0.5 * (st["x"] + st["x_end"])).to_numpy(),
+                               "y": (0.5 * (st["y"] + st["y_end"])).to_numpy(),
+                               "time": st["time"].to_numpy(), "total": st["total"].to_numpy(),
+                               "dwell_s": st["dwell_s"].to_numpy(),
+                               "energy_wh": 1000.0 * st["energy_kwh"].to_numpy(),
+                               "size": 4.0 + np.sqrt(st["dwell_s"].to_numpy())}
+            # one scale for the light with and without buildings: the shade shows as dark
+            v.mapper.high = max(float(s["unshaded"].max()) if len(s) else 0.0, 1.0)
+            cyc = res.cycle
+            v.src_cyc.data = {"time": cyc["time"].to_numpy(), "speed_kmh": cyc["speed_kmh"].to_numpy(),
+                              "soc": cyc["soc"].to_numpy(), "soc_pv": cyc["soc_pv"].to_numpy()}
+            v.soc_min_line.location = float(result["settings"]["soc_min"])
+            mon = result["monthly"].copy()
+            mon["month"] = month_labels(mon["month"])
+            v.f_mon.x_range.factors = list(mon["month"])
+            v.src_mon.data = {k: list(mon[k]) for k in v.src_mon.data}
+            c.numbers.text = numbers_html(res, _fleet_line(model, result["fleet"]))
+            c.error.text = ""
+        finally:
+            if doc is not None:
+                doc.unhold()
+
+    return compute, apply
+
+
+def _fleet_line(model: TripModel, fleet: pd.DataFrame) -> dict | None:
+    """The fleet's figures of the run rescaled to the chosen PV (:meth:`TripModel.monthly`)."""
+    if not len(fleet):
+        return None
+    tot = fleet[["allsky", "clearsky", "allsky_unshaded", "consumption"]].sum()
+    loss = fleet["shading_loss"] * fleet["allsky_unshaded"]
+    return {"run": model.summary, "allsky": tot["allsky"], "clearsky": tot["clearsky"],
+            "shading_loss": (float(loss.sum() / tot["allsky_unshaded"]) if tot["allsky_unshaded"] > 0
+                             else float("nan")),
+            "share": tot["allsky"] / tot["consumption"] if tot["consumption"] else np.nan,
+            "consumption": tot["consumption"]}
 
 
 def _header(model: TripModel) -> Div:
@@ -386,4 +571,6 @@ def _header(model: TripModel) -> Div:
     return Div(text=(f"<h2 style='margin:4px 0'>vipvflow: bus-roof PV along a trip</h2>"
                      f"<div style='color:#555'>run <code>{html.escape(str(model.run_dir))}</code>, "
                      f"scenario {html.escape(model.cfg.scenario)} {model.year}, "
-                     f"diffuse model {model.cfg.irradiance.diffuse_model}</div>{yields}"), width=1200)
+                     f"diffuse model {model.cfg.irradiance.diffuse_model}</div>{yields}"),
+               sizing_mode="stretch_width", name="header",
+               stylesheets=[":host code { overflow-wrap: anywhere; }"])

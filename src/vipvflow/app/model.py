@@ -63,6 +63,11 @@ TECHNOLOGIES = {
 }
 
 
+#: s: a segment the bus stands in this much longer than it takes to drive it is a stop (its
+#: dwell), shown apart on the map
+STOP_DWELL_S = 5.0
+
+
 #: degrees: within this of the horizon profile, or where it jumps by more between two
 #: azimuth bins, the app asks the occlusion ray instead of the profile
 HORIZON_BAND_DEG = 1.0
@@ -117,11 +122,16 @@ class TripResult:
 
     ``segments``: one row per segment pass (``segment_id, t_utc, time`` (local),
     ``dt_s, speed_mps``, W/m2 ``direct, diffuse, reflected, total, unshaded``,
-    ``sun_visible``, ``power_kw``, ``energy_kwh``, ``x, y, x_end, y_end``);
+    ``sun_visible``, ``elevation`` (deg), ``dwell_s`` (s standing beyond driving the segment
+    at the trip's running speed), ``stop`` (dwell of :data:`STOP_DWELL_S` or more),
+    ``power_kw``, ``energy_kwh``, ``x, y, x_end, y_end``);
     ``cycle``: the 2 s driving cycle (``time`` local, ``t_s``, ``speed_kmh``, ``soc``,
     ``soc_pv``, ``pv_kwh_cum``, ``battery_kwh_cum``); ``numbers``: ``pv_kwh``,
-    ``pv_kwh_unshaded``, ``consumption_kwh``, ``share``, ``shading_loss``, ``soc_end``,
-    ``soc_end_pv``, ``distance_km``, ``duration_min``, ``compute_s``.
+    ``pv_kwh_unshaded``, ``consumption_kwh``, ``share``, Wh/m2 of light on the roof
+    ``h_direct, h_diffuse, h_reflected, h_total, h_unshaded``, ``shading_loss`` (on that
+    light, :func:`vipvflow.models.irradiance.shading_loss`; NaN when the sun is down),
+    ``sun_up``, ``stops``, ``stop_s``, ``stop_pv_kwh``, ``soc_end``, ``soc_end_pv``,
+    ``distance_km``, ``duration_min``, ``compute_s``.
     """
 
     trip_id: str
@@ -516,13 +526,19 @@ class TripModel:
                  for c in ("direct", "diffuse", "reflected", "reflected_sd")}
         g = self.geometry.iloc[self._row[sid]]
         tz = self.timezone
+        # the time the bus stands in a segment beyond driving it at the trip's running speed
+        # (the median of its segments'): a stop's dwell, shown apart on the map
+        length = g["length_m"].to_numpy(np.float64)
+        running = float(np.median(speed[speed > 0])) if (speed > 0).any() else 1.0
+        dwell = np.maximum(dt - length / running, 0.0)
         segs = pd.DataFrame({
             "segment_id": sid, "t_utc": origin + off,
             "time": pd.to_datetime(origin + off, unit="s", utc=True).tz_convert(tz).tz_localize(None),
             "dt_s": dt, "speed_mps": speed,
             **{k: np.asarray(irr[k], np.float64) for k in ("direct", "diffuse", "reflected", "total",
                                                            "unshaded")},
-            "sun_visible": irr["sun_visible"],
+            "sun_visible": irr["sun_visible"], "elevation": np.asarray(irr["elevation"], np.float64),
+            "dwell_s": dwell, "stop": dwell >= STOP_DWELL_S,
             "power_kw": np.divide(energy * 3600.0, dt, out=np.zeros_like(dt), where=dt > 0),
             "energy_kwh": energy,
             "x": g["x"].to_numpy(), "y": g["y"].to_numpy(),
@@ -539,6 +555,12 @@ class TripModel:
         use = float(cons["battery_kwh"])
         end = soc_trace(pd.DataFrame({"battery_kwh": [use]}), [pv_kwh], params, soc_start=soc0)
         uns = float(energy_uns.sum())
+        # the light on the roof over the trip (Wh/m2): the shading loss is defined on it, as
+        # in the run, whatever the PV model (a non-linear one would weigh the components
+        # differently)
+        light = {c: float((np.asarray(irr[c], np.float64) * dt).sum() / 3600.0)
+                 for c in ("direct", "diffuse", "reflected", "total", "unshaded")}
+        stop = segs["stop"].to_numpy()
         numbers = {
             "pv_kwh": pv_kwh, "pv_kwh_unshaded": uns, "consumption_kwh": use,
             "share": pv_kwh / use if use > 0 else float("nan"),
@@ -548,7 +570,11 @@ class TripModel:
             # the run's reflected kWh of this trip varies by this much (its one sample point
             # per reflector and pass), independent passes
             "pv_kwh_reflected_se": float(np.sqrt((parts["reflected_sd"] ** 2).sum())),
-            "shading_loss": float(shading_loss(parts["direct"].sum(), parts["diffuse"].sum(), uns)),
+            **{f"h_{c}": v for c, v in light.items()},
+            "shading_loss": float(shading_loss(light["direct"], light["diffuse"], light["unshaded"])),
+            "sun_up": bool((irr["elevation"] > 0).any() and light["unshaded"] > 0),
+            "stops": int(stop.sum()), "stop_s": float(dwell[stop].sum()),
+            "stop_pv_kwh": float(energy[stop].sum()),
             "soc_start": float(soc0), "soc_start_from": soc_from,
             "soc_end": float(end["soc_end"].iloc[0]), "soc_end_pv": float(end["soc_end_pv"].iloc[0]),
             "soc_min": params.soc_min, "kwp": pv.peak_kw,

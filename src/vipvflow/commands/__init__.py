@@ -28,3 +28,24 @@ def add_config(parser, default: str | None = None) -> None:
     parser.add_argument("--config", "-c", default=default, metavar="SCENARIO",
                         help=CONFIG_HELP.format(names=", ".join(shipped_scenarios()),
                                                 default=default or "the shipped defaults alone"))
+
+
+def port_number(suggest: int, allow_zero: bool = False):
+    """An argparse type: a TCP port, 1..65535 (0 too with *allow_zero*: any free port); else
+    one line saying what is wrong and suggesting port *suggest*."""
+    import argparse
+
+    low = 0 if allow_zero else 1
+
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            value = None
+        if value is None or not low <= value <= 65535:
+            raise argparse.ArgumentTypeError(f"{text!r} is not a port number ({low}..65535): "
+                                             f"try {suggest}")
+        return value
+
+    parse.__name__ = "port"
+    return parse

@@ -22,7 +22,9 @@ def register(sub):
     p = sub.add_parser("data", help="fetch the real datasets of data_manifest.yaml (needs a network)")
     inner = p.add_subparsers(dest="action", metavar="ACTION")
     f = inner.add_parser("fetch", help="download what has a direct URL, explain the rest")
-    f.add_argument("--manifest", default="data_manifest.yaml")
+    f.add_argument("--manifest", default="data_manifest.yaml",
+                   help="the list of datasets (URL, licence, checksum; default: data_manifest.yaml "
+                        "of the repository)")
     f.add_argument("--year", type=int, default=2024, help="year of CAMS series to request")
     f.add_argument("names", nargs="*", help="datasets to fetch (default: all)")
     f.set_defaults(func=fetch)

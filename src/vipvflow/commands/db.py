@@ -7,11 +7,15 @@ import sys
 
 def register(sub):
     p = sub.add_parser("db", help="start / stop a local PostgreSQL+PostGIS server or Citus cluster",
-                       description="A throwaway PostgreSQL + PostGIS server in one folder, "
-                       "listening on 127.0.0.1 only (the password of role postgres is printed "
-                       "once and kept in DIR/pgpass; as the postgres system user when run as "
-                       "root), or a Citus coordinator with workers on this machine. `start` "
-                       "prints the DSN to pass to `vipvflow mirror --db`.")
+                       description="A throwaway PostgreSQL + PostGIS server in one folder "
+                       "(DIR/pgdata, DIR/socket, DIR/postgresql.log), or a Citus coordinator with "
+                       "workers on this machine (DIR/worker<i>), run as the postgres system user "
+                       "when started as root. Authentication: on TCP it listens on 127.0.0.1 only "
+                       "and asks for the password of role postgres (scram-sha-256), generated on "
+                       "the first start, printed once on stderr and kept in DIR/pgpass (mode "
+                       "0600); the unix socket in DIR/socket (folder mode 0700) trusts the "
+                       "server's own user. `start` prints the DSN to pass to `vipvflow mirror "
+                       "--db` on stdout: it names DIR/pgpass (?passfile=) and holds no password.")
     actions = p.add_subparsers(dest="action", metavar="ACTION", required=True)
     start = actions.add_parser("start", help="create (first time) and start the server; print its DSN")
     start.add_argument("--dir", required=True, help="folder of the server (e.g. data/pg)")
@@ -22,7 +26,7 @@ def register(sub):
                        "Kept: a later start of DIR starts the same cluster")
     start.set_defaults(func=run_start)
     stop = actions.add_parser("stop", help="stop the server (all nodes of a Citus cluster)")
-    stop.add_argument("--dir", required=True)
+    stop.add_argument("--dir", required=True, help="folder of the cluster given to start")
     stop.set_defaults(func=run_stop)
     citus = actions.add_parser(
         "citus", help="use the installed Citus, or build and install it from source",

@@ -5,7 +5,7 @@ from pathlib import Path
 
 from ..config import load_config
 from ..progress import set_quiet
-from . import add_config
+from . import add_config, port_number
 
 
 def register(sub):
@@ -14,13 +14,18 @@ def register(sub):
                        "every trip of the year per (tile, month) partition, reduce and write "
                        "out/<scenario>/<year>/. Re-running resumes an interrupted run.")
     add_config(p, default="demo")
-    p.add_argument("--year", type=int, required=True)
+    p.add_argument("--year", type=int, required=True,
+                   help="calendar year to simulate (the GTFS calendar must serve it and the CAMS "
+                        "radiation cover it; the demo is generated for it)")
     p.add_argument("--out", type=Path, default=None,
                    help="folder for the scenario's relative data_dir and out_dir (and the demo's "
                         "generated inputs) instead of the current directory")
     p.add_argument("--scheduler", default=None,
                    help="address of a running Dask scheduler (tcp://host:8786); default: a LocalCluster")
     p.add_argument("--workers", type=int, default=None, help="LocalCluster worker processes (default: cores)")
+    p.add_argument("--dashboard-port", type=port_number(8787, allow_zero=True), default=None, metavar="PORT",
+                   help="port of the LocalCluster's Dask dashboard (default: dask.dashboard_port, "
+                        "8787; when taken, or 0, any free port: the address is printed)")
     p.add_argument("--db", default=None, help="PostgreSQL DSN: mirror the finished run into PostGIS/Citus")
     p.add_argument("--quiet", "-q", action="store_true",
                    help="no progress bars or progress lines")
@@ -34,10 +39,7 @@ def run(args):
     from ..simulation import run_simulation
 
     set_quiet(args.quiet)
-    overrides = {"db": {"dsn": args.db}} if args.db else {}
-    cfg = load_config(args.config, overrides=overrides)
-    if args.out is not None:
-        cfg = load_config(args.config, overrides={**overrides, **under(cfg, args.out)})
+    cfg = scenario(args)
     run_dir = run_simulation(cfg, args.year, scheduler=args.scheduler, n_workers=args.workers,
                              force=args.force)
     if cfg.db.dsn and (run_dir / "summary.json").exists():
@@ -45,6 +47,18 @@ def run(args):
 
         mirror_run(cfg.db.dsn, run_dir)
     return 0
+
+
+def scenario(args):
+    """The configuration the options make: the scenario, then ``--db``, ``--dashboard-port``
+    and ``--out`` over it."""
+    overrides = {"db": {"dsn": args.db}} if args.db else {}
+    if args.dashboard_port is not None:
+        overrides["dask"] = {"dashboard_port": args.dashboard_port or None}
+    cfg = load_config(args.config, overrides=overrides)
+    if args.out is not None:
+        cfg = load_config(args.config, overrides={**overrides, **under(cfg, args.out)})
+    return cfg
 
 
 def under(cfg, folder: Path) -> dict:

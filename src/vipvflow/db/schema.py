@@ -126,6 +126,9 @@ BLOCK_DAY = Table(
     "block_day", "block_day.parquet", ("block_id", "service_date"), [
         ("block_id", "text"), ("service_date", "date"), ("trips", "bigint"), ("pv_kwh", _F),
         ("pv_kwh_clear", _F), ("consumption_kwh", _F), ("first_departure_s", _F),
+        # instants: UTC timestamps in the file (vipvflow.simulation.dictionary.INSTANT)
+        *_cols(["window_start_utc", "window_end_utc", "first_departure_utc", "last_arrival_utc",
+                "infeasible_at_utc"], "timestamptz"),
     ], distribute_by="block_id", colocate_with="trip_energy")
 
 FLEET_MONTH = Table(

@@ -16,7 +16,7 @@ import numpy as np
 import pandas as pd
 
 from ..models.irradiance import shading_loss
-from ..simulation.dictionary import SUMMARY
+from ..simulation.dictionary import SUMMARY, render_html
 from ..store import RunDir, write_bytes, write_text
 
 #: colour limits of the maps: these percentiles of the segments' values (a few segments with
@@ -320,11 +320,15 @@ def fig_routes(rm: pd.DataFrame, coverage: float | None = None):
     """Per route and direction: the driving PV's share of the trips' consumption
     (coverage_driving) and the shading loss; the fleet's headline coverage in the title."""
     plt = _pyplot()
+    rm = rm.assign(trip_headsign=rm["trip_headsign"] if "trip_headsign" in rm else "")
     r = rm.groupby(["route_short_name", "direction_id"], dropna=False).agg(
         trips=("trips", "sum"), pv_kwh=("pv_kwh", "sum"), consumption_kwh=("consumption_kwh", "sum"),
         pv_kwh_unshaded=("pv_kwh_unshaded", "sum"), pv_kwh_direct=("pv_kwh_direct", "sum"),
-        pv_kwh_diffuse=("pv_kwh_diffuse", "sum")).reset_index()
-    labels = [f"{a} / dir {b}" for a, b in zip(r["route_short_name"], r["direction_id"])]
+        pv_kwh_diffuse=("pv_kwh_diffuse", "sum"),
+        headsign=("trip_headsign", lambda v: v.dropna().mode().iloc[0] if v.notna().any() else "")).reset_index()
+    # the names passengers know: "S5 to Ostheim" (the direction's number without a headsign)
+    labels = [f"{a} to {h}" if h else f"{a} / dir {b}"
+              for a, b, h in zip(r["route_short_name"], r["direction_id"], r["headsign"])]
     fig, ax = plt.subplots(1, 2, figsize=(10, 3.8))
     ax[0].bar(labels, 100 * r["pv_kwh"] / r["consumption_kwh"], color="#4285f4")
     ax[0].set_ylabel("driving PV / trips' consumption (%)")
@@ -459,7 +463,7 @@ def summary_table(summary: dict) -> str:
     more = [k for k, v in summary.items() if k not in shown and not isinstance(v, (dict, list))
             and k not in ("scenario", "year")]
     if more:
-        rows.append("<tr><th colspan='3' class='sec'>More (see docs/outputs.md)</th></tr>")
+        rows.append("<tr><th colspan='3' class='sec'>More (see <a href='#data-dictionary'>the data dictionary</a>)</th></tr>")
         rows += [_summary_row(summary, k, f"<code>{html.escape(k)}</code>", None, auto=True)
                  for k in more]
     return f"<table class='summary'>{''.join(rows)}</table>"
@@ -507,7 +511,8 @@ def _how_to_read(summary: dict) -> str:
         "the run. On the maps each segment shows the year of a bus that spent all its service "
         "hours in that segment's light, so a street's colour does not depend on how many buses "
         "use it or how long they stop there. Every column of the output files is explained, with "
-        "its unit, in <code>docs/outputs.md</code> and in the files' own metadata.</p>")
+        "its unit, in <a href='#data-dictionary'>the data dictionary</a> at the end of this report "
+        "and in the files' own metadata.</p>")
 
 
 def _inputs_table(cfg, crs_label: str, tiles: int | None) -> str:
@@ -643,7 +648,8 @@ def write_report(run_dir: Path, summary: dict, figures: list[tuple[str, str, byt
 <style>body{{font-family:sans-serif;max-width:1100px;margin:2em auto;color:#222}}img{{max-width:100%}}
 td,th{{text-align:left;padding:2px 10px}}td.num{{text-align:right;font-variant-numeric:tabular-nums}}
 th.sec{{padding-top:10px;border-bottom:1px solid #ccc}}tr[title]:hover{{background:#f4f4f4}}
-p{{line-height:1.45;max-width:900px}}</style></head><body>
+p{{line-height:1.45;max-width:900px}}details{{margin:4px 0}}summary{{cursor:pointer}}
+table.dictionary td{{vertical-align:top;font-size:0.9em}}</style></head><body>
 <h1>Bus-roof PV, fleet-year: {html.escape(title)}</h1>
 <p>{html.escape(_model_note(summary))}</p>
 <h2>How to read this</h2>{_how_to_read(summary)}
@@ -651,7 +657,8 @@ p{{line-height:1.45;max-width:900px}}</style></head><body>
 <h2>Summary</h2>{summary_table(summary)}
 <h2>Inputs</h2>{_inputs_table(cfg, crs, len(tiles) if tiles else None)}
 {_model_3d(model)}
-{''.join(parts)}</body></html>"""
+{''.join(parts)}
+<h2 id="data-dictionary">Data dictionary</h2>{render_html()}</body></html>"""
     return write_text(doc, RunDir(run_dir).report)
 
 

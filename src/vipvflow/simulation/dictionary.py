@@ -11,8 +11,11 @@ vocabulary shared by every file (:data:`COLUMNS`); the file says what one row ho
 Columns nobody documented are written without metadata (never an error); the tests require
 an entry for every column a run writes.
 
-Months are dates: ``month`` is written as a Parquet ``date32``, the first day of the month
-(local calendar of the feed), whatever the table held in memory (``"YYYY-MM"`` strings).
+Times are typed by what they are, whatever the table held in memory: a column whose unit is
+:data:`DATE` (``service_date``, ``month``: a day of the feed's local calendar; a month as its
+first day) is written as a Parquet ``date32``; a column whose unit is :data:`INSTANT` (the
+``*_utc`` columns: a moment) as a timestamp in microseconds with time zone UTC (from Unix
+seconds or a timestamp).
 """
 from __future__ import annotations
 
@@ -23,6 +26,12 @@ from dataclasses import dataclass
 class Column:
     unit: str
     meaning: str
+
+
+#: the unit of a calendar day (``date32`` in the files)
+DATE = "date"
+#: the unit of a moment (a timestamp with time zone UTC in the files, microseconds)
+INSTANT = "timestamp (UTC)"
 
 
 #: the light a roof receives, by component and sky (``h_<c>`` sums, ``g_<c>`` means, ``pv_kwh_<c>``)
@@ -75,8 +84,8 @@ COLUMNS: dict[str, Column] = {
     "tile": Column("", "city tile holding the segment's start, named by its south-west corner in "
                        "hundreds of metres of the city CRS (E0770N0750: x 77,000 m, y 75,000 m)"),
     "trip_id": Column("", "GTFS trip_id"),
-    "service_date": Column("date", "GTFS service date (local calendar of the feed)"),
-    "month": Column("date", "month, as its first day (local calendar of the feed)"),
+    "service_date": Column(DATE, "GTFS service date (local calendar of the feed)"),
+    "month": Column(DATE, "month, as its first day (local calendar of the feed)"),
     "hour": Column("h", "local clock hour, 0..23 (hour starting then)"),
     "route_id": Column("", "GTFS route_id"),
     "route_short_name": Column("", "GTFS route_short_name (the line's public name; its long name, "
@@ -124,7 +133,7 @@ COLUMNS: dict[str, Column] = {
     "feasible": Column("", "true when the charging plan serves the block-day with PV: the SoC stays at "
                            "or above the vehicle's soc_min and the depot restores the morning's SoC"),
     "feasible_without_pv": Column("", "the same without PV"),
-    "infeasible_at_utc": Column("UTC", "when the SoC (with PV) crosses soc_min, linear in time within the "
+    "infeasible_at_utc": Column(INSTANT, "when the SoC (with PV) crosses soc_min, linear in time within the "
                                        "trip or layover; null when it never does"),
     "infeasible_soc": Column("fraction", "SoC (with PV) at the end of the trip or layover where it falls "
                                          "below soc_min"),
@@ -138,12 +147,12 @@ COLUMNS: dict[str, Column] = {
     "grid_kwh_avoided": Column("kWh", "grid energy PV saves: (depot + terminals) without PV - with PV"),
     "soc_at_departure": Column("fraction", "the trip's battery state of charge at departure in its "
                                            "block-day's balance with PV (the web app starts from it)"),
-    "window_start_utc": Column("s (Unix)", "start of the block-day's time window (its GTFS service day)"),
-    "window_end_utc": Column("s (Unix)", "end of the block-day's time window (stretched to the last "
+    "window_start_utc": Column(INSTANT, "start of the block-day's time window (its GTFS service day)"),
+    "window_end_utc": Column(INSTANT, "end of the block-day's time window (stretched to the last "
                                          "arrival past the service day)"),
     "window_s": Column("s", "length of the block-day's window: seconds_driving + seconds_layover + seconds_parked"),
-    "first_departure_utc": Column("s (Unix)", "first departure of the block-day"),
-    "last_arrival_utc": Column("s (Unix)", "last arrival of the block-day"),
+    "first_departure_utc": Column(INSTANT, "first departure of the block-day"),
+    "last_arrival_utc": Column(INSTANT, "last arrival of the block-day"),
     "overlap_s": Column("s", "time two trips of the block overlap in the timetable (counted once, as driving)"),
     "seconds_driving": Column("s", "time on trips (first departure to last arrival of each trip)"),
     "seconds_layover": Column("s", "time standing at terminals between the block's trips"),
@@ -437,25 +446,17 @@ def describe(output: str, column: str) -> Column | None:
 
 
 def annotate(table, output: str):
-    """*table* (pyarrow) as written for the output file *output*: ``month`` strings
-    (``YYYY-MM``) as dates (first day), each documented field with ``unit`` and
-    ``description`` metadata; in the file's key-value metadata the file's title
+    """*table* (pyarrow) as written for the output file *output*: its dates as ``date32``
+    and its instants as UTC timestamps (:func:`typed_times`), each documented field with
+    ``unit`` and ``description`` metadata; in the file's key-value metadata the file's title
     (``vipvflow:rows``) and the same column entries as JSON (``vipvflow:columns``, for readers
     that do not show Arrow field metadata, e.g. DuckDB's ``parquet_kv_metadata``)."""
     import json
 
     import pyarrow as pa
-    import pyarrow.compute as pc
 
     spec = OUTPUTS[output]
-    if "month" in table.column_names:
-        i = table.column_names.index("month")
-        col = table.column(i)
-        if pa.types.is_string(col.type) or pa.types.is_large_string(col.type):
-            days = pc.strptime(pc.binary_join_element_wise(col.cast(pa.string()), "-01", ""),
-                               format="%Y-%m-%d", unit="s")
-            table = table.set_column(i, pa.field("month", pa.date32()), days.cast(pa.date32()))
-            table = table.replace_schema_metadata(_pandas_month_as_date(table.schema.metadata))
+    table = typed_times(table, output)
     fields, columns = [], {}
     for f in table.schema:
         entry = describe(output, f.name)
@@ -471,17 +472,70 @@ def annotate(table, output: str):
     return table.cast(pa.schema(fields, metadata=meta))
 
 
-def _pandas_month_as_date(meta: dict | None) -> dict | None:
-    """Schema metadata whose pandas entry (GeoDataFrames carry one) says ``month`` holds
-    dates, so pandas reads the column back as dates rather than as strings."""
+def typed_times(table, output: str):
+    """*table* (pyarrow) with each column the dictionary calls a :data:`DATE` as ``date32``
+    (from ``"YYYY-MM"`` or ``"YYYY-MM-DD"`` strings, timestamps or dates) and each it calls
+    an :data:`INSTANT` as ``timestamp[us, tz=UTC]`` (from Unix seconds, or a timestamp: a
+    naive one is taken as UTC); NaN seconds become nulls.  The pandas metadata (a
+    GeoDataFrame carries some) is told the new types, so pandas reads them as typed."""
+    import pyarrow as pa
+    import pyarrow.compute as pc
+
+    changed = {}
+    for i, name in enumerate(table.column_names):
+        entry = describe(output, name)
+        if entry is None or entry.unit not in (DATE, INSTANT):
+            continue
+        col = table.column(i)
+        t = col.type
+        if entry.unit == DATE:
+            if pa.types.is_date32(t):
+                continue
+            if pa.types.is_string(t) or pa.types.is_large_string(t):
+                text = col.cast(pa.string())
+                whole = pc.if_else(pc.equal(pc.utf8_length(text), 7),
+                                   pc.binary_join_element_wise(text, "-01", ""), text)
+                col = pc.strptime(whole, format="%Y-%m-%d", unit="s")
+            elif pa.types.is_timestamp(t) and t.tz is not None:
+                col = col.cast(pa.timestamp(t.unit))
+            col = col.cast(pa.date32())
+        else:
+            if pa.types.is_timestamp(t) and t.tz == "UTC" and t.unit == "us":
+                continue
+            if pa.types.is_floating(t) or pa.types.is_integer(t):
+                seconds = col.cast(pa.float64())
+                us = pc.round(pc.multiply(seconds, 1e6))
+                us = pc.if_else(pc.is_nan(us), None, us) if pa.types.is_floating(t) else us
+                col = us.cast(pa.int64()).cast(pa.timestamp("us", tz="UTC"))
+            elif pa.types.is_timestamp(t):          # to microseconds (truncated), in UTC
+                col = pc.cast(col, pa.timestamp("us", tz=t.tz or "UTC"), safe=False)
+                if t.tz not in (None, "UTC"):
+                    col = col.cast(pa.timestamp("us", tz="UTC"))
+            else:
+                raise TypeError(f"{output}.{name}: an instant, but of type {t}")
+        table = table.set_column(i, pa.field(name, col.type), col)
+        changed[name] = entry.unit
+    if changed:
+        table = table.replace_schema_metadata(_pandas_types(table.schema.metadata, changed))
+    return table
+
+
+def _pandas_types(meta: dict | None, changed: dict) -> dict | None:
+    """Schema metadata whose pandas entry (GeoDataFrames carry one) gives the *changed*
+    columns their new types (a date, a UTC timestamp), so pandas reads them as such rather
+    than as what the frame held before."""
     import json
 
     if not meta or b"pandas" not in meta:
         return meta
     pandas_meta = json.loads(meta[b"pandas"])
     for col in pandas_meta.get("columns", []):
-        if col.get("name") == "month":
+        unit = changed.get(col.get("name"))
+        if unit == DATE:
             col.update({"pandas_type": "date", "numpy_type": "object", "metadata": None})
+        elif unit == INSTANT:
+            col.update({"pandas_type": "datetimetz", "numpy_type": "datetime64[us, UTC]",
+                        "metadata": {"timezone": "UTC"}})
     return {**meta, b"pandas": json.dumps(pandas_meta).encode()}
 
 
@@ -500,7 +554,11 @@ def render_markdown() -> str:
         "`SELECT decode(value) FROM parquet_kv_metadata('segments.parquet') "
         "WHERE decode(key) = 'vipvflow:columns'`). "
         "Geometries are in the city's projected CRS (named in the GeoParquet metadata and in "
-        "`report.html`). `month` is a date: the first day of the month. Units: `fraction` is 0..1 "
+        "`report.html`). Times: a column of unit `date` (`service_date`, `month`) is a Parquet "
+        "`date32`, a day of the feed's local calendar (`month`: the month's first day); a column "
+        "of unit `timestamp (UTC)` (the `*_utc` columns) is a moment, a Parquet timestamp in "
+        "microseconds with time zone UTC (pandas: `datetime64[us, UTC]`; DuckDB: `TIMESTAMP WITH "
+        "TIME ZONE`). Units: `fraction` is 0..1 "
         "(x 100 for %), `Wh/m2` and `kWh/m2` are irradiation (energy per m2 of roof), `W/m2` "
         "irradiance (power).",
         "",
@@ -558,6 +616,35 @@ def render_markdown() -> str:
         lines.append(f"| `{k}` | {e.unit} | {e.meaning} |")
     lines.append("")
     return "\n".join(lines)
+
+
+def render_html() -> str:
+    """The data dictionary as HTML for the report (the report carries its own: a pip install
+    has no docs/ folder): an introduction, then each output file's columns and
+    ``summary.json``'s keys, each in a ``<details>`` block."""
+    import html
+
+    def row(name: str, e: Column) -> str:
+        return (f"<tr><td><code>{html.escape(name)}</code></td><td>{html.escape(e.unit)}</td>"
+                f"<td>{html.escape(e.meaning)}</td></tr>")
+
+    parts = ["<p>Every Parquet file of the run carries the unit and meaning of each column (Arrow "
+             "field metadata <code>unit</code>, <code>description</code>; for other readers JSON in "
+             "the key-value metadata <code>vipvflow:columns</code>). Dates (<code>service_date</code>, "
+             "<code>month</code>: a day of the feed's local calendar, a month as its first day) are "
+             "Parquet <code>date32</code>; instants (<code>*_utc</code>) are timestamps in "
+             "microseconds with time zone UTC. <code>fraction</code> is 0..1; W/m2 irradiance, "
+             "Wh/m2 and kWh/m2 irradiation.</p>"]
+    for name, spec in OUTPUTS.items():
+        rows = "".join(row(c, describe(name, c)) for c in spec.columns)
+        parts.append(f"<details><summary><code>{name}.parquet</code>: {html.escape(spec.title)} "
+                     f"({html.escape(spec.rows)})</summary><table class='dictionary'>"
+                     f"<tr><th>column</th><th>unit</th><th>meaning</th></tr>{rows}</table></details>")
+    rows = "".join(row(k, e) for k, e in SUMMARY.items())
+    parts.append("<details><summary><code>summary.json</code>: the fleet-year (yearly figures scaled "
+                 "by 12 / months when the run covers fewer)</summary><table class='dictionary'>"
+                 f"<tr><th>key</th><th>unit</th><th>meaning</th></tr>{rows}</table></details>")
+    return "\n".join(parts)
 
 
 if __name__ == "__main__":

@@ -109,8 +109,7 @@ def run_simulation(cfg: Config, year: int, scheduler: str | None = None,
         ray_threads = cfg.dask.ray_threads or (
             max(1, (os.cpu_count() or 1) // max(1, n_workers_now)) if cluster is not None else 1)
         ctx = dataclasses.replace(ctx, ray_threads=ray_threads)
-        say(f"dask dashboard: {client.dashboard_link}" if importlib.util.find_spec("bokeh")
-            else "dask dashboard: off (it needs bokeh: pip install 'vipvflow[app]')")
+        say(_dashboard_line(client, cluster, cfg.dask.dashboard_port))
         warm.join()
         # what this process holds by now (the libraries, the inputs' tables) outlives the
         # run: the cyclic collector leaves it alone until the run is done (each of its full
@@ -171,6 +170,19 @@ def run_simulation(cfg: Config, year: int, scheduler: str | None = None,
     say(_summary_line(summary))
     say(f"outputs in {run_dir}")
     return run_dir
+
+
+def _dashboard_line(client, cluster, port: int | None) -> str:
+    """Where the Dask dashboard is; for a LocalCluster whose configured port was taken, that
+    it serves on another."""
+    from urllib.parse import urlsplit
+
+    if not importlib.util.find_spec("bokeh"):
+        return "dask dashboard: off (it needs bokeh: pip install 'vipvflow[app]')"
+    link = client.dashboard_link
+    if cluster is not None and port and urlsplit(link).port != port:
+        return f"dask dashboard: {link} (port {port} is taken)"
+    return f"dask dashboard: {link}"
 
 
 def _run_context(cfg: Config, year: int, run_dir: Path) -> tuple[RunContext, list[str]]:
