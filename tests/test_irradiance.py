@@ -456,3 +456,98 @@ def test_segment_uniforms_are_each_keys_own_default_rng():
     got = segment_uniforms(42, 2, keys, 33)
     for row, key in zip(got, keys):
         np.testing.assert_array_equal(row, np.random.default_rng([42, 2, int(key)]).random(33))
+
+
+# ---------------------------------------------------------------------------- the Perez sky
+def test_perez_coefficients_give_pvlibs_perez_sky_diffuse():
+    """An open tilted plane: the model's Perez sky (isotropic part x (1 + cos tilt) / 2,
+    circumsolar part seen with the sun, horizon part x sin tilt) is pvlib's
+    ``irradiance.perez`` sky diffuse, component by component."""
+    from vipvflow.models.irradiance import roof_components
+    from vipvflow.models.sky import perez_coefficients
+
+    rng = np.random.default_rng(3)
+    n = 2000
+    times = pd.Timestamp("2024-01-01", tz="UTC") + pd.to_timedelta(rng.uniform(0, 366, n), "D")
+    zen, azi = rng.uniform(0, 89, n), rng.uniform(0, 360, n)
+    tilt, s_az = rng.uniform(0, 90, n), rng.uniform(0, 360, n)
+    dni, dhi = rng.uniform(0, 950, n), rng.uniform(1, 400, n)
+    e0 = pvlib.irradiance.get_extra_radiation(times).to_numpy()
+    am = pvlib.atmosphere.get_relative_airmass(zen)
+    ref = pvlib.irradiance.perez(tilt, s_az, dhi, dni, e0, zen, azi, am, return_components=True)
+    f1, f2 = perez_coefficients(dhi, dni, e0, zen, am)
+    cos_aoi = np.maximum(pvlib.irradiance.aoi_projection(tilt, s_az, zen, azi), 0)
+    f = np.float32
+    iso = ((1 + np.cos(np.radians(tilt))) / 2).astype(f)
+    sin_t = np.sin(np.radians(tilt)).astype(f)
+    sky = {"f1": f1.astype(f), "f2": f2.astype(f), "cos_zenith": np.cos(np.radians(zen)).astype(f),
+           "horizon_view": sin_t, "reflector_horizon": np.zeros(n, f), "sin_tilt": sin_t}
+    z = np.zeros(n, f)
+    direct, diffuse, _, unshaded = roof_components(
+        dni.astype(f), dhi.astype(f), z, cos_aoi.astype(f), np.ones(n, f), iso, np.zeros((n, 0), f),
+        np.zeros((n, 0), f), z, z, iso, sky)
+    np.testing.assert_allclose(diffuse, ref["poa_sky_diffuse"], rtol=2e-5, atol=2e-4)
+    np.testing.assert_allclose(unshaded - direct, ref["poa_sky_diffuse"], rtol=2e-5, atol=2e-4)
+    # in the shade of a building the circumsolar part goes with the sun
+    _, shaded, _, _ = roof_components(
+        dni.astype(f), dhi.astype(f), z, cos_aoi.astype(f), np.zeros(n, f), iso,
+        np.zeros((n, 0), f), np.zeros((n, 0), f), z, z, iso, sky)
+    want = np.maximum(ref["poa_isotropic"] + ref["poa_horizon"], 0)
+    np.testing.assert_allclose(shaded, want, rtol=2e-5, atol=2e-4)
+    assert (ref["poa_circumsolar"] > 50).sum() > 100          # the case has circumsolar light
+
+
+def test_radiation_table_perez_full_chain_matches_pvlib():
+    """Radiation table (its Perez coefficients per minute) + pass times, no buildings:
+    the total is pvlib's Perez plane-of-array irradiance (albedo 0)."""
+    grid = np.arange(pd.Timestamp("2024-06-01", tz="UTC").timestamp(),
+                     pd.Timestamp("2024-06-03", tz="UTC").timestamp(), 60.0)
+    vals = {c: np.full(len(grid), v) for c, v in zip(COLUMNS, (600, 700, 150, 800, 850, 90))}
+    table = RadiationTable.from_grid(grid, vals, 49.61, 6.13, 300.0)
+    segs = _segments([0.0, 10.0, 20.0], 0.0, 3.2, [0.0, 90.0, 200.0], [0.0, 0.08, -0.03])
+    scene = Scene(box_mesh(np.zeros((0, 6))))
+    cfg = IrradianceCfg(svf_rays=64, reflection_rays=16, diffuse_model="perez_svf")
+    geometry = segment_geometry(scene, segs, cfg)
+    # the open roof sees all of the band near the horizon in front of it
+    np.testing.assert_allclose(geometry["hbv"], np.sin(np.radians(geometry["tilt_deg"])), rtol=1e-6)
+    rng = np.random.default_rng(5)
+    p = 300
+    t = rng.uniform(grid[10], grid[-10], p)
+    t = np.round(t / 60) * 60             # on the grid: no interpolation of the coefficients
+    passes = pd.DataFrame({"segment_id": rng.integers(0, 3, p), "t_utc": t})
+    out = evaluate_passes(passes, segs, geometry, table, scene, cfg, time_at="start")
+    times = pd.to_datetime(t * 1e9, utc=True)
+    sp = pvlib.solarposition.get_solarposition(times, 49.61, 6.13, altitude=300.0)
+    tilt, az = roof_plane(segs["heading_deg"].to_numpy()[passes["segment_id"]],
+                          segs["gradient"].to_numpy()[passes["segment_id"]])
+    zen = sp["apparent_zenith"].to_numpy()
+    up = zen < 90
+    ref = pvlib.irradiance.get_total_irradiance(tilt, az, zen, sp["azimuth"].to_numpy(),
+                                                np.where(up, 700, 0), 600, 150, albedo=0.0,
+                                                model="perez", dni_extra=pvlib.irradiance.get_extra_radiation(times),
+                                                airmass=pvlib.atmosphere.get_relative_airmass(zen))
+    # the sky view factor is 64 rays' estimate of (1 + cos tilt) / 2: exact on level roofs
+    # (the table's constant DHI at night is the test's, pvlib leaves it out there)
+    level = geometry["tilt_deg"].to_numpy()[passes["segment_id"]] == 0
+    assert up.sum() > 100 and (level & up).sum() > 30
+    got, want = out["total_unshaded"].to_numpy()[up], ref["poa_global"][up]
+    np.testing.assert_allclose(got, want, rtol=2e-3, atol=0.5)   # the sun at dawn: 5-min SPA grid
+    np.testing.assert_allclose(out["total"][level & up], ref["poa_global"][level & up], rtol=2e-3,
+                               atol=0.05)
+    np.testing.assert_allclose(out["total"][up], want, rtol=2e-2, atol=0.5)
+
+
+def test_horizon_band_view_of_a_facade_half_hidden():
+    """A facade facing east with a tall wall across the north-east half of its view: it
+    sees half of the band near the horizon in front of it (the band's light on it is
+    symmetric about its normal); an open one sees all of it, a level roof none."""
+    from vipvflow.models.view_factors import horizon_band_view, segment_uniforms
+
+    wall = Scene(box_mesh([[5.0, 0.0, -100.0, 6.0, 50_000.0, 500.0]]))
+    o = np.array([[0.0, 0.0, 1.0]] * 3)
+    nrm = np.array([[1.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
+    uni = segment_uniforms(7, 4, np.arange(3), 2 * 256)
+    h = horizon_band_view(wall, o, nrm, uni, 256, 100_000.0)
+    assert abs(h[0] - 0.5) < 0.01 and h[2] == 0.0
+    open_ = horizon_band_view(Scene(box_mesh(np.zeros((0, 6)))), o, nrm, uni, 256, 300.0)
+    assert open_[0] == 1.0 and open_[2] == 0.0

@@ -23,9 +23,12 @@ class CycleCfg(_Params):
 
 
 class IrradianceCfg(_Params):
-    # sky_view_factor: DHI x the roof point's cosine-weighted sky view (the default);
-    # isotropic: the paper's DHI (1 + cos tilt) / 2, an upper bound in streets
-    diffuse_model: Literal["isotropic", "sky_view_factor"] = "sky_view_factor"
+    # perez_svf: DHI split by the Perez model into an isotropic part (x the roof point's
+    # sky view factor), a circumsolar part (seen when the sun is) and a horizon band (x the
+    # roof point's view of the band near the horizon); sky_view_factor: DHI x the roof
+    # point's cosine-weighted sky view (a uniform sky); isotropic: the paper's DHI (1 + cos
+    # tilt) / 2, an upper bound in streets
+    diffuse_model: Literal["perez_svf", "isotropic", "sky_view_factor"] = "sky_view_factor"
     reflection: bool = True
     reflection_rays: int = Field(256, ge=0, le=65_536)
     svf_rays: int = Field(512, gt=0, le=65_536)
@@ -35,6 +38,7 @@ class IrradianceCfg(_Params):
     reflector_points: int = Field(64, ge=1)
     reflector_sampling: Literal["rotate", "all"] = "rotate"
     reflector_sky_rays: int = Field(4, ge=1)
+    horizon_band_rays: int = Field(64, ge=1, le=65_536)
     seed: int = 7
 
 

@@ -17,6 +17,7 @@ import pandas as pd
 from ..errors import InputError
 from ..inputs.cams import _GRID_S, COLUMNS, ingest_cams
 from ..store import DataDir, RadiationDir, write_npz
+from .sky import perez_table
 
 log = logging.getLogger(__name__)
 
@@ -85,8 +86,9 @@ class RadiationTable:
     ----------
     t0 : float, Unix s of grid point 0
     step_s : float, grid step (s)
-    data : dict name -> (K, N) float32; ``ghi ... dhi_clear`` (W/m2) and the sun unit vector
-        ``sun_x, sun_y, sun_z`` (east, north, up; from pvlib apparent zenith and azimuth)
+    data : dict name -> (K, N) float32; ``ghi ... dhi_clear`` (W/m2), the sun unit vector
+        ``sun_x, sun_y, sun_z`` (east, north, up; from pvlib apparent zenith and azimuth) and
+        the Perez coefficients ``f1, f2, f1_clear, f2_clear`` (dimensionless)
     lat, lon : (K,) float64, degrees
 
     References
@@ -187,6 +189,11 @@ class RadiationTable:
             sun = sun_vectors(t, lat, lon, alt, sun_step_s)
         for j, name in enumerate(("sun_x", "sun_y", "sun_z")):
             data[name] = sun[j]
+        # the Perez sky's circumsolar and horizon coefficients of every time step, all-sky
+        # and clear-sky (models.sky): looked up per pass like the radiation
+        for sfx in ("", "_clear"):
+            data["f1" + sfx], data["f2" + sfx] = perez_table(
+                t, data["dhi" + sfx], data["dni" + sfx], data["sun_z"])
         return cls(t0=float(t[0]), step_s=step, data=data, lat=lat, lon=lon)
 
     @classmethod
@@ -267,7 +274,8 @@ class RadiationTable:
         -------
         dict of float32 arrays
             ``ghi, dni, dhi, ghi_clear, dni_clear, dhi_clear`` (W/m2), ``sun_x, sun_y, sun_z``
-            (unit vector east/north/up), ``zenith`` (apparent, deg), ``azimuth`` (deg from
+            (unit vector east/north/up), ``f1, f2, f1_clear, f2_clear`` (the Perez sky's
+            circumsolar and horizon coefficients, :mod:`vipvflow.models.sky`), ``zenith`` (apparent, deg), ``azimuth`` (deg from
             north, clockwise).  NaN outside the grid.
         """
         t = np.asarray(t_utc, dtype=np.float64)

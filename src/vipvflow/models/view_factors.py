@@ -263,13 +263,14 @@ def _reflector_surroundings(scene, keys, pts, nrm, used, cfg: IrradianceCfg, str
     Returns
     -------
     dict of (m, G) arrays ``sky``, ``gnd`` (albedo-weighted street), ``open``, ``wall``
-    (albedo-weighted facades and roofs), and the street hits ``hits``: ``pair`` (segment x
+    (albedo-weighted facades and roofs), ``hor`` (view of the band of sky near the horizon,
+    :func:`horizon_band_view`, mean over the points), and the street hits ``hits``: ``pair`` (segment x
     G + group), ``p`` (hit points, m), ``n`` (upward normals), ``w`` (albedo / rays, the
     hit's share of the group's ``gnd``).
     """
     m, G, P, _ = pts.shape
     R = cfg.reflector_sky_rays
-    out = {k: np.zeros((m, G)) for k in ("sky", "gnd", "open", "wall")}
+    out = {k: np.zeros((m, G)) for k in ("sky", "gnd", "open", "wall", "hor")}
     sel = np.flatnonzero(used.reshape(-1))                     # active (segment, group)
     out["hits"] = {"pair": np.zeros(0, np.int64), "p": np.zeros((0, 3)), "n": np.zeros((0, 3)),
                    "w": np.zeros(0)}
@@ -293,6 +294,12 @@ def _reflector_surroundings(scene, keys, pts, nrm, used, cfg: IrradianceCfg, str
         out[k].reshape(-1)[sel] = v.astype(np.float64).reshape(-1, n).mean(1)
     out["gnd"].reshape(-1)[sel] = np.where(on_ground, a, 0.0).reshape(-1, n).mean(1)
     out["wall"].reshape(-1)[sel] = np.where(hit & ~on_ground, a, 0.0).reshape(-1, n).mean(1)
+    # the view of the band of sky near the horizon (the Perez horizon term), R rays a point
+    pn = nrm.reshape(m * G, P, 3)[sel].reshape(-1, 3)
+    band_uni = segment_uniforms(cfg.seed, stream + 3, keys, G * P * 2 * R).reshape(m * G, P, 2 * R)
+    band = horizon_band_view(scene, pts.reshape(m * G, P, 3)[sel].reshape(-1, 3), pn,
+                             band_uni[sel].reshape(-1, 2 * R), R, cfg.ray_length_m)
+    out["hor"].reshape(-1)[sel] = band.reshape(-1, P).mean(1)
     g = np.flatnonzero(on_ground & (a > 0))
     if len(g):
         tn = np.asarray(mesh.normals, np.float64)[tri[g]]
@@ -402,10 +409,17 @@ def segment_geometry(scene, segments: pd.DataFrame, cfg: IrradianceCfg | None = 
     origin = _roof_points(segments) + cfg.ray_offset_m * normal
     G, P = cfg.max_reflector_groups, cfg.reflector_points
     svf = np.ones(n_seg, np.float64)
+    hbv = np.zeros(n_seg, np.float64)
     acc = _no_reflectors(origin, G, P)
+    H = cfg.horizon_band_rays
     for a in range(0, n_seg, chunk):
         sl = slice(a, min(n_seg, a + chunk))
         svf[sl] = _sky_view_factor(scene, origin[sl], normal[sl], seg_ids[sl], cfg)
+        tilted = np.flatnonzero(np.hypot(normal[sl, 0], normal[sl, 1]) > 1e-6)
+        if len(tilted):
+            uni = segment_uniforms(cfg.seed, 4, seg_ids[sl][tilted], 2 * H)
+            hbv[a + tilted] = horizon_band_view(scene, origin[sl][tilted], normal[sl][tilted],
+                                                uni, H, cfg.ray_length_m)
         if not (cfg.reflection and cfg.reflection_rays > 0 and G > 0):
             continue
         # more rays where the sky view is small: reflections matter most there
@@ -414,7 +428,7 @@ def segment_geometry(scene, segments: pd.DataFrame, cfg: IrradianceCfg | None = 
             idx = np.arange(sl.start, sl.stop)[part]
             if len(idx):
                 _reflectors(scene, origin[idx], normal[idx], seg_ids[idx], N, cfg, acc, idx)
-    return _geometry_frame(seg_ids, origin, tilt, azim, normal, svf, acc, G, P)
+    return _geometry_frame(seg_ids, origin, tilt, azim, normal, svf, acc, G, P, hbv)
 
 
 def _no_reflectors(origin, G: int, P: int) -> dict:
@@ -424,7 +438,7 @@ def _no_reflectors(origin, G: int, P: int) -> dict:
             "n": np.tile(np.array([0.0, 0.0, 1.0]), (n, G, 1)) if G else np.zeros((n, 0, 3)),
             "rep": np.repeat(origin[:, None], G, axis=1),
             "pts": np.repeat(np.repeat(origin[:, None, None], G, axis=1), P, axis=2),
-            **{k: np.zeros((n, G)) for k in ("sky", "gnd", "open", "wall")},
+            **{k: np.zeros((n, G)) for k in ("sky", "gnd", "open", "wall", "hor")},
             "nlen": np.ones((n, G)), "surface": np.full((n, G), -1, np.int64),
             "street": {"n": np.tile([0.0, 0.0, 1.0], (n, 1)),
                        "pts": np.repeat(origin[:, None], P, axis=1),
@@ -446,6 +460,76 @@ def _sky_view_factor(scene, o, nrm, keys, cfg: IrradianceCfg) -> np.ndarray:
     free = ((~blocked) & (d[:, 2] > 0)).reshape(len(o), R).mean(axis=1)
     # never above the open field's (1 + cos tilt) / 2, which the rays only estimate
     return np.minimum(free, isotropic_sky_view(np.asarray(nrm, np.float64)[:, 2]))
+
+
+def horizon_band_directions(normals: np.ndarray, n_rays: int, uni: np.ndarray) -> np.ndarray:
+    """Directions into the band of sky near the horizon in front of each plane, drawn in
+    proportion to the light the band gives the plane.
+
+    The Perez model's horizon band lies at the horizon, so it lights a plane of tilt
+    ``beta`` in proportion to ``sin beta cos phi`` (``phi`` the azimuth from the plane's
+    own); ray ``k`` takes its azimuth from the ``k``-th of *n_rays* equal shares of that
+    weight (``phi = asin(2 u - 1)``, stratified and jittered) and its elevation uniform in
+    the band's 6.5 deg, so the share of rays that escape is the weighted view of the band.
+
+    Parameters
+    ----------
+    normals : (m, 3) float, unit normals (east, north, up)
+    n_rays : int, rays per normal
+    uni : (m, 2 n_rays) float, uniforms in [0, 1): the azimuth jitter, then the elevation
+
+    Returns
+    -------
+    (m, n_rays, 3) float64 unit vectors
+
+    References
+    ----------
+    R. Perez, R. Seals, P. Ineichen, R. Stewart, D. Menicucci (1987), Solar Energy 39(3),
+    221-231 (the horizon band); M. Pharr, W. Jakob, G. Humphreys, Physically Based Rendering,
+    3rd ed., section 13.3 (inversion method, stratified sampling).
+    """
+    from .sky import HORIZON_BAND_DEG
+
+    n = np.asarray(normals, np.float64)
+    m = len(n)
+    uni = np.asarray(uni, np.float64).reshape(m, 2, n_rays)
+    az0 = np.arctan2(n[:, 0], n[:, 1])[:, None]
+    u = (np.arange(n_rays)[None, :] + uni[:, 0]) / n_rays
+    az = az0 + np.arcsin(np.clip(2.0 * u - 1.0, -1.0, 1.0))
+    el = np.radians(HORIZON_BAND_DEG) * uni[:, 1]
+    ce = np.cos(el)
+    return np.stack([ce * np.sin(az), ce * np.cos(az), np.sin(el)], -1)
+
+
+def horizon_band_view(scene, o, nrm, uni, n_rays: int, ray_length_m: float) -> np.ndarray:
+    """Each plane's view of the band of sky near the horizon, weighted as the Perez horizon
+    term lights it: ``sin beta`` x the weighted share of the band in front of it that no
+    surface hides (``sin beta`` for an open plane, 0 for a horizontal one); (m,) float64.
+
+    Parameters
+    ----------
+    scene : vipvflow.models.shading.Scene
+    o : (m, 3) ray origins (m), nrm : (m, 3) unit normals
+    uni : (m, 2 n_rays) uniforms in [0, 1) (:func:`segment_uniforms`)
+    n_rays : int, rays per plane (:func:`horizon_band_directions`)
+    ray_length_m : float, m
+
+    References
+    ----------
+    R. Perez et al. (1990), Solar Energy 44(5), 271-289 (the horizon term ``F2 sin beta``);
+    pvlib ``irradiance.perez``.
+    """
+    nrm = np.asarray(nrm, np.float64)
+    s = np.hypot(nrm[:, 0], nrm[:, 1])
+    out = np.zeros(len(nrm))
+    tilted = np.flatnonzero(s > 1e-6)
+    if not len(tilted):
+        return out
+    d = horizon_band_directions(nrm[tilted], n_rays, np.asarray(uni)[tilted]).reshape(-1, 3)
+    blocked = scene.occluded(np.repeat(np.asarray(o, np.float64)[tilted], n_rays, axis=0), d,
+                             ray_length_m)
+    out[tilted] = s[tilted] * (~blocked).reshape(-1, n_rays).mean(1)
+    return out
 
 
 def _merge_groups(hs, hn, w, m: int, G: int) -> np.ndarray:
@@ -515,7 +599,7 @@ def _reflectors(scene, o, nrm, keys, N: int, cfg: IrradianceCfg, acc: dict, idx)
     lift = max(cfg.ray_offset_m, _MIN_REFLECTOR_LIFT)
     pts, pn = _group_points(o, hs, gkey, w, hp, hn, w_g, n_g, P, lift)
     around = _reflector_surroundings(scene, keys, pts, pn, nz, cfg)
-    for k in ("sky", "gnd", "open", "wall"):
+    for k in ("sky", "gnd", "open", "wall", "hor"):
         acc[k][idx] = around[k]
     acc["w"][idx], acc["n"][idx], acc["rep"][idx], acc["pts"][idx] = w_g, n_g, rep.reshape(m, G, 3), pts
     st = _street(o, w_g, around, keys, cfg, scene, lift)
@@ -523,14 +607,15 @@ def _reflectors(scene, o, nrm, keys, N: int, cfg: IrradianceCfg, acc: dict, idx)
         acc["street"][k][idx] = st[k]
 
 
-def _geometry_frame(seg_ids, origin, tilt, azim, normal, svf, acc: dict, G: int, P: int) -> pd.DataFrame:
+def _geometry_frame(seg_ids, origin, tilt, azim, normal, svf, acc: dict, G: int, P: int,
+                    hbv) -> pd.DataFrame:
     """The stored geometry table (plain numeric columns, see :func:`segment_geometry`)."""
     f32 = np.float32
     out = {"segment_id": seg_ids,
            "px": origin[:, 0], "py": origin[:, 1], "pz": origin[:, 2],
            "tilt_deg": tilt.astype(f32), "azimuth_deg": azim.astype(f32),
            "nx": normal[:, 0].astype(f32), "ny": normal[:, 1].astype(f32),
-           "nz": normal[:, 2].astype(f32), "svf": svf.astype(f32),
+           "nz": normal[:, 2].astype(f32), "svf": svf.astype(f32), "hbv": hbv.astype(f32),
            "refl_vf": acc["refl_vf"].astype(f32), "refl_vf_se": acc["refl_se"].astype(f32)}
     for g in range(G):
         out[f"r{g}_w"] = acc["w"][:, g].astype(f32)
@@ -541,7 +626,7 @@ def _geometry_frame(seg_ids, origin, tilt, azim, normal, svf, acc: dict, G: int,
         for k in range(P):
             for j, c in enumerate("xyz"):
                 out[f"r{g}_p{k}_{c}"] = acc["pts"][:, g, k, j]
-        for k in ("sky", "gnd", "open", "wall", "nlen"):
+        for k in ("sky", "gnd", "open", "wall", "hor", "nlen"):
             out[f"r{g}_{k}"] = acc[k][:, g].astype(f32)
         out[f"r{g}_surface"] = acc["surface"][:, g].astype(np.int32)
     if G:
@@ -714,8 +799,10 @@ def pack_geometry(geometry: pd.DataFrame, cfg: IrradianceCfg, ground_albedo: flo
     Returns
     -------
     dict of arrays per segment ``s`` and reflector ``J`` (groups, then the street): ``p``
-    (s, 3) ray origins (m), ``n`` (s, 3) roof normals, ``svf`` (s,), ``refl_sky`` and
-    ``refl_ghi`` (s,) the weights of DHI and GHI in the reflected part (dimensionless),
+    (s, 3) ray origins (m), ``n`` (s, 3) roof normals, ``svf`` (s,), ``hbv`` (s,) the roof's
+    view of the horizon band, ``refl_sky`` and ``refl_ghi`` (s,) the weights of DHI and GHI
+    in the reflected part, ``refl_hor`` (s,) the reflectors' horizon-band views so weighted
+    (x DHI F2 under the Perez sky; all dimensionless),
     ``wn`` (s, J, 3) weight x normal of each reflector (its beam weight is ``wn . sun``),
     ``group_p`` (s J, P, 3) sample points (m); with *scene* also ``scene_origin``,
     ``p_local`` and ``group_p_local`` (float32, the scene's frame).
@@ -740,7 +827,7 @@ def pack_geometry(geometry: pd.DataFrame, cfg: IrradianceCfg, ground_albedo: flo
     w = np.stack([col(f"r{g}_w") for g in range(G)], 1) if G else np.zeros((s, 0))
     nrm = np.zeros((s, J, 3))
     pts = np.zeros((s, J, max(P, 1), 3), np.float64)
-    f_s, f_g, f_o, f_w = (np.zeros((s, G)) for _ in range(4))
+    f_s, f_g, f_o, f_w, f_h = (np.zeros((s, G)) for _ in range(5))
     beam_len = np.ones((s, J))
     # the sample points: one (s, P x 3) block per reflector (a thousand columns read one
     # by one cost more than the rest of the packing)
@@ -759,6 +846,8 @@ def pack_geometry(geometry: pd.DataFrame, cfg: IrradianceCfg, ground_albedo: flo
             f_s[:, g], f_o[:, g] = (1 + nrm[:, g, 2]) / 2, (1 - nrm[:, g, 2]) / 2
         if f"r{g}_wall" in cols:
             f_w[:, g] = col(f"r{g}_wall")
+        if f"r{g}_hor" in cols:
+            f_h[:, g] = col(f"r{g}_hor")
         if f"r{g}_nlen" in cols:
             beam_len[:, g] = col(f"r{g}_nlen")
     src_sky, src_ghi = f_s, ground_albedo * f_o
@@ -770,13 +859,16 @@ def pack_geometry(geometry: pd.DataFrame, cfg: IrradianceCfg, ground_albedo: flo
         m = _exchange_weights(w, f_g, f_w, col("st_wall"), has)
         src_sky = np.concatenate([f_s, col("st_sky")[:, None]], 1)
         src_ghi = np.concatenate([src_ghi, np.zeros((s, 1))], 1)
+        f_h = np.concatenate([f_h, np.zeros((s, 1))], 1)     # a level street: no horizon term
     else:                     # the street lit as an open field, by GHI
         m = w
         src_ghi = src_ghi + f_g
     geo = {"p": np.ascontiguousarray(geometry[["px", "py", "pz"]].to_numpy(np.float64)),
            "n": np.ascontiguousarray(geometry[["nx", "ny", "nz"]].to_numpy(f32)),
            "svf": geometry["svf"].to_numpy(f32),
+           "hbv": (geometry["hbv"].to_numpy(f32) if "hbv" in cols else np.zeros(s, f32)),
            "refl_sky": (m * src_sky).sum(1).astype(f32), "refl_ghi": (m * src_ghi).sum(1).astype(f32),
+           "refl_hor": (m * f_h).sum(1).astype(f32),
            "wn": ((m * beam_len)[..., None] * nrm).astype(f32), "group_p": pts.reshape(s * J, -1, 3)}
     if scene is not None:
         geo["scene_origin"] = np.asarray(scene.origin, np.float64).copy()
