@@ -39,6 +39,10 @@ class IrradianceCfg(_Params):
     reflector_sampling: Literal["rotate", "all"] = "rotate"
     reflector_sky_rays: int = Field(4, ge=1)
     horizon_band_rays: int = Field(64, ge=1, le=65_536)
+    # where the city model has no ground (no terrain, no road surfaces) the street under the
+    # bus is the level ground at the road's height, lit and shaded as it is, with the road's
+    # albedo; false: rays that leave the model downwards see an open field lit by GHI
+    virtual_street: bool = True
     seed: int = 7
 
 

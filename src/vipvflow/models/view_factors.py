@@ -206,11 +206,11 @@ def _group_points(o, hs, gkey, w, hp, hn, w_g, n_g, P: int, lift: float):
     key1 = np.where(v, hp[:, 2], np.hypot(rel[:, 0], rel[:, 1]))
     key2 = np.where(v, along, np.arctan2(rel[:, 0], rel[:, 1]))
     wflat = w_g.reshape(-1)
-    before = np.cumsum(wflat) - wflat                           # weight of earlier groups
     # band of each hit: the weight quantile of its mid-weight along key1 within its group
+    # (sums within each group only, so a group's points do not depend on the others')
     srt = np.lexsort((key1, gkey))
     mid = np.empty(len(w))
-    mid[srt] = np.cumsum(w[srt]) - 0.5 * w[srt] - before[gkey[srt]]
+    mid[srt] = _group_cumsum(w[srt], gkey[srt]) - 0.5 * w[srt]
     B = math.isqrt(P)
     B = B if B * B == P else P           # P not a square: P bands along key1, as in 1D
     band = np.minimum((B * mid / np.maximum(wflat[gkey], 1e-300)).astype(np.int64), B - 1)
@@ -218,7 +218,7 @@ def _group_points(o, hs, gkey, w, hp, hn, w_g, n_g, P: int, lift: float):
     bkey = gkey * B + band
     w_band = np.bincount(bkey, w, m * G * B)
     srt = np.lexsort((key2, bkey))
-    mid[srt] = np.cumsum(w[srt]) - 0.5 * w[srt] - (np.cumsum(w_band) - w_band)[bkey[srt]]
+    mid[srt] = _group_cumsum(w[srt], bkey[srt]) - 0.5 * w[srt]
     per = P // B                                                # cells per band
     cell = np.minimum((per * mid / np.maximum(w_band[bkey], 1e-300)).astype(np.int64), per - 1)
     ckey = bkey * per + cell
@@ -227,22 +227,32 @@ def _group_points(o, hs, gkey, w, hp, hn, w_g, n_g, P: int, lift: float):
     # (a Latin square of bands and cells) and B x per strata of key2 within the bands
     srt = np.lexsort((key1, ckey))
     cs = ckey[srt]
-    cw = np.cumsum(w[srt])
+    gs = gkey[srt]
+    cw = _group_cumsum(w[srt], gs)                              # within each group
     n_cell = m * G * B * per
-    w_cell = np.bincount(ckey, w, n_cell).reshape(m * G, B, per)
-    start = (np.cumsum(w_cell) - w_cell.reshape(-1)).reshape(m * G, B, per)
+    w_cell = np.bincount(ckey, w, n_cell).reshape(m * G, B * per)
+    start = np.cumsum(w_cell, axis=1) - w_cell                  # within each group
     bb, cc = np.divmod(np.arange(B * per), per)
     sub = ((cc + bb) % per + 0.5) / per
-    target = (start + sub.reshape(B, per) * w_cell).reshape(m * G, P)
+    target = start + sub[None, :] * w_cell
     cells = np.arange(n_cell).reshape(m * G, P)
     lo = np.searchsorted(cs, cells, side="left")
     hi = np.searchsorted(cs, cells, side="right") - 1
     # an empty cell (a group of few hits) takes the hit at its target in the group's order
-    glo = np.searchsorted(gkey[srt], np.arange(m * G), side="left")[:, None]
-    ghi = np.searchsorted(gkey[srt], np.arange(m * G), side="right")[:, None] - 1
+    glo = np.searchsorted(gs, np.arange(m * G), side="left")[:, None]
+    ghi = np.searchsorted(gs, np.arange(m * G), side="right")[:, None] - 1
     empty = hi < lo
     lo, hi = np.where(empty, glo, lo), np.where(empty, np.maximum(ghi, glo), hi)
-    idx = np.clip(np.searchsorted(cw, target, side="left"), lo, hi)
+    # the first hit of the group whose cumulative weight reaches the target: merge the
+    # targets into the hits' (group, cumulative weight) order, a target before equal hits
+    q_group = np.repeat(np.arange(m * G), P)
+    order = np.lexsort((np.r_[np.zeros(len(q_group), np.int8), np.ones(len(gs), np.int8)],
+                        np.r_[target.reshape(-1), cw], np.r_[q_group, gs]))
+    is_hit = order >= len(q_group)
+    hits_before = np.cumsum(is_hit) - is_hit
+    first = np.empty(len(q_group), np.int64)
+    first[order[~is_hit]] = hits_before[~is_hit]
+    idx = np.clip(first.reshape(m * G, P), lo, hi)
     idx = srt[np.minimum(idx, len(srt) - 1)]
     used = (wflat > 0)[:, None]
     pts = np.where(used[..., None], hp[idx] + lift * hn[idx],
@@ -251,14 +261,73 @@ def _group_points(o, hs, gkey, w, hp, hn, w_g, n_g, P: int, lift: float):
     return pts.reshape(m, G, P, 3), nrm.reshape(m, G, P, 3)
 
 
-def _reflector_surroundings(scene, keys, pts, nrm, used, cfg: IrradianceCfg, stream: int = 2):
+#: the surface index of the street where the city model has none (the virtual ground)
+VIRTUAL_GROUND = -2
+
+
+def _hits(scene, o, d, ray_length_m: float, ground_z, road_albedo: float) -> dict:
+    """What rays from *o* (n, 3) along *d* (n, 3) hit first: a triangle of the mesh, else the
+    street where the city model has none.
+
+    A city model without terrain or road surfaces (most LoD2 building files) leaves the
+    street out, and a ray that leaves a facade downwards would escape, counted as open
+    ground lit like a field.  Here a ray that hits nothing and points down meets the
+    level ground at *ground_z* (the road under the roof point, m) within the ray length:
+    the street, with the road's albedo, lit and shaded as the buildings shade it (its
+    sample points cast their own sun rays).  A mesh hit always wins (terrain, roads).
+
+    Returns
+    -------
+    dict of (n,) arrays: ``tri`` (mesh triangle, :data:`VIRTUAL_GROUND` for the virtual
+    street, -1 for nothing), ``dist`` (m, inf for nothing), ``albedo``, ``ground`` (bool:
+    ground, terrain, road or the virtual street), ``normal`` (n, 3) the surface's normal as
+    stored (up for the virtual street)
+    """
+    tri, dist = scene.first_hit(o, d, ray_length_m)
+    tri = tri.astype(np.int64)
+    dist = dist.astype(np.float64)
+    mesh = scene.mesh
+    n = len(tri)
+    hit = tri >= 0
+    t = np.where(hit, tri, 0)
+    albedo = np.zeros(n)
+    ground = np.zeros(n, bool)
+    normal = np.zeros((n, 3))
+    normal[:, 2] = 1.0
+    if len(mesh.albedo):
+        albedo[hit] = np.asarray(mesh.albedo, np.float64)[t[hit]]
+        ground[hit] = np.isin(np.asarray(mesh.surface_type)[t[hit]], _GROUND_CODES)
+        normal[hit] = np.asarray(mesh.normals, np.float64)[t[hit]]
+    if ground_z is not None:
+        gz = np.broadcast_to(np.asarray(ground_z, np.float64), (n,))
+        down = ~hit & (d[:, 2] < 0)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            t_g = (o[:, 2] - gz) / -d[:, 2]
+        virtual = down & (t_g > 0) & (t_g <= ray_length_m)
+        tri[virtual], dist[virtual] = VIRTUAL_GROUND, t_g[virtual]
+        albedo[virtual], ground[virtual] = road_albedo, True
+    return {"tri": tri, "dist": dist, "albedo": albedo, "ground": ground, "normal": normal}
+
+
+def _group_cumsum(values: np.ndarray, groups: np.ndarray) -> np.ndarray:
+    """Cumulative sums of *values* restarting at each run of equal *groups* (sorted): each
+    group's sums are its own, whatever comes before it (float64)."""
+    if not len(values):
+        return np.zeros(0)
+    return pd.Series(np.asarray(values, np.float64)).groupby(np.asarray(groups), sort=False).cumsum().to_numpy()
+
+
+def _reflector_surroundings(scene, keys, pts, nrm, used, cfg: IrradianceCfg, stream: int = 2,
+                            ground_z=None, road_albedo: float = 0.10):
     """What the sample points of each reflector group see over their own hemisphere (m, G).
 
     ``cfg.reflector_sky_rays`` cosine-weighted rays from every sample point: a ray that
-    escapes upwards sees sky, one that escapes downwards sees open ground outside the mesh
-    (lit as an open field, albedo applied per run), one that hits a ground or terrain
-    triangle sees the street (weighted by that triangle's albedo), one that hits any other
-    surface (a facade, a roof) sees light that surface reflects (weighted by its albedo).
+    escapes upwards sees sky, one that hits a ground, terrain or road triangle, or the level
+    street under the segment where the model has no surface (*ground_z*, m, per segment;
+    :func:`_hits`), sees the street (weighted by its albedo; *road_albedo* for the virtual
+    street), one that escapes downwards beyond the ray length sees open ground (lit as an
+    open field, albedo applied per run), one that hits any other surface (a facade, a roof)
+    sees light that surface reflects (weighted by its albedo).
 
     Returns
     -------
@@ -280,15 +349,12 @@ def _reflector_surroundings(scene, keys, pts, nrm, used, cfg: IrradianceCfg, str
     d = cosine_directions(nrm.reshape(m * G, P, 3)[sel].reshape(-1, 3), R,
                           uni[sel].reshape(-1, R + 1)).reshape(-1, 3)
     oo = np.repeat(pts.reshape(m * G, P, 3)[sel].reshape(-1, 3), R, axis=0)
-    tri, dist = scene.first_hit(oo, d, cfg.ray_length_m)
-    mesh = scene.mesh
-    ground_tri = np.isin(np.asarray(mesh.surface_type), _GROUND_CODES)
-    albedo = np.asarray(mesh.albedo, np.float64)
-    hit = tri >= 0
-    t = np.where(hit, tri, 0)
-    on_ground = hit & ground_tri[t] if len(ground_tri) else np.zeros(len(tri), bool)
-    a = albedo[t] if len(albedo) else np.zeros(len(tri))
     n = P * R
+    gz = None if ground_z is None else np.repeat(np.repeat(np.asarray(ground_z, np.float64), G)[sel], n)
+    h = _hits(scene, oo, d, cfg.ray_length_m, gz, road_albedo)
+    tri, dist, a = h["tri"], h["dist"], h["albedo"]
+    hit = tri != -1
+    on_ground = h["ground"]
     rays = {"sky": ~hit & (d[:, 2] > 0), "open": ~hit & (d[:, 2] <= 0)}
     for k, v in rays.items():
         out[k].reshape(-1)[sel] = v.astype(np.float64).reshape(-1, n).mean(1)
@@ -302,14 +368,15 @@ def _reflector_surroundings(scene, keys, pts, nrm, used, cfg: IrradianceCfg, str
     out["hor"].reshape(-1)[sel] = band.reshape(-1, P).mean(1)
     g = np.flatnonzero(on_ground & (a > 0))
     if len(g):
-        tn = np.asarray(mesh.normals, np.float64)[tri[g]]
+        tn = h["normal"][g]
         tn = np.where((tn[:, 2:3] < 0), -tn, tn)
         out["hits"] = {"pair": sel[g // n], "p": oo[g] + dist[g, None].astype(np.float64) * d[g],
                        "n": tn, "w": a[g] / n}
     return out
 
 
-def _street(o, gw, surround, keys, cfg: IrradianceCfg, scene, lift: float):
+def _street(o, gw, surround, keys, cfg: IrradianceCfg, scene, lift: float, ground_z=None,
+            road_albedo: float = 0.10):
     """The street the reflector groups see, as one more reflector of each segment.
 
     Its P sample points are taken from the street hits of the groups' own rays, each hit
@@ -336,13 +403,15 @@ def _street(o, gw, surround, keys, cfg: IrradianceCfg, scene, lift: float):
         z = np.zeros(m)
         return {"n": n_s[:, 0], "pts": pts, "used": used, "sky": z, "wall": z.copy()}
     pts, pn = _group_points(o, seg, seg, w, h["p"], h["n"], w_s, n_s, P, lift)
-    own = _reflector_surroundings(scene, keys, pts, pn, used[:, None], cfg, stream=3)
+    own = _reflector_surroundings(scene, keys, pts, pn, used[:, None], cfg, stream=3,
+                                  ground_z=ground_z, road_albedo=road_albedo)
     return {"n": n_s[:, 0], "pts": pts[:, 0], "used": used, "sky": own["sky"][:, 0],
             "wall": own["wall"][:, 0]}
 
 
 def segment_geometry(scene, segments: pd.DataFrame, cfg: IrradianceCfg | None = None,
-                     chunk: int = 4096) -> pd.DataFrame:
+                     chunk: int = 4096, road_albedo: float = 0.10,
+                     roof_height_m: float | None = 3.2) -> pd.DataFrame:
     """Time-independent geometry of every segment: roof plane, sky view factor, reflectors.
 
     Parameters
@@ -351,14 +420,22 @@ def segment_geometry(scene, segments: pd.DataFrame, cfg: IrradianceCfg | None = 
     segments : DataFrame with ``segment_id, x, y, z, heading_deg, gradient`` (optional
         ``x_end, y_end, z_end``: the roof point is then the segment's midpoint), metres
     cfg : IrradianceCfg (``svf_rays``, ``reflection_rays``, ``max_reflector_groups``,
-        ``reflector_points``, ``reflector_sky_rays``, ``ray_length_m``, ``ray_offset_m``,
-        ``seed``)
+        ``reflector_points``, ``reflector_sky_rays``, ``horizon_band_rays``,
+        ``ray_length_m``, ``ray_offset_m``, ``seed``)
+    road_albedo : float, albedo of the street where the city model has no surface
+        (``city.albedo.road``)
+    roof_height_m : float or None, height of the roof point above the street, m: the level
+        of the street under it where the model has no ground (:func:`_hits`; a
+        ``ground_z`` column of *segments*, m, gives it instead); None: no such street, a ray
+        that leaves the mesh downwards sees open ground
 
     Returns
     -------
     DataFrame, one row per segment (plain numeric columns):
         ``segment_id``; ``px, py, pz`` ray origin (roof point lifted by ``ray_offset_m``
         along the normal, m); ``tilt_deg, azimuth_deg``; ``nx, ny, nz`` roof normal;
+        ``hbv`` the roof's view of the band of sky near the horizon (``sin tilt`` in the
+        open, :func:`horizon_band_view`);
         ``svf`` cosine-weighted sky view factor (sky above the horizon and not blocked;
         (1 + cos tilt)/2 with no buildings); ``refl_vf`` albedo-weighted view factor of
         all surfaces seen, ``refl_vf_se`` its Monte Carlo standard error; for each group
@@ -406,7 +483,14 @@ def segment_geometry(scene, segments: pd.DataFrame, cfg: IrradianceCfg | None = 
     tilt, azim = roof_plane(segments["heading_deg"].to_numpy(float),
                             segments["gradient"].to_numpy(float))
     normal = plane_normal(tilt, azim)
-    origin = _roof_points(segments) + cfg.ray_offset_m * normal
+    roof = _roof_points(segments)
+    origin = roof + cfg.ray_offset_m * normal
+    if "ground_z" in segments:
+        ground_z = segments["ground_z"].to_numpy(np.float64)
+    elif roof_height_m is not None:
+        ground_z = roof[:, 2] - float(roof_height_m)
+    else:
+        ground_z = None
     G, P = cfg.max_reflector_groups, cfg.reflector_points
     svf = np.ones(n_seg, np.float64)
     hbv = np.zeros(n_seg, np.float64)
@@ -427,7 +511,8 @@ def segment_geometry(scene, segments: pd.DataFrame, cfg: IrradianceCfg | None = 
         for part, N in ((~dense, cfg.reflection_rays), (dense, _DENSE_RAYS * cfg.reflection_rays)):
             idx = np.arange(sl.start, sl.stop)[part]
             if len(idx):
-                _reflectors(scene, origin[idx], normal[idx], seg_ids[idx], N, cfg, acc, idx)
+                _reflectors(scene, origin[idx], normal[idx], seg_ids[idx], N, cfg, acc, idx,
+                            None if ground_z is None else ground_z[idx], road_albedo)
     return _geometry_frame(seg_ids, origin, tilt, azim, normal, svf, acc, G, P, hbv)
 
 
@@ -553,19 +638,22 @@ def _merge_groups(hs, hn, w, m: int, G: int) -> np.ndarray:
     return target[hs, cls]
 
 
-def _reflectors(scene, o, nrm, keys, N: int, cfg: IrradianceCfg, acc: dict, idx) -> None:
+def _reflectors(scene, o, nrm, keys, N: int, cfg: IrradianceCfg, acc: dict, idx,
+                ground_z=None, road_albedo: float = 0.10) -> None:
     """Reflector groups of the roof points *o* (m, 3) with normals *nrm*, from *N*
     cosine-weighted rays each; written into the rows *idx* of *acc* (see
-    :func:`segment_geometry` for what each array holds)."""
+    :func:`segment_geometry` for what each array holds).  *ground_z* (m,): the level of the
+    street under each roof point where the model has none (:func:`_hits`)."""
     mesh = scene.mesh
     G, P = cfg.max_reflector_groups, cfg.reflector_points
     m = len(o)
     d = cosine_directions(nrm, N, segment_uniforms(cfg.seed, 1, keys, N + 1)).reshape(-1, 3)
     oo = np.repeat(o, N, axis=0)
-    tri, dist = scene.first_hit(oo, d, cfg.ray_length_m)
-    hit = tri >= 0
-    x = np.zeros(len(tri))
-    x[hit] = np.asarray(mesh.albedo, np.float64)[tri[hit]]
+    h = _hits(scene, oo, d, cfg.ray_length_m,
+              None if ground_z is None else np.repeat(np.asarray(ground_z, np.float64), N), road_albedo)
+    tri, dist = h["tri"], h["dist"]
+    hit = tri != -1
+    x = h["albedo"]
     xs = x.reshape(m, N)
     acc["refl_vf"][idx] = xs.mean(axis=1)
     acc["refl_se"][idx] = xs.std(axis=1, ddof=1) / np.sqrt(N) if N > 1 else 0.0
@@ -573,7 +661,7 @@ def _reflectors(scene, o, nrm, keys, N: int, cfg: IrradianceCfg, acc: dict, idx)
     if not hit.any():
         return
     hs, hd = np.repeat(np.arange(m), N)[hit], d[hit]
-    hn = np.asarray(mesh.normals, np.float64)[tri[hit]]
+    hn = h["normal"][hit]
     hn = np.where(((hn * hd).sum(1) > 0)[:, None], -hn, hn)     # the face the roof sees
     hp = oo[hit] + dist[hit, None].astype(np.float64) * hd
     w = x[hit] / N
@@ -593,16 +681,19 @@ def _reflectors(scene, o, nrm, keys, N: int, cfg: IrradianceCfg, acc: dict, idx)
     rep = np.repeat(o[:, None], G, axis=1).reshape(-1, 3)
     rep[gkey[first]] = hp[first]
     # the surface holding most of each group's weight (for the export)
-    acc["surface"][idx] = _dominant_surface(gkey, np.asarray(mesh.surface_index, np.int64)[tri[hit]],
-                                            w, m * G).reshape(m, G)
+    surf = np.full(int(hit.sum()), -1, np.int64)
+    on_mesh = tri[hit] >= 0
+    surf[on_mesh] = np.asarray(mesh.surface_index, np.int64)[tri[hit][on_mesh]]
+    acc["surface"][idx] = _dominant_surface(gkey, surf, w, m * G).reshape(m, G)
     # sample points (lit fraction) and the groups' own surroundings (sky, street, facades)
     lift = max(cfg.ray_offset_m, _MIN_REFLECTOR_LIFT)
     pts, pn = _group_points(o, hs, gkey, w, hp, hn, w_g, n_g, P, lift)
-    around = _reflector_surroundings(scene, keys, pts, pn, nz, cfg)
+    around = _reflector_surroundings(scene, keys, pts, pn, nz, cfg, ground_z=ground_z,
+                                     road_albedo=road_albedo)
     for k in ("sky", "gnd", "open", "wall", "hor"):
         acc[k][idx] = around[k]
     acc["w"][idx], acc["n"][idx], acc["rep"][idx], acc["pts"][idx] = w_g, n_g, rep.reshape(m, G, 3), pts
-    st = _street(o, w_g, around, keys, cfg, scene, lift)
+    st = _street(o, w_g, around, keys, cfg, scene, lift, ground_z, road_albedo)
     for k in acc["street"]:
         acc["street"][k][idx] = st[k]
 

@@ -185,6 +185,7 @@ def _run_context(cfg: Config, year: int, run_dir: Path) -> tuple[RunContext, lis
         pv_mode=cfg.pv.mode, monthly_temperature_c=tuple(cfg.climate.monthly_mean_temperature_c),
         wind_speed_mps=cfg.climate.wind_speed_mps, timezone=feed["timezone"],
         bvh_cache_size=cfg.dask.bvh_cache_size, ground_albedo=cfg.city.albedo.ground,
+        road_albedo=cfg.city.albedo.road, roof_height_m=cfg.trajectory.roof_height_m,
         routes=tuple(routes) if routes is not None else None, shapes=shapes,
         route_of_trip=dict(zip(trips["trip_id"], trips["route_id"].astype(str))))
     return ctx, tiles
