@@ -136,14 +136,15 @@ def _radiance_scene(spec, sun: np.ndarray, dni: float, dhi: float, black: bool) 
     return "\n".join(lines) + "\n"
 
 
-def _rtrace_irradiance(workdir: Path, tag: str, scene_text: str, points) -> np.ndarray:
-    """Irradiance (W/m2) on upward-facing sensors at *points*, from ``rtrace -I``."""
+def _rtrace_irradiance(workdir: Path, tag: str, scene_text: str, points, ambient=None) -> np.ndarray:
+    """Irradiance (W/m2) on upward-facing sensors at *points*, from ``rtrace -I``
+    (*ambient*: the ``-ab``/``-ad`` options, default :data:`RT_ABN`)."""
     rad = workdir / f"{tag}.rad"
     rad.write_text(scene_text)
     octree = workdir / f"{tag}.oct"
     octree.write_bytes(pr.oconv(str(rad)))
     rays = "".join("{:.9f} {:.9f} {:.9f} 0 0 1\n".format(*p) for p in points).encode()
-    out = pr.rtrace(rays, octree, header=False, irradiance=True, params=RT_COMMON + RT_ABN)
+    out = pr.rtrace(rays, octree, header=False, irradiance=True, params=RT_COMMON + (ambient or RT_ABN))
     rgb = np.array(out.split(), float).reshape(len(points), 3)
     assert np.ptp(rgb, axis=1).max() < 1e-6 * max(1.0, rgb.max()), out      # grey
     return rgb.mean(1)
