@@ -411,7 +411,7 @@ class TripModel:
         from ..models import pv as pvmod
 
         return pvmod.energy(poa, dt_s, pv.system(), pv.mode,
-                            temp_air_c=self.cfg.climate.monthly_mean_temperature_c[month - 1],
+                            temp_air_c=self.cfg.monthly_temperature_c()[month - 1],
                             vehicle_speed_mps=speed_mps, wind_mps=self.cfg.climate.wind_speed_mps)
 
     def _vehicle_run(self, pid: int, month: int, origin: float, off, dt, energy, aux_kw, soc_start,
@@ -434,7 +434,7 @@ class TripModel:
             params = params.model_copy(update=upd)
         soc0 = params.soc_max if soc_start is None else float(soc_start)
         cycle = self._cycle(pid)
-        cons = simulate_cycle(cycle, params, self.cfg.climate.monthly_mean_temperature_c[month - 1],
+        cons = simulate_cycle(cycle, params, self.cfg.monthly_temperature_c()[month - 1],
                               detail=True)
         iv = cons["intervals"]
         t_s = cycle["t_s"].to_numpy(np.float64)

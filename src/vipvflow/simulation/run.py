@@ -182,7 +182,7 @@ def _run_context(cfg: Config, year: int, run_dir: Path) -> tuple[RunContext, lis
     ctx = RunContext(
         data_dir=str(data_dir.resolve()), run_dir=str(run_dir.resolve()), year=year,
         irradiance=cfg.irradiance.model_dump(), pv_system=cfg.pv_system().model_dump(),
-        pv_mode=cfg.pv.mode, monthly_temperature_c=tuple(cfg.climate.monthly_mean_temperature_c),
+        pv_mode=cfg.pv.mode, monthly_temperature_c=tuple(cfg.monthly_temperature_c()),
         wind_speed_mps=cfg.climate.wind_speed_mps, timezone=feed["timezone"],
         bvh_cache_size=cfg.dask.bvh_cache_size, ground_albedo=cfg.city.albedo.ground,
         road_albedo=cfg.city.albedo.road, roof_height_m=cfg.trajectory.roof_height_m,
