@@ -498,8 +498,11 @@ def test_perez_coefficients_give_pvlibs_perez_sky_diffuse():
 
 
 def test_radiation_table_perez_full_chain_matches_pvlib():
-    """Radiation table (its Perez coefficients per minute) + pass times, no buildings:
-    the total is pvlib's Perez plane-of-array irradiance (albedo 0)."""
+    """Radiation table (its Perez sky per time step) + pass times, no buildings: a level
+    roof receives pvlib's Perez plane-of-array irradiance (albedo 0: beam + DHI); a tilted
+    one the Perez (1993) sky's luminance on the plane, near pvlib's Perez (1990) model,
+    fitted to tilted planes (two models of the same sky: 1.5 % on average, the low sun
+    behind a tilted roof up to a fifth apart)."""
     grid = np.arange(pd.Timestamp("2024-06-01", tz="UTC").timestamp(),
                      pd.Timestamp("2024-06-03", tz="UTC").timestamp(), 60.0)
     vals = {c: np.full(len(grid), v) for c, v in zip(COLUMNS, (600, 700, 150, 800, 850, 90))}
@@ -530,11 +533,14 @@ def test_radiation_table_perez_full_chain_matches_pvlib():
     # (the table's constant DHI at night is the test's, pvlib leaves it out there)
     level = geometry["tilt_deg"].to_numpy()[passes["segment_id"]] == 0
     assert up.sum() > 100 and (level & up).sum() > 30
-    got, want = out["total_unshaded"].to_numpy()[up], ref["poa_global"][up]
-    np.testing.assert_allclose(got, want, rtol=2e-3, atol=0.5)   # the sun at dawn: 5-min SPA grid
-    np.testing.assert_allclose(out["total"][level & up], ref["poa_global"][level & up], rtol=2e-3,
-                               atol=0.05)
-    np.testing.assert_allclose(out["total"][up], want, rtol=2e-2, atol=0.5)
+    got, want = out["total_unshaded"].to_numpy(), ref["poa_global"]
+    lv = level & up
+    np.testing.assert_allclose(got[lv], want[lv], rtol=2e-3, atol=0.5)   # dawn: 5-min SPA grid
+    np.testing.assert_allclose(out["total"][lv], want[lv], rtol=2e-3, atol=0.5)
+    np.testing.assert_allclose(out["total"], out["total_unshaded"], rtol=1e-6)   # in the open
+    tilted = ~level & up & (want > 50)
+    ratio = got[tilted] / want[tilted]
+    assert abs(ratio.mean() - 1) < 0.015 and np.abs(ratio - 1).max() < 0.25, ratio
 
 
 def test_horizon_band_view_of_a_facade_half_hidden():

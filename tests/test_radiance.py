@@ -89,7 +89,7 @@ RT_COMMON = ["-aa", "0", "-as", "0", "-av", "0", "0", "0", "-lw", "1e-10", "-lr"
 RT_ABN = ["-ab", "8", "-ad", "32768"]
 # rtrace has no seed option; its run-to-run spread here is below 0.2 W/m2 on every part
 
-CFG_SVF = IrradianceCfg(reflector_sampling="all")
+CFG_SVF = IrradianceCfg(reflector_sampling="all", diffuse_model="sky_view_factor")
 
 TOL_TOTAL, TOL_REFLECTED = 0.08, 0.20
 
@@ -340,19 +340,31 @@ def _perez_scene(spec, sun, dni, dhi, black: bool) -> str:
     return "\n".join(lines) + "\n"
 
 
-def perez_radiation(times, dni, dhi, ghi, sun) -> dict:
+def perez_radiation(times, dni, dhi, ghi, sun, geo=None) -> dict:
     """The engine's radiation of a set of instants with the Perez coefficients
     (:func:`vipvflow.models.sky.perez_coefficients`, pvlib's extraterrestrial irradiance
-    and airmass), float32, all-sky = clear-sky."""
-    from vipvflow.models.sky import perez_coefficients
+    and airmass), float32, all-sky = clear-sky; with the segments' geometry *geo* per
+    (instant, segment), instant-major, with the Perez (1993) sky's share of each, as
+    :meth:`RadiationTable.sky_share` gives it (:func:`vipvflow.models.sky.sky_table`)."""
+    from vipvflow.models.sky import perez_coefficients, sky_share, sky_table
+    from vipvflow.models.view_factors import SKY_COLUMNS
 
     zen = np.degrees(np.arccos(np.clip(sun[:, 2], -1, 1)))
     e0 = pvlib.irradiance.get_extra_radiation(pd.DatetimeIndex(times).day_of_year.to_numpy())
     f1, f2 = perez_coefficients(dhi, dni, e0, zen, pvlib.atmosphere.get_relative_airmass(zen))
     f = np.float32
     out = {"dni": dni, "dhi": dhi, "ghi": ghi, "f1": f1, "f2": f2}
-    out.update({f"{k}_clear": v for k, v in list(out.items())})
-    return {k: np.asarray(v, f) for k, v in out.items()}
+    if geo is not None:
+        tg, th = sky_table(dhi, dni, e0, sun)
+        k = len(geo)
+        levels = np.tile(geo[SKY_COLUMNS].to_numpy(np.float32), (len(dhi), 1))
+        normal = np.tile(geo[["nx", "ny", "nz"]].to_numpy(np.float32), (len(dhi), 1))
+        out = {c: np.repeat(v, k) for c, v in out.items()}
+        tg, th = np.repeat(tg, k, axis=0), np.repeat(th, k, axis=0)
+        out["sky_share"] = sky_share(tg, th, levels, normal)
+        out["sky_open"] = sky_share(tg, th, np.zeros_like(levels), normal)
+    out.update({f"{c}_clear": v for c, v in list(out.items())})
+    return {c: np.asarray(v, f) for c, v in out.items()}
 
 
 def _perez_sky():
@@ -375,11 +387,10 @@ def _perez_run(name: str, work: Path) -> pd.DataFrame:
                          "z": np.full(k, ROOF_Z), "heading_deg": np.zeros(k), "gradient": np.zeros(k)})
     geo = segment_geometry(scene, segs, CFG_PEREZ, road_albedo=spec["rho_road"])
     sun, el, dni, dhi, ghi = _perez_sky()
-    rad = perez_radiation(INSTANTS, dni, dhi, ghi, sun)
+    rad = perez_radiation(INSTANTS, dni, dhi, ghi, sun, geo)
     rows = np.tile(np.arange(k), n)
-    eng = roof_irradiance(geo, rows, np.repeat(sun.astype(np.float32), k, axis=0),
-                          {c: np.repeat(v, k) for c, v in rad.items()}, scene, CFG_PEREZ,
-                          ground_albedo=spec["rho_road"])
+    eng = roof_irradiance(geo, rows, np.repeat(sun.astype(np.float32), k, axis=0), rad, scene,
+                          CFG_PEREZ, ground_albedo=spec["rho_road"])
     origin = geo[["px", "py", "pz"]].to_numpy(float)
     recs = []
     for i in range(n):
@@ -390,7 +401,7 @@ def _perez_run(name: str, work: Path) -> pd.DataFrame:
         for j in range(k):
             q = i * k + j
             recs.append({"scene": name, "sun": SUN_IDS[i], "point": j, "elevation": el[i],
-                         "dni": dni[i], "dhi": dhi[i], "f1": float(rad["f1"][i]),
+                         "dni": dni[i], "dhi": dhi[i], "f1": float(rad["f1"][i * k]),
                          "svf": float(geo["svf"].iloc[j]), "sun_visible": bool(eng["sun_visible"][q]),
                          "eng_direct": float(eng["direct"][q]), "eng_diffuse": float(eng["diffuse"][q]),
                          "eng_reflected": float(eng["reflected"][q]), "eng_total": float(eng["total"][q]),
@@ -447,22 +458,11 @@ def test_perez_black_open_sky_is_calibrated(tmp_path):
         assert got == pytest.approx(ghi[i], rel=0.015), (INSTANTS[i], got, ghi[i])
 
 
-# Issue 36's acceptance for the Perez sky, not met by perez_svf (measured 2026-11-26 at the
-# default seed: total 9.6 % mean absolute, 38 % worst; diffuse in the shade -11 % mean, 45 %
-# worst; docs/physics.md says why).  Strict: a change that meets them fails here until the
-# marks go.
-UNMET = pytest.mark.xfail(strict=True, reason="issue 36 acceptance not met by perez_svf: the "
-                          "Perez (1990) circumsolar part as a point source vs Radiance's broad "
-                          "aureole (docs/physics.md)")
-
-
-@UNMET
 def test_perez_total_within_5_percent_mean_15_worst(perez_results):
     s = perez_summary(perez_results)
     assert s["total_mean_abs"] < TOL_PEREZ_MEAN and s["total_worst"] < TOL_PEREZ_WORST, s
 
 
-@UNMET
 def test_perez_diffuse_within_10_percent_in_the_shade(perez_results):
     s = perez_summary(perez_results)
     assert s["shade_diffuse_worst"] < TOL_PEREZ_SHADE, s

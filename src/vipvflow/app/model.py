@@ -390,6 +390,9 @@ class TripModel:
             terms = {**sky_terms(geo, rows, sun[:, 2], bool(J)),
                      "f1": np.nan_to_num(np.asarray(rad["f1"], f32)),
                      "f2": np.nan_to_num(np.asarray(rad["f2"], f32))}
+            if geo["sky_x"].shape[1]:            # the sky the roof point sees, as the run
+                terms["share"], terms["share_open"] = self.radiation.sky_share(
+                    np.asarray(t_utc, np.float64), geo["sky_x"][rows], nrm, loc)
         direct, diffuse, reflected, unshaded = roof_components(
             dni, dhi, ghi, cos_aoi, visible, sky, beam, lit, r_sky, r_ghi, iso, terms)
         # the run's estimate of a reflector's beam, per pass: one sample point (0 or 1),

@@ -97,8 +97,12 @@ def roof_components(dni_wm2, dhi_wm2, ghi_wm2, cos_aoi, sun_visible, sky_view,
         The Perez sky (``diffuse_model: perez_svf``; none: a uniform sky), (n,) arrays:
         ``f1, f2`` the circumsolar and horizon coefficients (:mod:`vipvflow.models.sky`),
         ``cos_zenith`` of the sun, ``horizon_view`` the roof point's view of the horizon
-        band, ``reflector_horizon`` the reflectors' so weighted (:func:`pack_geometry`) and
-        ``sin_tilt`` of the roof (the open field's horizon view, for the unshaded reference).
+        band, ``reflector_horizon`` the reflectors' so weighted (:func:`pack_geometry`),
+        ``sin_tilt`` of the roof (the open field's horizon view, for the unshaded reference)
+        and, optionally, ``share``: the share of DHI the roof point receives from the Perez
+        (1993) sky luminance over the sky it sees (:meth:`RadiationTable.sky_share`), which
+        then is its diffuse light instead of the three parts below, and ``share_open`` the
+        same in the open (the unshaded reference's).
 
     Returns
     -------
@@ -109,8 +113,11 @@ def roof_components(dni_wm2, dhi_wm2, ghi_wm2, cos_aoi, sun_visible, sky_view,
 
     Notes
     -----
-    Under the Perez sky (Perez et al. 1990, pvlib ``irradiance.perez``) the diffuse light
-    is ``DHI [(1 - F1) SVF + F2 H] + C cos AOI V_sun`` with ``C = DHI F1 / max(cos Z, cos 85
+    With ``share`` (the run's ``perez_svf``) the roof's diffuse light is ``DHI x share``:
+    the sky's luminance (Perez, Seals, Michalsky 1993, as Radiance's ``gendaylit``)
+    integrated over the sky above the roof point's horizon; without it, the three-part form
+    of the Perez (1990) model.  Under the Perez sky (Perez et al. 1990, pvlib
+    ``irradiance.perez``) the three-part diffuse light is ``DHI [(1 - F1) SVF + F2 H] + C cos AOI V_sun`` with ``C = DHI F1 / max(cos Z, cos 85
     deg)`` the circumsolar irradiance at normal incidence: the circumsolar part is seen
     when, and only when, the sun is (it travels the sun ray), the isotropic part by the sky
     view factor and the horizon part by the horizon-band view ``H``.  The reflectors are lit
@@ -142,13 +149,19 @@ def roof_components(dni_wm2, dhi_wm2, ghi_wm2, cos_aoi, sun_visible, sky_view,
     circumsolar = dhi_wm2 * f1 / np.maximum(sky["cos_zenith"], f32(COS_85))
     circ_on_roof = circumsolar * cos_aoi
     iso = f32(1) - f1
-    diffuse = np.maximum(dhi_wm2 * (iso * sky_view + f2 * sky["horizon_view"])
-                         + circ_on_roof * sun_visible, f32(0))
+    if "share" in sky:
+        diffuse = np.maximum(dhi_wm2 * sky["share"], f32(0))
+    else:
+        diffuse = np.maximum(dhi_wm2 * (iso * sky_view + f2 * sky["horizon_view"])
+                             + circ_on_roof * sun_visible, f32(0))
     reflected = ((dni_wm2 + circumsolar) * beam_factor
                  + dhi_wm2 * (iso * reflector_sky + f2 * sky["reflector_horizon"])
                  + ghi_wm2 * reflector_ghi)
-    unshaded = beam_on_roof + np.maximum(dhi_wm2 * (iso * isotropic_view + f2 * sky["sin_tilt"])
-                                         + circ_on_roof, f32(0))
+    if "share" in sky:
+        unshaded = beam_on_roof + np.maximum(dhi_wm2 * sky["share_open"], f32(0))
+    else:
+        unshaded = beam_on_roof + np.maximum(dhi_wm2 * (iso * isotropic_view + f2 * sky["sin_tilt"])
+                                             + circ_on_roof, f32(0))
     return direct, diffuse, reflected, unshaded
 
 
@@ -248,7 +261,10 @@ def roof_irradiance(geometry, rows, sun: np.ndarray, rad: dict, scene, cfg: Irra
     dnic, dhic, ghic = _finite(rad["dni_clear"]), _finite(rad["dhi_clear"]), _finite(rad["ghi_clear"])
     perez = cfg.diffuse_model == "perez_svf"
     if perez:
-        missing = [c for c in ("f1", "f2", "f1_clear", "f2_clear") if c not in rad]
+        need = ("f1", "f2", "f1_clear", "f2_clear") + (
+            ("sky_share", "sky_share_clear", "sky_open", "sky_open_clear")
+            if geo["sky_x"].shape[1] else ())
+        missing = [c for c in need if c not in rad]
         if missing:
             raise KeyError(f"the Perez sky needs {', '.join(missing)} in the radiation "
                            "(models.sky.perez_coefficients)")
@@ -321,6 +337,9 @@ def roof_irradiance(geometry, rows, sun: np.ndarray, rad: dict, scene, cfg: Irra
         terms = None
         if perez:
             terms = {**perez_sky, "f1": f1 if not sfx else f1c, "f2": f2 if not sfx else f2c}
+            if geo["sky_x"].shape[1]:
+                terms["share"] = _finite(rad["sky_share" + sfx])
+                terms["share_open"] = _finite(rad["sky_open" + sfx])
         (out["direct" + sfx], out["diffuse" + sfx], out["reflected" + sfx],
          unshaded) = roof_components(b, dh, gh, cos_aoi, visible, sky, beam_sum[:, None],
                                      one[:, None], r_sky, r_ghi, iso, terms)
@@ -485,6 +504,10 @@ def evaluate_passes(passes: pd.DataFrame, segments: pd.DataFrame, geometry: pd.D
         r = row[idx]
         loc = None if loc_col is None else loc_col[r]
         rad = radiation_table.lookup(t[idx], location=loc, angles=False)
+        if cfg.diffuse_model == "perez_svf" and geo["sky_x"].shape[1]:
+            for sfx in ("", "_clear"):
+                rad["sky_share" + sfx], rad["sky_open" + sfx] = radiation_table.sky_share(
+                    t[idx], geo["sky_x"][r], geo["n"][r], loc, clear=bool(sfx))
         sun = np.stack([rad["sun_x"], rad["sun_y"], rad["sun_z"]], 1)
         key = pass_sample_key(seg[idx], t_start[idx])
         clock["lookup_s"] += time.perf_counter() - t_look

@@ -28,7 +28,7 @@ class IrradianceCfg(_Params):
     # roof point's view of the band near the horizon); sky_view_factor: DHI x the roof
     # point's cosine-weighted sky view (a uniform sky); isotropic: the paper's DHI (1 + cos
     # tilt) / 2, an upper bound in streets
-    diffuse_model: Literal["perez_svf", "isotropic", "sky_view_factor"] = "sky_view_factor"
+    diffuse_model: Literal["perez_svf", "isotropic", "sky_view_factor"] = "perez_svf"
     reflection: bool = True
     reflection_rays: int = Field(256, ge=0, le=65_536)
     svf_rays: int = Field(512, gt=0, le=65_536)

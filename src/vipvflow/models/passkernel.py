@@ -40,7 +40,7 @@ import numpy as np
 from numba import njit
 
 from .irradiance import ROULETTE_WEIGHT
-from .sky import COS_85
+from .sky import COS_85, SECTOR_COS, SECTOR_SIN
 
 #: components of a pass in the order of the kernel's output block (W/m2)
 BLOCK_COLUMNS = ("direct", "diffuse", "reflected", "total", "direct_clear", "diffuse_clear",
@@ -52,7 +52,11 @@ RAY_BUDGET = 1 << 21
 _RAD = ("dni", "dhi", "ghi", "dni_clear", "dhi_clear", "ghi_clear", "sun_x", "sun_y", "sun_z",
         "f1", "f2", "f1_clear", "f2_clear")
 _N_RAD = len(_RAD)
+#: per pass after the radiation: the Perez sky tables' two rows and the weight of the second
+_N_ROW = _N_RAD + 3
 _COS_85 = np.float32(COS_85)
+_SEC_SIN = SECTOR_SIN.astype(np.float32)
+_SEC_COS = SECTOR_COS.astype(np.float32)
 
 _M30, _M27, _M31 = np.uint64(30), np.uint64(27), np.uint64(31)
 _C1, _C2, _C3 = np.uint64(0x9E3779B97F4A7C15), np.uint64(0xBF58476D1CE4E5B9), np.uint64(0x94D049BB133111EB)
@@ -70,7 +74,7 @@ def _sample_key(segment_id, t_utc):
 
 @njit(cache=True, nogil=True)
 def _setup(lo, hi, seg, t_start, dt, mid, row, loc_of_row, packed, cols, t0, step,
-           nrm, wn, p_local, gp_local, rotate, roulette_w, perez,
+           nrm, wn, p_local, gp_local, rotate, roulette_w, perez, sky_rows, sky_t0, sky_step,
            rad, cos_aoi, pass_ray, pair_w, pair_pass, o, d, done):
     """Radiation lookup and ray batch of passes ``lo..hi`` (see the module docstring).
 
@@ -117,6 +121,19 @@ def _setup(lo, hi, seg, t_start, dt, mid, row, loc_of_row, packed, cols, t0, ste
         if dark:
             continue
         done[c] = True
+        if sky_rows.shape[1]:
+            # the Perez sky tables' rows around the pass (RadiationTable.sky_share)
+            n_s = sky_rows.shape[1]
+            fs = min(max((t - sky_t0) / sky_step, 0.0), n_s - 1.000001)
+            js = np.int64(fs)
+            r0, r1 = sky_rows[li, js], sky_rows[li, js + 1]
+            if r0 < 0:
+                r0 = r1
+            if r1 < 0:
+                r1 = r0
+            rad[c, _N_RAD] = np.float32(r0)
+            rad[c, _N_RAD + 1] = np.float32(r1)
+            rad[c, _N_RAD + 2] = np.float32(fs - js)
         sx, sy, sz = rad[c, 6], rad[c, 7], rad[c, 8]
         # the circumsolar part of the Perez sky travels the sun ray, like the beam
         if not (sz > 0 and (rad[c, 0] > 0 or rad[c, 3] > 0 or rad[c, 9] > 0 or rad[c, 11] > 0)):
@@ -163,8 +180,38 @@ def _setup(lo, hi, seg, t_start, dt, mid, row, loc_of_row, packed, cols, t0, ste
 
 
 @njit(cache=True, nogil=True, inline="always")
+def _level(table, r, k, i, f, n_l):
+    a = table[r, k, i]
+    b = table[r, k, i + 1] if i + 1 < n_l else np.float32(0.0)
+    return a + f * (b - a)
+
+
+@njit(cache=True, nogil=True)
+def _share(tg, th, r0, r1, w, x, nx, ny, nz):
+    """The Perez (1993) sky's share of DHI on a roof of normal ``(nx, ny, nz)`` with
+    horizon levels *x* (36,), and in the open, between table rows *r0* and *r1*
+    (:func:`vipvflow.models.sky.sky_share`, interpolated with weight *w*)."""
+    n_l = tg.shape[2]
+    s0 = np.float32(0.0)
+    s1 = np.float32(0.0)
+    o0 = np.float32(0.0)
+    o1 = np.float32(0.0)
+    zero = np.float32(0.0)
+    for k in range(x.shape[0]):
+        xi = x[k]
+        i = np.int64(xi)
+        f = xi - np.float32(i)
+        t = nx * _SEC_SIN[k] + ny * _SEC_COS[k]
+        s0 += nz * _level(tg, r0, k, i, f, n_l) + t * _level(th, r0, k, i, f, n_l)
+        s1 += nz * _level(tg, r1, k, i, f, n_l) + t * _level(th, r1, k, i, f, n_l)
+        o0 += nz * _level(tg, r0, k, 0, zero, n_l) + t * _level(th, r0, k, 0, zero, n_l)
+        o1 += nz * _level(tg, r1, k, 0, zero, n_l) + t * _level(th, r1, k, 0, zero, n_l)
+    return s0 + w * (s1 - s0), o0 + w * (o1 - o0)
+
+
+@njit(cache=True, nogil=True, inline="always")
 def _components(c, r, rad, cos_aoi, visible, beam_sum, sky, iso, refl_sky, refl_ghi,
-                perez, hbv, refl_hor, sin_tilt, out):
+                perez, hbv, refl_hor, sin_tilt, sky_x, sky_tables, nrm, out):
     """The 12 :data:`BLOCK_COLUMNS` of one pass into *out* (float32, as
     :func:`vipvflow.models.irradiance.roof_components` sums them, the Perez sky with
     *perez*)."""
@@ -179,10 +226,23 @@ def _components(c, r, rad, cos_aoi, visible, beam_sum, sky, iso, refl_sky, refl_
             cs = dh * f1 / max(rad[c, 8], _COS_85)
             circ = cs * ca
             iso_w = np.float32(1.0) - f1
-            diffuse = max(dh * (iso_w * sky[r] + f2 * hbv[r]) + circ * vis, np.float32(0.0))
+            if sky_x.shape[1]:
+                r0, r1 = np.int64(rad[c, _N_RAD]), np.int64(rad[c, _N_RAD + 1])
+                share = np.float32(0.0)
+                share_open = np.float32(0.0)
+                if r0 >= 0:
+                    share, share_open = _share(sky_tables[2 * s], sky_tables[2 * s + 1], r0, r1,
+                                               rad[c, _N_RAD + 2], sky_x[r], nrm[r, 0], nrm[r, 1],
+                                               nrm[r, 2])
+                diffuse = max(dh * share, np.float32(0.0))
+            else:
+                diffuse = max(dh * (iso_w * sky[r] + f2 * hbv[r]) + circ * vis, np.float32(0.0))
             reflected = ((b + cs) * beam_sum + dh * (iso_w * refl_sky[r] + f2 * refl_hor[r])
                          + gh * refl_ghi[r])
-            unshaded = beam + max(dh * (iso_w * iso[r] + f2 * sin_tilt[r]) + circ, np.float32(0.0))
+            if sky_x.shape[1]:
+                unshaded = beam + max(dh * share_open, np.float32(0.0))
+            else:
+                unshaded = beam + max(dh * (iso_w * iso[r] + f2 * sin_tilt[r]) + circ, np.float32(0.0))
         else:
             diffuse = dh * sky[r]
             reflected = b * beam_sum + dh * refl_sky[r] + gh * refl_ghi[r]
@@ -223,8 +283,8 @@ def _visibility(c, pass_ray, pair_w, pair_pass, q, occ, cos_aoi, rotate, P):
 
 @njit(cache=True, nogil=True)
 def _finish(lo, hi, row, rad, cos_aoi, pass_ray, pair_w, pair_pass, occ, done,
-            sky, iso, refl_sky, refl_ghi, perez, hbv, refl_hor, sin_tilt, rotate, P, to_bins,
-            block, visible_out, dt, seg_hour, run, seg_bins, run_bins):
+            sky, iso, refl_sky, refl_ghi, perez, hbv, refl_hor, sin_tilt, sky_x, sky_tables, nrm,
+            rotate, P, to_bins, block, visible_out, dt, seg_hour, run, seg_bins, run_bins):
     """Components of passes ``lo..hi``: into columns of *block* (12, n) and *visible_out*,
     or, with *to_bins*, as irradiation (Wh/m2) added into ``seg_bins[seg_hour[i]]`` and
     ``run_bins[run[i]]`` ((bins, 12) float64, :data:`BLOCK_COLUMNS`); the other side's
@@ -238,7 +298,7 @@ def _finish(lo, hi, row, rad, cos_aoi, pass_ray, pair_w, pair_pass, occ, done,
         visible, beam_sum, q = _visibility(c, pass_ray, pair_w, pair_pass, q, occ, cos_aoi,
                                            rotate, P)
         _components(c, row[i], rad, cos_aoi, visible, beam_sum, sky, iso, refl_sky, refl_ghi,
-                    perez, hbv, refl_hor, sin_tilt, out)
+                    perez, hbv, refl_hor, sin_tilt, sky_x, sky_tables, nrm, out)
         if to_bins:
             w = dt[i] / 3600.0
             b, k = seg_hour[i], run[i]
@@ -376,7 +436,7 @@ class _Batch:
 
     def __init__(self, chunk: int, rays_per_pass: int, pairs_per_pass: int):
         f32 = np.float32
-        self.rad = np.empty((chunk, _N_RAD), f32)
+        self.rad = np.empty((chunk, _N_ROW), f32)
         self.cos_aoi = np.empty(chunk, f32)
         self.pass_ray = np.empty(chunk + 1, np.int64)
         self.done = np.empty(chunk, np.bool_)
@@ -433,8 +493,18 @@ def _inputs(geo: dict, cfg, radiation_table, rows_of_segment_loc):
              hbv=hbv.astype(f32, copy=False), refl_hor=r_hor.astype(f32, copy=False),
              sin_tilt=sin_tilt, loc=loc)
     x = {k: _writable(v) for k, v in x.items()}
-    x.update(t0=float(radiation_table.t0), step=float(radiation_table.step_s),
-             perez=cfg.diffuse_model == "perez_svf")
+    perez = cfg.diffuse_model == "perez_svf"
+    x.update(t0=float(radiation_table.t0), step=float(radiation_table.step_s), perez=perez)
+    sky_x = geo.get("sky_x")
+    if perez and sky_x is not None and sky_x.shape[1]:
+        tables = radiation_table.sky()
+        x.update(sky_x=_writable(np.asarray(sky_x, f32)), sky_rows=_writable(tables["rows"]),
+                 sky_tables=(tables["all"], tables["all_h"], tables["clear"], tables["clear_h"]),
+                 sky_t0=tables["t0"], sky_step=tables["step"])
+    else:
+        empty = np.zeros((0, 36, 9), f32)
+        x.update(sky_x=np.zeros((n_seg, 0), f32), sky_rows=np.zeros((1, 0), np.int32),
+                 sky_tables=(empty, empty, empty, empty), sky_t0=0.0, sky_step=1.0)
     return x
 
 
@@ -452,7 +522,7 @@ def _run(seg, t_start, dt, mid, row, geo, cfg, radiation_table, scene, loc_of_ro
         t_a = time.perf_counter()
         nr, _ = _setup(lo, hi, seg, t_start, dt, mid, row, x["loc"], x["packed"], x["cols"],
                        x["t0"], x["step"], x["nrm"], x["wn"], x["p_local"], x["gp_local"],
-                       rotate, rw, x["perez"], bt.rad, bt.cos_aoi, bt.pass_ray, bt.pair_w, bt.pair_pass,
+                       rotate, rw, x["perez"], x["sky_rows"], x["sky_t0"], x["sky_step"], bt.rad, bt.cos_aoi, bt.pass_ray, bt.pair_w, bt.pair_pass,
                        bt.o, bt.d, bt.done)
         t_b = time.perf_counter()
         occ = (scene.occluded_local(bt.o[:nr], bt.d[:nr], cfg.ray_length_m) if nr
@@ -532,7 +602,8 @@ def _finisher(row, dt, to_bins, block, visible, seg_hour, run, seg_bins, run_bin
     def finish(lo, hi, x, bt, occ, P, rotate):
         _finish(lo, hi, row, bt.rad, bt.cos_aoi, bt.pass_ray, bt.pair_w, bt.pair_pass,
                 occ, bt.done, x["sky"], x["iso"], x["refl_sky"], x["refl_ghi"], x["perez"],
-                x["hbv"], x["refl_hor"], x["sin_tilt"], rotate, P, to_bins, block, visible, dt, seg_hour, run, seg_bins, run_bins)
+                x["hbv"], x["refl_hor"], x["sin_tilt"], x["sky_x"], x["sky_tables"], x["nrm"],
+                rotate, P, to_bins, block, visible, dt, seg_hour, run, seg_bins, run_bins)
     return finish
 
 
@@ -542,20 +613,24 @@ def warm() -> float:
     t = time.perf_counter()
     f32, i64 = np.float32, np.int64
     one_i, one_f, one_t = np.zeros(1, i64), np.zeros(1, f32), np.zeros(1)
-    rad, pr = np.zeros((1, _N_RAD), f32), np.zeros(2, i64)
+    rad, pr = np.zeros((1, _N_ROW), f32), np.zeros(2, i64)
     o3 = np.zeros((1, 3), f32)
     packed = np.zeros((1, 2, _N_RAD), f32)
+    tables = np.zeros((1, 36, 9), f32)
     for rotate in (True, False):
         for perez in (True, False):
-            _setup(0, 1, one_i, one_t, one_t, True, one_i, one_i, packed,
-                   np.arange(_N_RAD, dtype=i64), 0.0, 60.0, o3, np.zeros((1, 1, 3), f32), o3,
-                   np.zeros((1, 1, 3), f32), rotate, f32(0.02), perez, rad, one_f, pr, one_f,
-                   one_i, o3, o3, np.zeros(1, np.bool_))
-            for to_bins in (False, True):
-                _finish(0, 1, one_i, rad, one_f, pr, one_f, one_i, np.zeros(1, bool),
-                        np.zeros(1, np.bool_), one_f, one_f, one_f, one_f, perez, one_f, one_f,
-                        one_f, rotate, 1, to_bins, np.zeros((12, 1), f32), np.zeros(1, bool),
-                        one_t, one_i, one_i, np.zeros((1, 12)), np.zeros((1, 12)))
+            for n_sky in (0, 36):
+                rows = np.zeros((1, 2 if n_sky else 0), np.int32)
+                _setup(0, 1, one_i, one_t, one_t, True, one_i, one_i, packed,
+                       np.arange(_N_RAD, dtype=i64), 0.0, 60.0, o3, np.zeros((1, 1, 3), f32), o3,
+                       np.zeros((1, 1, 3), f32), rotate, f32(0.02), perez, rows, 0.0, 900.0,
+                       rad, one_f, pr, one_f, one_i, o3, o3, np.zeros(1, np.bool_))
+                for to_bins in (False, True):
+                    _finish(0, 1, one_i, rad, one_f, pr, one_f, one_i, np.zeros(1, bool),
+                            np.zeros(1, np.bool_), one_f, one_f, one_f, one_f, perez, one_f, one_f,
+                            one_f, np.zeros((1, n_sky), f32), (tables,) * 4, o3, rotate, 1, to_bins,
+                            np.zeros((12, 1), f32), np.zeros(1, bool), one_t, one_i, one_i,
+                            np.zeros((1, 12)), np.zeros((1, 12)))
     _groups(one_i, one_i, one_i, one_t, one_t, 0, one_i, 0, one_t, one_i, one_i, one_i, one_i)
     _seconds(one_i, one_i, one_i, one_t, one_t, one_t, one_t, one_i, one_i)
     return time.perf_counter() - t

@@ -17,7 +17,7 @@ import pandas as pd
 from ..errors import InputError
 from ..inputs.cams import _GRID_S, COLUMNS, ingest_cams
 from ..store import DataDir, RadiationDir, write_npz
-from .sky import perez_table
+from .sky import SKY_STEP_S, perez_table, sky_table
 
 log = logging.getLogger(__name__)
 
@@ -75,6 +75,29 @@ def _cached_sun(path: Path, grid, lat, lon, alt) -> np.ndarray:
     except OSError:
         pass
     return sun
+
+
+def _sky_tables(grid_t0: float, n_steps: int, table: "RadiationTable", k: int) -> dict:
+    """The Perez (1993) visible-sky tables of location *k* every :data:`SKY_STEP_S` from
+    *grid_t0*: ``rows`` (n_steps,) int32 (-1 where the sun is more than 3 deg below the
+    horizon), ``all`` and ``clear`` (rows, 36, 9) float32 (:func:`vipvflow.models.sky.sky_table`)."""
+    import pvlib
+
+    t = grid_t0 + SKY_STEP_S * np.arange(n_steps)
+    v = table.lookup(t, location=k, angles=False)
+    sun = np.stack([v["sun_x"], v["sun_y"], v["sun_z"]], 1).astype(np.float64)
+    day = np.nan_to_num(v["sun_z"], nan=-1.0) > -0.05
+    rows = np.full(n_steps, -1, np.int32)
+    rows[day] = np.arange(int(day.sum()), dtype=np.int32)
+    times = pd.DatetimeIndex(pd.to_datetime(np.round(t[day] * 1e3).astype(np.int64), unit="ms", utc=True))
+    e0 = np.asarray(pvlib.irradiance.get_extra_radiation(times.day_of_year.to_numpy()), np.float64)
+    out = {"rows": rows}
+    for sfx, name in (("", "all"), ("_clear", "clear")):
+        out[name], out[name + "_h"] = sky_table(v["dhi" + sfx][day], v["dni" + sfx][day], e0, sun[day])
+    return out
+
+
+_SKY_KEYS = ("rows", "all", "all_h", "clear", "clear_h")
 
 
 # --------------------------------------------------------------------------- lookup
@@ -231,7 +254,9 @@ class RadiationTable:
                         100 * (1 - covered), year)
         alts = np.array(alts)
         sun = _cached_sun(path, grid, locs[:, 0], locs[:, 1], alts)
-        return cls.from_grid(grid, values, locs[:, 0], locs[:, 1], alts, sun=sun)
+        out = cls.from_grid(grid, values, locs[:, 0], locs[:, 1], alts, sun=sun)
+        out.__dict__["_source"] = str(path)            # where the sky tables are cached
+        return out
 
     @classmethod
     def from_cams(cls, paths) -> "RadiationTable":
@@ -250,6 +275,74 @@ class RadiationTable:
             for c in COLUMNS:
                 values[c][i, idx] = part[c].to_numpy(np.float32)
         return cls.from_grid(grid, values, locs[:, 0], locs[:, 1], locs[:, 2])
+
+    def sky(self) -> dict:
+        """The Perez (1993) sky's visible-share tables of every location, every
+        :data:`vipvflow.models.sky.SKY_STEP_S` from the grid's start (``diffuse_model:
+        perez_svf``): ``t0``, ``step``, ``rows`` (K, n_steps) int32 into ``all``, ``all_h``,
+        ``clear`` and ``clear_h`` (rows, 36, 9) float32 (-1 at night; the ``_h`` tables the
+        tilt term, :func:`vipvflow.models.sky.sky_table`).  Computed once per table (a few seconds for a
+        year) and kept beside the radiation file where it came from one (:meth:`load`)."""
+        cache = self.__dict__.get("_sky")
+        if cache is not None:
+            return cache
+        n_steps = int(np.floor((self.t_end - self.t0) / SKY_STEP_S)) + 2
+        path = self.__dict__.get("_source")
+        key = None
+        if path is not None:
+            st = Path(path).stat()
+            key = json.dumps(["sky-2", st.st_size, st.st_mtime_ns, self.t0, self.n, SKY_STEP_S,
+                              np.round(self.lat, 8).tolist(), np.round(self.lon, 8).tolist()])
+            file = RadiationDir(Path(path).parent).root / f"sky_{int(self.t0)}_{self.n}.npz"
+            try:
+                with np.load(file) as z:
+                    if str(z["key"]) == key:
+                        cache = {k: z[k] for k in _SKY_KEYS}
+            except (OSError, KeyError, ValueError):
+                pass
+        if cache is None:
+            parts = [_sky_tables(self.t0, n_steps, self, k) for k in range(len(self.lat))]
+            offset = np.cumsum([0] + [len(p["all"]) for p in parts])
+            cache = {"rows": np.stack([np.where(p["rows"] >= 0, p["rows"] + offset[i], -1)
+                                       for i, p in enumerate(parts)]).astype(np.int32),
+                     **{k: np.concatenate([p[k] for p in parts]) for k in _SKY_KEYS[1:]}}
+            if key is not None:
+                try:
+                    write_npz(file, key=np.array(key), **cache)
+                except OSError:
+                    pass
+        cache = {**cache, "t0": float(self.t0), "step": float(SKY_STEP_S)}
+        self.__dict__["_sky"] = cache
+        return cache
+
+    def sky_share(self, t_utc, levels, normal, location=None, clear: bool = False):
+        """The share of DHI a roof point receives from the Perez (1993) sky it sees, and
+        the same in the open: two float32 (n,) arrays, at times *t_utc* (Unix s), for
+        horizons *levels* (n, 36) (:func:`vipvflow.models.sky.sky_levels`) and roof unit
+        *normal* (n, 3), from the tables of :meth:`sky` interpolated linearly in time;
+        all-sky or *clear*-sky.  Where no table row is near (night) both are 0."""
+        sky = self.sky()
+        f = np.clip((np.asarray(t_utc, np.float64) - sky["t0"]) / sky["step"], 0, sky["rows"].shape[1] - 1.000001)
+        j = f.astype(np.int64)
+        w = (f - j).astype(np.float32)
+        loc = np.zeros(len(f), np.int64) if location is None else np.broadcast_to(np.asarray(location, np.int64), f.shape)
+        r0, r1 = sky["rows"][loc, j], sky["rows"][loc, j + 1]
+        r0, r1 = np.where(r0 < 0, r1, r0), np.where(r1 < 0, r0, r1)
+        name = "clear" if clear else "all"
+        tg, th = sky[name], sky[name + "_h"]
+        from .sky import SKY_AZIMUTH_BINS, sky_share as share
+
+        out, open_ = np.zeros(len(f), np.float32), np.zeros(len(f), np.float32)
+        ok = r0 >= 0
+        if ok.any():
+            lv = np.asarray(levels, np.float32)[ok]
+            nrm = np.asarray(normal, np.float32)[ok]
+            zero = np.zeros((len(lv), SKY_AZIMUTH_BINS), np.float32)
+            a, b = r0[ok], r1[ok]
+            for res, x in ((out, lv), (open_, zero)):
+                s0, s1 = share(tg[a], th[a], x, nrm), share(tg[b], th[b], x, nrm)
+                res[ok] = s0 + w[ok] * (s1 - s0)
+        return out, open_
 
     def nearest_location(self, lat, lon) -> np.ndarray:
         """Index of the nearest table location for each point (degrees; great-circle)."""

@@ -513,7 +513,23 @@ def segment_geometry(scene, segments: pd.DataFrame, cfg: IrradianceCfg | None = 
             if len(idx):
                 _reflectors(scene, origin[idx], normal[idx], seg_ids[idx], N, cfg, acc, idx,
                             None if ground_z is None else ground_z[idx], road_albedo)
-    return _geometry_frame(seg_ids, origin, tilt, azim, normal, svf, acc, G, P, hbv)
+    frame = _geometry_frame(seg_ids, origin, tilt, azim, normal, svf, acc, G, P, hbv)
+    if cfg.diffuse_model == "perez_svf":
+        # the Perez sky's luminance is integrated over the sky the roof point sees: its
+        # horizon per 10 deg sector as a level index (models.sky.sky_levels)
+        from .horizon import horizon_profile
+        from .sky import sky_levels
+
+        levels = np.zeros((n_seg, 36), np.float32)
+        for a in range(0, n_seg, chunk):
+            sl = slice(a, min(n_seg, a + chunk))
+            levels[sl] = sky_levels(horizon_profile(scene, origin[sl], max_distance_m=cfg.ray_length_m))
+        frame = pd.concat([frame, pd.DataFrame(levels, columns=SKY_COLUMNS)], axis=1)
+    return frame
+
+
+#: the geometry table's columns of the roof point's horizon per sky sector (perez_svf)
+SKY_COLUMNS = [f"sky_x{k:02d}" for k in range(36)]
 
 
 def _no_reflectors(origin, G: int, P: int) -> dict:
@@ -893,7 +909,9 @@ def pack_geometry(geometry: pd.DataFrame, cfg: IrradianceCfg, ground_albedo: flo
     (s, 3) ray origins (m), ``n`` (s, 3) roof normals, ``svf`` (s,), ``hbv`` (s,) the roof's
     view of the horizon band, ``refl_sky`` and ``refl_ghi`` (s,) the weights of DHI and GHI
     in the reflected part, ``refl_hor`` (s,) the reflectors' horizon-band views so weighted
-    (x DHI F2 under the Perez sky; all dimensionless),
+    (x DHI F2 under the Perez sky; all dimensionless), ``sky_x`` (s, 36) the roof point's
+    horizon per sky sector as a level index (:func:`vipvflow.models.sky.sky_levels`; (s, 0)
+    without the ``sky_x..`` columns),
     ``wn`` (s, J, 3) weight x normal of each reflector (its beam weight is ``wn . sun``),
     ``group_p`` (s J, P, 3) sample points (m); with *scene* also ``scene_origin``,
     ``p_local`` and ``group_p_local`` (float32, the scene's frame).
@@ -958,6 +976,8 @@ def pack_geometry(geometry: pd.DataFrame, cfg: IrradianceCfg, ground_albedo: flo
            "n": np.ascontiguousarray(geometry[["nx", "ny", "nz"]].to_numpy(f32)),
            "svf": geometry["svf"].to_numpy(f32),
            "hbv": (geometry["hbv"].to_numpy(f32) if "hbv" in cols else np.zeros(s, f32)),
+           "sky_x": (np.ascontiguousarray(geometry[SKY_COLUMNS].to_numpy(f32))
+                     if set(SKY_COLUMNS) <= cols else np.zeros((s, 0), f32)),
            "refl_sky": (m * src_sky).sum(1).astype(f32), "refl_ghi": (m * src_ghi).sum(1).astype(f32),
            "refl_hor": (m * f_h).sum(1).astype(f32),
            "wn": ((m * beam_len)[..., None] * nrm).astype(f32), "group_p": pts.reshape(s * J, -1, 3)}

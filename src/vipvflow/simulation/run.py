@@ -90,8 +90,8 @@ def run_simulation(cfg: Config, year: int, scheduler: str | None = None,
         timeline = _Background(write_timeline, cfg, year, run_dir, routes=routes, name="timeline")
         # the radiation table's sun positions are computed (and cached beside the radiation
         # file, where every worker loads them) while the cluster starts
-        warm = threading.Thread(target=_warm_radiation, args=(ctx.data_dir, year), daemon=True,
-                                name="sun-positions")
+        warm = threading.Thread(target=_warm_radiation, daemon=True, name="sun-positions",
+                                args=(ctx.data_dir, year, cfg.irradiance.diffuse_model == "perez_svf"))
         warm.start()
         t_wait = time.perf_counter()
         client, cluster = starting.result()
@@ -234,13 +234,16 @@ class _Starting(_Background):
             close_client(*self._out["value"])
 
 
-def _warm_radiation(data_dir: str, year: int) -> None:
-    """Load the radiation table once in this process (writes its sun-position cache); a
-    failure is left for the workers to report with the file named."""
+def _warm_radiation(data_dir: str, year: int, sky: bool = False) -> None:
+    """Load the radiation table once in this process (writes its sun-position cache, and
+    with *sky* the Perez sky's tables); a failure is left for the workers to report with
+    the file named."""
     from ..models.sun_sky import RadiationTable
 
     try:
-        RadiationTable.load(data_dir, year)
+        table = RadiationTable.load(data_dir, year)
+        if sky:
+            table.sky()
     except Exception:  # noqa: BLE001 - the same load fails again in the tasks, with its message
         pass
 
