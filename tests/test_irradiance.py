@@ -18,6 +18,12 @@ from vipvflow.models.shading import Scene, box_mesh
 LONG = 3000.0     # half length of "infinite" walls (m)
 
 
+def _uniform(**kw) -> IrradianceCfg:
+    """The engine's settings under a uniform sky (``sky_view_factor``) unless *kw* names
+    another: these tests check geometry and light against analytic forms of that sky."""
+    return IrradianceCfg(**{"diffuse_model": "sky_view_factor", **kw})
+
+
 def _segments(x, y, z, heading=0.0, gradient=0.0):
     n = len(np.atleast_1d(x))
     return pd.DataFrame({"segment_id": np.arange(n), "x": np.atleast_1d(x).astype(float),
@@ -54,7 +60,7 @@ def test_no_buildings_equals_pvlib_isotropic():
     heading = rng.uniform(0, 360, n)
     segs = _segments(rng.uniform(0, 100, n), 0.0, 3.2, heading, gradient)
     scene = Scene(box_mesh(np.zeros((0, 6))))
-    cfg = IrradianceCfg(svf_rays=16, reflection_rays=16, diffuse_model="isotropic")
+    cfg = _uniform(svf_rays=16, reflection_rays=16, diffuse_model="isotropic")
     geometry = segment_geometry(scene, segs, cfg, roof_height_m=None)     # nothing, not even a street
     zen, azi = rng.uniform(0, 89, n), rng.uniform(0, 360, n)
     dni, dhi = rng.uniform(0, 900, n), rng.uniform(0, 300, n)
@@ -81,7 +87,7 @@ def test_evaluate_passes_full_chain_matches_pvlib():
     table = RadiationTable.from_grid(grid, vals, 49.61, 6.13, 300.0)
     segs = _segments([0.0, 10.0, 20.0], 0.0, 3.2, [0.0, 90.0, 200.0], [0.0, 0.08, -0.03])
     scene = Scene(box_mesh(np.zeros((0, 6))))
-    cfg = IrradianceCfg(svf_rays=16, reflection_rays=16, diffuse_model="isotropic")
+    cfg = _uniform(svf_rays=16, reflection_rays=16, diffuse_model="isotropic")
     geometry = segment_geometry(scene, segs, cfg)
     rng = np.random.default_rng(5)
     p = 300
@@ -102,7 +108,7 @@ def test_evaluate_passes_full_chain_matches_pvlib():
 def test_long_wall_blocks_below_profile_angle():
     H, D, zr = 15.0, 8.0, 3.2
     scene = Scene(box_mesh([[D, -LONG, 0.0, D + 1.0, LONG, H]]))
-    cfg = IrradianceCfg(svf_rays=16, reflection_rays=0, ray_length_m=5000.0, ray_offset_m=0.05)
+    cfg = _uniform(svf_rays=16, reflection_rays=0, ray_length_m=5000.0, ray_offset_m=0.05)
     geometry = segment_geometry(scene, _segments(0.0, 0.0, zr), cfg)
     rng = np.random.default_rng(3)
     n = 4000
@@ -132,14 +138,14 @@ def test_canyon_sky_view_factor(H, W):
     zr = 3.0
     scene = Scene(box_mesh([[-W / 2 - 1, -LONG, 0, -W / 2, LONG, zr + H],
                             [W / 2, -LONG, 0, W / 2 + 1, LONG, zr + H]]))
-    cfg = IrradianceCfg(svf_rays=4096, reflection_rays=64, ray_length_m=10_000.0, ray_offset_m=0.0)
+    cfg = _uniform(svf_rays=4096, reflection_rays=64, ray_length_m=10_000.0, ray_offset_m=0.0)
     geometry = segment_geometry(scene, _segments([0.0], 0.0, zr, 0.0, 0.0), cfg)
     expected = np.cos(np.arctan(2 * H / W))
     assert geometry["svf"].iloc[0] == pytest.approx(expected, rel=0.02)
 
 
 def test_tilted_roof_open_sky_view_factor():
-    cfg = IrradianceCfg(svf_rays=1024, reflection_rays=8)
+    cfg = _uniform(svf_rays=1024, reflection_rays=8)
     scene = Scene(box_mesh(np.zeros((0, 6))))
     g = np.tan(np.radians([0.0, 10.0, 30.0]))
     geometry = segment_geometry(scene, _segments([0, 1, 2], 0.0, 3.0, 45.0, g), cfg)
@@ -157,7 +163,7 @@ def test_reflection_from_large_wall_matches_view_factor():
     """
     D, H, zr, rho, rho_g = 6.0, 25.0, 3.0, 0.4, 0.2
     scene = Scene(box_mesh([[D, -LONG, 0.0, D + 2, LONG, zr + H]], albedo_wall=rho))
-    cfg = IrradianceCfg(svf_rays=64, reflection_rays=4096, ray_length_m=10_000.0, ray_offset_m=0.0,
+    cfg = _uniform(svf_rays=64, reflection_rays=4096, ray_length_m=10_000.0, ray_offset_m=0.0,
                         max_reflector_groups=3, reflector_points=16,
                         reflector_sky_rays=16)
     geometry = segment_geometry(scene, _segments([0.0], 0.0, zr), cfg, roof_height_m=None)
@@ -205,7 +211,7 @@ def test_sky_view_factor_diffuse_mode():
     H, W, zr = 16.0, 20.0, 3.0
     scene = Scene(box_mesh([[-W / 2 - 1, -LONG, 0, -W / 2, LONG, zr + H],
                             [W / 2, -LONG, 0, W / 2 + 1, LONG, zr + H]]))
-    iso = IrradianceCfg(svf_rays=1024, reflection_rays=256, ray_length_m=5000.0,
+    iso = _uniform(svf_rays=1024, reflection_rays=256, ray_length_m=5000.0,
                         diffuse_model="isotropic")
     svf = iso.model_copy(update={"diffuse_model": "sky_view_factor"})
     geometry = segment_geometry(scene, _segments([0.0], 0.0, zr), svf)
@@ -241,7 +247,7 @@ def test_partly_lit_facade_lit_fraction(P):
     of the group's weight, F / (2 P)."""
     H, W, zr, rho, el, dni = 16.0, 18.0, 3.2, 0.35, 20.0, 800.0
     scene = Scene(_canyon(H, W, rho))
-    cfg = IrradianceCfg(svf_rays=64, reflection_rays=8192, ray_length_m=10_000.0,
+    cfg = _uniform(svf_rays=64, reflection_rays=8192, ray_length_m=10_000.0,
                         reflector_points=P, reflector_sky_rays=8, reflector_sampling="all")
     geometry = segment_geometry(scene, _segments([0.0], 0.0, zr), cfg)
     s_ = lambda h: (W / 2) / np.hypot(W / 2, h)
@@ -270,7 +276,7 @@ def test_rotating_reflector_sample_is_the_p_point_lit_fraction_on_average():
     many passes converges to it."""
     H, W, zr, el, dni, P = 16.0, 18.0, 3.2, 20.0, 800.0, 8
     scene = Scene(_canyon(H, W, 0.35))
-    all_ = IrradianceCfg(svf_rays=64, reflection_rays=4096, ray_length_m=10_000.0,
+    all_ = _uniform(svf_rays=64, reflection_rays=4096, ray_length_m=10_000.0,
                          reflector_points=P, reflector_sky_rays=8, reflector_sampling="all")
     rot = all_.model_copy(update={"reflector_sampling": "rotate"})
     geometry = segment_geometry(scene, _segments([0.0], 0.0, zr), all_)
@@ -313,7 +319,7 @@ def test_canyon_facade_sees_its_own_sky_and_road():
     the means over its sample points, the road's weighted by its albedo."""
     H, W, zr, rho_road = 16.0, 18.0, 3.2, 0.15
     scene = Scene(_canyon(H, W, rho_road=rho_road))
-    cfg = IrradianceCfg(svf_rays=64, reflection_rays=2048, ray_length_m=10_000.0,
+    cfg = _uniform(svf_rays=64, reflection_rays=2048, ray_length_m=10_000.0,
                         reflector_points=4, reflector_sky_rays=2048)
     geometry = segment_geometry(scene, _segments([0.0], 0.0, zr), cfg)
     row = geometry.iloc[0]
@@ -332,7 +338,7 @@ def test_geometry_is_per_segment_and_plain_numeric():
     """A segment's rays come from its own random stream: the same geometry whether it is
     computed with others in one batch or alone; every column is a plain number (parquet)."""
     scene = Scene(box_mesh([[8, -50, 0, 12, 50, 15], [-14, -20, 0, -9, 30, 22]]))
-    cfg = IrradianceCfg(svf_rays=32, reflection_rays=64, reflector_points=3, reflector_sky_rays=8)
+    cfg = _uniform(svf_rays=32, reflection_rays=64, reflector_points=3, reflector_sky_rays=8)
     segs = _segments(np.linspace(-5, 5, 7), np.linspace(-30, 30, 7), 3.2, 10.0, 0.02)
     segs["segment_id"] = [40, 3, 17, 8, 99, 5, 61]
     together = segment_geometry(scene, segs, cfg)
@@ -355,7 +361,7 @@ def test_geometry_file_reads_back_as_computed(tmp_path):
     from vipvflow.store import write_parquet
 
     scene = Scene(box_mesh([[8, -50, 0, 12, 50, 15], [-14, -20, 0, -9, 30, 22]]))
-    cfg = IrradianceCfg(svf_rays=32, reflection_rays=64, reflector_points=5, reflector_sky_rays=8)
+    cfg = _uniform(svf_rays=32, reflection_rays=64, reflector_points=5, reflector_sky_rays=8)
     segs = _segments(np.linspace(-5, 5, 7), np.linspace(-30, 30, 7), 3.2, 10.0, 0.02)
     segs["segment_id"] = [40, 3, 17, 8, 99, 5, 61]
     geometry = segment_geometry(scene, segs, cfg)
@@ -397,7 +403,7 @@ def test_sun_along_the_canyon_lights_the_roof_through_the_street():
     exchange factor, between 1 and 1 / (1 - max F_wall)."""
     H, W, zr, el, dni = 16.0, 18.0, 3.2, 40.0, 800.0
     scene = Scene(_canyon(H, W))
-    cfg = IrradianceCfg(reflection_rays=2048, reflector_sky_rays=64, ray_length_m=10_000.0,
+    cfg = _uniform(reflection_rays=2048, reflector_sky_rays=64, ray_length_m=10_000.0,
                         reflector_sampling="all")
     geometry = segment_geometry(scene, _segments([0.0], 0.0, zr), cfg)
     row = geometry.iloc[0]
@@ -509,7 +515,7 @@ def test_radiation_table_perez_full_chain_matches_pvlib():
     table = RadiationTable.from_grid(grid, vals, 49.61, 6.13, 300.0)
     segs = _segments([0.0, 10.0, 20.0], 0.0, 3.2, [0.0, 90.0, 200.0], [0.0, 0.08, -0.03])
     scene = Scene(box_mesh(np.zeros((0, 6))))
-    cfg = IrradianceCfg(svf_rays=64, reflection_rays=16, diffuse_model="perez_svf")
+    cfg = _uniform(svf_rays=64, reflection_rays=16, diffuse_model="perez_svf")
     geometry = segment_geometry(scene, segs, cfg)
     # the open roof sees all of the band near the horizon in front of it
     np.testing.assert_allclose(geometry["hbv"], np.sin(np.radians(geometry["tilt_deg"])), rtol=1e-6)
@@ -571,7 +577,7 @@ def test_open_street_reflects_like_pvlibs_ground_diffuse():
     scene = Scene(box_mesh(np.zeros((0, 6))))
     # (rays as long as the street is wide: at 300 m a 20 deg roof loses 8 % of its street,
     # the ground below 0.6 deg of depression, to the open ground beyond the city model)
-    cfg = IrradianceCfg(svf_rays=64, reflection_rays=1024, reflector_sampling="all",
+    cfg = _uniform(svf_rays=64, reflection_rays=1024, reflector_sampling="all",
                         ray_length_m=100_000.0)
     geometry = segment_geometry(scene, segs, cfg, road_albedo=0.12)
     zen, azi = rng.uniform(0, 80, n), rng.uniform(0, 360, n)

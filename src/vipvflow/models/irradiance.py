@@ -4,8 +4,10 @@ The paper's model (sections 3.2.1 to 3.2.3), extended for streets:
 
 * (1) direct    ``E_b = DNI x max(cos AOI, 0) x V_sun`` with ``V_sun`` = 1 when the ray
   from the roof point to the sun is not blocked (Embree occlusion query);
-* (2) diffuse   ``E_d = DHI x SVF`` with the cosine-weighted sky view factor of the roof
-  point (``diffuse_model: sky_view_factor``, the default), or the paper's isotropic sky
+* (2) diffuse   the Perez (1993) sky's light over the sky the roof point sees
+  (``diffuse_model: perez_svf``, the default; :mod:`vipvflow.models.sky`), or
+  ``E_d = DHI x SVF`` with the cosine-weighted sky view factor of the roof point
+  (``sky_view_factor``, a uniform sky), or the paper's isotropic sky
   ``E_d = DHI x (1 + cos beta) / 2`` (Liu & Jordan; pvlib ``irradiance.isotropic``;
   ``diffuse_model: isotropic``), which counts the sky the buildings hide as open: an upper
   bound in streets;

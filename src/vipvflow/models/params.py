@@ -23,11 +23,10 @@ class CycleCfg(_Params):
 
 
 class IrradianceCfg(_Params):
-    # perez_svf: DHI split by the Perez model into an isotropic part (x the roof point's
-    # sky view factor), a circumsolar part (seen when the sun is) and a horizon band (x the
-    # roof point's view of the band near the horizon); sky_view_factor: DHI x the roof
-    # point's cosine-weighted sky view (a uniform sky); isotropic: the paper's DHI (1 + cos
-    # tilt) / 2, an upper bound in streets
+    # perez_svf (default): the Perez (1993) sky's light over the sky the roof point sees
+    # (its horizon per 10 deg sector), the reflectors lit by the three-part Perez (1990) sky;
+    # sky_view_factor: DHI x the roof point's cosine-weighted sky view (a uniform sky);
+    # isotropic: the paper's DHI (1 + cos tilt) / 2, an upper bound in streets
     diffuse_model: Literal["perez_svf", "isotropic", "sky_view_factor"] = "perez_svf"
     reflection: bool = True
     reflection_rays: int = Field(256, ge=0, le=65_536)

@@ -520,11 +520,10 @@ def segment_geometry(scene, segments: pd.DataFrame, cfg: IrradianceCfg | None = 
         from .horizon import horizon_profile
         from .sky import sky_levels
 
-        levels = np.zeros((n_seg, 36), np.float32)
-        for a in range(0, n_seg, chunk):
-            sl = slice(a, min(n_seg, a + chunk))
-            levels[sl] = sky_levels(horizon_profile(scene, origin[sl], max_distance_m=cfg.ray_length_m))
-        frame = pd.concat([frame, pd.DataFrame(levels, columns=SKY_COLUMNS)], axis=1)
+        profile = np.concatenate([horizon_profile(scene, origin[a:a + chunk], max_distance_m=cfg.ray_length_m)
+                                  for a in range(0, n_seg, chunk)]) if n_seg else np.zeros((0, 72), np.float32)
+        frame = pd.concat([frame, pd.DataFrame(sky_levels(profile), columns=SKY_COLUMNS)], axis=1)
+        frame.attrs["horizon_profile"] = profile        # the run stores it for the app, once
     return frame
 
 

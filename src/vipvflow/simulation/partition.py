@@ -142,9 +142,11 @@ def tile_geometry(ctx: RunContext, tile: str) -> pd.DataFrame:
         write_parquet(geometry_table(geom), path)
     hpath = RunDir(ctx.run_dir).tile_part("horizon", tile)
     if not hpath.exists():
-        origins = geom[["px", "py", "pz"]].to_numpy(np.float64)
-        profile = horizon_profile(_scene(ctx, tile), origins,
-                                  max_distance_m=IrradianceCfg(**ctx.irradiance).ray_length_m)
+        profile = geom.attrs.get("horizon_profile")         # computed with the geometry (perez_svf)
+        if profile is None or len(profile) != len(geom):
+            origins = geom[["px", "py", "pz"]].to_numpy(np.float64)
+            profile = horizon_profile(_scene(ctx, tile), origins,
+                                      max_distance_m=IrradianceCfg(**ctx.irradiance).ray_length_m)
         write_parquet(horizon_frame(geom["segment_id"].to_numpy(), profile), hpath)
     return geom
 
