@@ -265,7 +265,7 @@ class Config(_Model):
     def _temperature(self) -> tuple[tuple, str]:
         given = self.climate.monthly_mean_temperature_c
         if given is not None:
-            return tuple(given), f"{self._source}: climate.monthly_mean_temperature_c"
+            return tuple(given), f"{Path(self._source).name}: climate.monthly_mean_temperature_c"
         key = str(Path(self.data_dir).resolve())
         hit = _TEMPERATURES.get(key)
         if hit is None:
