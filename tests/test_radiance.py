@@ -346,7 +346,7 @@ def perez_radiation(times, dni, dhi, ghi, sun, geo=None) -> dict:
     and airmass), float32, all-sky = clear-sky; with the segments' geometry *geo* per
     (instant, segment), instant-major, with the Perez (1993) sky's share of each, as
     :meth:`RadiationTable.sky_share` gives it (:func:`vipvflow.models.sky.sky_table`)."""
-    from vipvflow.models.sky import perez_coefficients, sky_share, sky_table
+    from vipvflow.models.sky import open_share, open_terms, perez_coefficients, sky_share, sky_table
     from vipvflow.models.view_factors import SKY_COLUMNS
 
     zen = np.degrees(np.arccos(np.clip(sun[:, 2], -1, 1)))
@@ -362,7 +362,7 @@ def perez_radiation(times, dni, dhi, ghi, sun, geo=None) -> dict:
         out = {c: np.repeat(v, k) for c, v in out.items()}
         tg, th = np.repeat(tg, k, axis=0), np.repeat(th, k, axis=0)
         out["sky_share"] = sky_share(tg, th, levels, normal)
-        out["sky_open"] = sky_share(tg, th, np.zeros_like(levels), normal)
+        out["sky_open"] = open_share(open_terms(th), normal)
     out.update({f"{c}_clear": v for c, v in list(out.items())})
     return {c: np.asarray(v, f) for c, v in out.items()}
 

@@ -40,7 +40,7 @@ import numpy as np
 from numba import njit
 
 from .irradiance import ROULETTE_WEIGHT
-from .sky import COS_85, SECTOR_COS, SECTOR_SIN
+from .sky import COS_85, SECTOR_COS, SECTOR_SIN, SKY_AZIMUTH_BINS, SKY_LEVELS
 
 #: components of a pass in the order of the kernel's output block (W/m2)
 BLOCK_COLUMNS = ("direct", "diffuse", "reflected", "total", "direct_clear", "diffuse_clear",
@@ -52,8 +52,8 @@ RAY_BUDGET = 1 << 21
 _RAD = ("dni", "dhi", "ghi", "dni_clear", "dhi_clear", "ghi_clear", "sun_x", "sun_y", "sun_z",
         "f1", "f2", "f1_clear", "f2_clear")
 _N_RAD = len(_RAD)
-#: per pass after the radiation: the Perez sky tables' two rows and the weight of the second
-_N_ROW = _N_RAD + 3
+#: per pass after the radiation: the Perez sky tables' row nearest in time
+_N_ROW = _N_RAD + 1
 _COS_85 = np.float32(COS_85)
 _SEC_SIN = SECTOR_SIN.astype(np.float32)
 _SEC_COS = SECTOR_COS.astype(np.float32)
@@ -122,18 +122,10 @@ def _setup(lo, hi, seg, t_start, dt, mid, row, loc_of_row, packed, cols, t0, ste
             continue
         done[c] = True
         if sky_rows.shape[1]:
-            # the Perez sky tables' rows around the pass (RadiationTable.sky_share)
-            n_s = sky_rows.shape[1]
-            fs = min(max((t - sky_t0) / sky_step, 0.0), n_s - 1.000001)
-            js = np.int64(fs)
-            r0, r1 = sky_rows[li, js], sky_rows[li, js + 1]
-            if r0 < 0:
-                r0 = r1
-            if r1 < 0:
-                r1 = r0
-            rad[c, _N_RAD] = np.float32(r0)
-            rad[c, _N_RAD + 1] = np.float32(r1)
-            rad[c, _N_RAD + 2] = np.float32(fs - js)
+            # the Perez sky tables' row nearest the pass (RadiationTable.sky_steps)
+            js = np.int64(min(max(np.floor((t - sky_t0) / sky_step + 0.5), 0.0),
+                              sky_rows.shape[1] - 1))
+            rad[c, _N_RAD] = np.float32(sky_rows[li, js])
         sx, sy, sz = rad[c, 6], rad[c, 7], rad[c, 8]
         # the circumsolar part of the Perez sky travels the sun ray, like the beam
         if not (sz > 0 and (rad[c, 0] > 0 or rad[c, 3] > 0 or rad[c, 9] > 0 or rad[c, 11] > 0)):
@@ -180,38 +172,28 @@ def _setup(lo, hi, seg, t_start, dt, mid, row, loc_of_row, packed, cols, t0, ste
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _level(table, r, k, i, f, n_l):
-    a = table[r, k, i]
-    b = table[r, k, i + 1] if i + 1 < n_l else np.float32(0.0)
-    return a + f * (b - a)
-
-
-@njit(cache=True, nogil=True)
-def _share(tg, th, r0, r1, w, x, nx, ny, nz):
-    """The Perez (1993) sky's share of DHI on a roof of normal ``(nx, ny, nz)`` with
-    horizon levels *x* (36,), and in the open, between table rows *r0* and *r1*
-    (:func:`vipvflow.models.sky.sky_share`, interpolated with weight *w*)."""
-    n_l = tg.shape[2]
-    s0 = np.float32(0.0)
-    s1 = np.float32(0.0)
-    o0 = np.float32(0.0)
-    o1 = np.float32(0.0)
-    zero = np.float32(0.0)
-    for k in range(x.shape[0]):
-        xi = x[k]
-        i = np.int64(xi)
-        f = xi - np.float32(i)
-        t = nx * _SEC_SIN[k] + ny * _SEC_COS[k]
-        s0 += nz * _level(tg, r0, k, i, f, n_l) + t * _level(th, r0, k, i, f, n_l)
-        s1 += nz * _level(tg, r1, k, i, f, n_l) + t * _level(th, r1, k, i, f, n_l)
-        o0 += nz * _level(tg, r0, k, 0, zero, n_l) + t * _level(th, r0, k, 0, zero, n_l)
-        o1 += nz * _level(tg, r1, k, 0, zero, n_l) + t * _level(th, r1, k, 0, zero, n_l)
-    return s0 + w * (s1 - s0), o0 + w * (o1 - o0)
+def _share(tg, th, r, cell, f, t, tilted, nz):
+    """The Perez (1993) sky's share of DHI on a roof from table row *r*: per sector its
+    cell, interpolation weight and tilt weight (:func:`vipvflow.models.sky.sky_share`; the
+    tables flat, (rows, 36 x 10))."""
+    s = np.float32(0.0)
+    if tilted:
+        for k in range(cell.shape[0]):
+            j = cell[k]
+            g0, h0 = tg[r, j], th[r, j]
+            s += nz * (g0 + f[k] * (tg[r, j + 1] - g0)) + t[k] * (h0 + f[k] * (th[r, j + 1] - h0))
+    else:
+        for k in range(cell.shape[0]):
+            j = cell[k]
+            g0 = tg[r, j]
+            s += nz * (g0 + f[k] * (tg[r, j + 1] - g0))
+    return s
 
 
 @njit(cache=True, nogil=True, inline="always")
 def _components(c, r, rad, cos_aoi, visible, beam_sum, sky, iso, refl_sky, refl_ghi,
-                perez, hbv, refl_hor, sin_tilt, sky_x, sky_tables, nrm, out):
+                perez, hbv, refl_hor, sin_tilt, sky_cell, sky_f, sky_t, sky_tilted, tg_all, th_all,
+                to_all, tg_clear, th_clear, to_clear, nrm, out):
     """The 12 :data:`BLOCK_COLUMNS` of one pass into *out* (float32, as
     :func:`vipvflow.models.irradiance.roof_components` sums them, the Perez sky with
     *perez*)."""
@@ -226,20 +208,26 @@ def _components(c, r, rad, cos_aoi, visible, beam_sum, sky, iso, refl_sky, refl_
             cs = dh * f1 / max(rad[c, 8], _COS_85)
             circ = cs * ca
             iso_w = np.float32(1.0) - f1
-            if sky_x.shape[1]:
-                r0, r1 = np.int64(rad[c, _N_RAD]), np.int64(rad[c, _N_RAD + 1])
+            if sky_cell.shape[1]:
+                rs = np.int64(rad[c, _N_RAD])
                 share = np.float32(0.0)
                 share_open = np.float32(0.0)
-                if r0 >= 0:
-                    share, share_open = _share(sky_tables[2 * s], sky_tables[2 * s + 1], r0, r1,
-                                               rad[c, _N_RAD + 2], sky_x[r], nrm[r, 0], nrm[r, 1],
-                                               nrm[r, 2])
+                if rs >= 0:
+                    nx, ny, nz = nrm[r, 0], nrm[r, 1], nrm[r, 2]
+                    if s == 0:
+                        share = _share(tg_all, th_all, rs, sky_cell[r], sky_f[r], sky_t[r],
+                                       sky_tilted[r], nz)
+                        share_open = nz + (nx * to_all[rs, 0] + ny * to_all[rs, 1])
+                    else:
+                        share = _share(tg_clear, th_clear, rs, sky_cell[r], sky_f[r], sky_t[r],
+                                       sky_tilted[r], nz)
+                        share_open = nz + (nx * to_clear[rs, 0] + ny * to_clear[rs, 1])
                 diffuse = max(dh * share, np.float32(0.0))
             else:
                 diffuse = max(dh * (iso_w * sky[r] + f2 * hbv[r]) + circ * vis, np.float32(0.0))
             reflected = ((b + cs) * beam_sum + dh * (iso_w * refl_sky[r] + f2 * refl_hor[r])
                          + gh * refl_ghi[r])
-            if sky_x.shape[1]:
+            if sky_cell.shape[1]:
                 unshaded = beam + max(dh * share_open, np.float32(0.0))
             else:
                 unshaded = beam + max(dh * (iso_w * iso[r] + f2 * sin_tilt[r]) + circ, np.float32(0.0))
@@ -283,8 +271,9 @@ def _visibility(c, pass_ray, pair_w, pair_pass, q, occ, cos_aoi, rotate, P):
 
 @njit(cache=True, nogil=True)
 def _finish(lo, hi, row, rad, cos_aoi, pass_ray, pair_w, pair_pass, occ, done,
-            sky, iso, refl_sky, refl_ghi, perez, hbv, refl_hor, sin_tilt, sky_x, sky_tables, nrm,
-            rotate, P, to_bins, block, visible_out, dt, seg_hour, run, seg_bins, run_bins):
+            sky, iso, refl_sky, refl_ghi, perez, hbv, refl_hor, sin_tilt, sky_cell, sky_f, sky_t,
+            sky_tilted, tg_all, th_all, to_all, tg_clear, th_clear, to_clear, nrm, rotate, P,
+            to_bins, block, visible_out, dt, seg_hour, run, seg_bins, run_bins):
     """Components of passes ``lo..hi``: into columns of *block* (12, n) and *visible_out*,
     or, with *to_bins*, as irradiation (Wh/m2) added into ``seg_bins[seg_hour[i]]`` and
     ``run_bins[run[i]]`` ((bins, 12) float64, :data:`BLOCK_COLUMNS`); the other side's
@@ -298,7 +287,8 @@ def _finish(lo, hi, row, rad, cos_aoi, pass_ray, pair_w, pair_pass, occ, done,
         visible, beam_sum, q = _visibility(c, pass_ray, pair_w, pair_pass, q, occ, cos_aoi,
                                            rotate, P)
         _components(c, row[i], rad, cos_aoi, visible, beam_sum, sky, iso, refl_sky, refl_ghi,
-                    perez, hbv, refl_hor, sin_tilt, sky_x, sky_tables, nrm, out)
+                    perez, hbv, refl_hor, sin_tilt, sky_cell, sky_f, sky_t, sky_tilted, tg_all,
+                    th_all, to_all, tg_clear, th_clear, to_clear, nrm, out)
         if to_bins:
             w = dt[i] / 3600.0
             b, k = seg_hour[i], run[i]
@@ -498,13 +488,20 @@ def _inputs(geo: dict, cfg, radiation_table, rows_of_segment_loc):
     sky_x = geo.get("sky_x")
     if perez and sky_x is not None and sky_x.shape[1]:
         tables = radiation_table.sky()
-        x.update(sky_x=_writable(np.asarray(sky_x, f32)), sky_rows=_writable(tables["rows"]),
-                 sky_tables=(tables["all"], tables["all_h"], tables["clear"], tables["clear_h"]),
+        flat = lambda a: _writable(a.reshape(len(a), -1))          # noqa: E731
+        x.update(sky_cell=_writable(geo["sky_cell"]), sky_f=_writable(geo["sky_f"]),
+                 sky_t=_writable(geo["sky_t"]), sky_tilted=_writable(geo["sky_tilted"]),
+                 sky_rows=_writable(tables["rows"]),
+                 sky_tables=(flat(tables["all"]), flat(tables["all_h"]), _writable(tables["all_open"]),
+                             flat(tables["clear"]), flat(tables["clear_h"]), _writable(tables["clear_open"])),
                  sky_t0=tables["t0"], sky_step=tables["step"])
     else:
-        empty = np.zeros((0, 36, 9), f32)
-        x.update(sky_x=np.zeros((n_seg, 0), f32), sky_rows=np.zeros((1, 0), np.int32),
-                 sky_tables=(empty, empty, empty, empty), sky_t0=0.0, sky_step=1.0)
+        e2 = np.zeros((0, 2), f32)
+        e = np.zeros((0, SKY_AZIMUTH_BINS * (SKY_LEVELS + 1)), f32)
+        x.update(sky_cell=np.zeros((n_seg, 0), np.int64), sky_f=np.zeros((n_seg, 0), f32),
+                 sky_t=np.zeros((n_seg, 0), f32), sky_tilted=np.zeros(n_seg, np.bool_),
+                 sky_rows=np.zeros((1, 0), np.int32),
+                 sky_tables=(e, e, e2, e, e, e2), sky_t0=0.0, sky_step=1.0)
     return x
 
 
@@ -602,8 +599,8 @@ def _finisher(row, dt, to_bins, block, visible, seg_hour, run, seg_bins, run_bin
     def finish(lo, hi, x, bt, occ, P, rotate):
         _finish(lo, hi, row, bt.rad, bt.cos_aoi, bt.pass_ray, bt.pair_w, bt.pair_pass,
                 occ, bt.done, x["sky"], x["iso"], x["refl_sky"], x["refl_ghi"], x["perez"],
-                x["hbv"], x["refl_hor"], x["sin_tilt"], x["sky_x"], x["sky_tables"], x["nrm"],
-                rotate, P, to_bins, block, visible, dt, seg_hour, run, seg_bins, run_bins)
+                x["hbv"], x["refl_hor"], x["sin_tilt"], x["sky_cell"], x["sky_f"], x["sky_t"],
+                x["sky_tilted"], *x["sky_tables"], x["nrm"], rotate, P, to_bins, block, visible, dt, seg_hour, run, seg_bins, run_bins)
     return finish
 
 
@@ -616,10 +613,10 @@ def warm() -> float:
     rad, pr = np.zeros((1, _N_ROW), f32), np.zeros(2, i64)
     o3 = np.zeros((1, 3), f32)
     packed = np.zeros((1, 2, _N_RAD), f32)
-    tables = np.zeros((1, 36, 9), f32)
+    tables = np.zeros((1, SKY_AZIMUTH_BINS * (SKY_LEVELS + 1)), f32)
     for rotate in (True, False):
         for perez in (True, False):
-            for n_sky in (0, 36):
+            for n_sky in (0, SKY_AZIMUTH_BINS):
                 rows = np.zeros((1, 2 if n_sky else 0), np.int32)
                 _setup(0, 1, one_i, one_t, one_t, True, one_i, one_i, packed,
                        np.arange(_N_RAD, dtype=i64), 0.0, 60.0, o3, np.zeros((1, 1, 3), f32), o3,
@@ -628,7 +625,10 @@ def warm() -> float:
                 for to_bins in (False, True):
                     _finish(0, 1, one_i, rad, one_f, pr, one_f, one_i, np.zeros(1, bool),
                             np.zeros(1, np.bool_), one_f, one_f, one_f, one_f, perez, one_f, one_f,
-                            one_f, np.zeros((1, n_sky), f32), (tables,) * 4, o3, rotate, 1, to_bins,
+                            one_f, np.zeros((1, n_sky), np.int64), np.zeros((1, n_sky), f32),
+                            np.zeros((1, n_sky), f32), np.zeros(1, np.bool_), tables, tables,
+                            np.zeros((1, 2), f32), tables, tables, np.zeros((1, 2), f32), o3,
+                            rotate, 1, to_bins,
                             np.zeros((12, 1), f32), np.zeros(1, bool), one_t, one_i, one_i,
                             np.zeros((1, 12)), np.zeros((1, 12)))
     _groups(one_i, one_i, one_i, one_t, one_t, 0, one_i, 0, one_t, one_i, one_i, one_i, one_i)

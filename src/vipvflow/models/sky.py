@@ -203,7 +203,8 @@ SECTOR_COS = np.cos(np.radians((np.arange(SKY_AZIMUTH_BINS) + 0.5) * 360.0 / SKY
 
 def sky_table(dhi_wm2, dni_wm2, dni_extra_wm2, sun_xyz) -> tuple[np.ndarray, np.ndarray]:
     """The light of the sky above each elevation level in each azimuth sector, as shares
-    of the diffuse horizontal irradiance, per time: two (n, 36, 9) float32 tables.
+    of the diffuse horizontal irradiance, per time: two (n, 36, 10) float32 tables (levels
+    0, 10, .. 90 deg; at 90 deg 0).
 
     ``G[i, k, j]`` = the Perez (1993) sky's light on a horizontal plane from sector ``k``
     above elevation ``10 j`` deg, over its light from the whole sky (``G[i, :, 0].sum()``
@@ -249,8 +250,8 @@ def sky_table(dhi_wm2, dni_wm2, dni_extra_wm2, sun_xyz) -> tuple[np.ndarray, np.
     grad_den = np.maximum(np.sin(EL).reshape(-1), 0.01)
     w_v = (w * np.sin(EL)).reshape(-1)                # horizontal plane: cos of incidence
     w_h = (w * np.cos(EL)).reshape(-1)                # the horizontal part, for tilt
-    out_g = np.empty((n, SKY_AZIMUTH_BINS, SKY_LEVELS), np.float32)
-    out_h = np.empty((n, SKY_AZIMUTH_BINS, SKY_LEVELS), np.float32)
+    out_g = np.zeros((n, SKY_AZIMUTH_BINS, SKY_LEVELS + 1), np.float32)
+    out_h = np.zeros((n, SKY_AZIMUTH_BINS, SKY_LEVELS + 1), np.float32)
     shape = (SKY_LEVELS, _SUB, SKY_AZIMUTH_BINS, _SUB)
     for lo in range(0, n, 2048):
         hi = min(n, lo + 2048)
@@ -267,7 +268,7 @@ def sky_table(dhi_wm2, dni_wm2, dni_extra_wm2, sun_xyz) -> tuple[np.ndarray, np.
             if out is out_g:
                 total = cum[:, 0].sum(1)
                 norm = np.where(total > 0, total, 1.0)[:, None, None]
-            out[lo:hi] = (cum / norm).transpose(0, 2, 1)
+            out[lo:hi, :, :SKY_LEVELS] = (cum / norm).transpose(0, 2, 1)
     return out_g, out_h
 
 
@@ -291,16 +292,31 @@ def _interp(table, levels):
     r = np.arange(n)[:, None]
     k = np.arange(SKY_AZIMUTH_BINS)[None, :]
     lo = table[r, k, i]
-    hi = np.where(i + 1 < SKY_LEVELS, table[r, k, np.minimum(i + 1, SKY_LEVELS - 1)], np.float32(0))
-    return lo + f * (hi - lo)
+    return lo + f * (table[r, k, i + 1] - lo)
 
 
 def sky_share(table_g, table_h, levels, normal) -> np.ndarray:
     """The share of DHI a roof point receives from the sky above its horizon, for rows of
-    the two sky tables (:func:`sky_table`, (n, 36, 9)), its *levels* (n, 36)
+    the two sky tables (:func:`sky_table`, (n, 36, 10)), its *levels* (n, 36)
     (:func:`sky_levels`) and its unit *normal* (n, 3): float32 (n,), 1 for a level roof in
     the open.  Beyond the last level the sky above 90 deg is none."""
     nrm = np.asarray(normal, np.float32)
     tilt = (nrm[:, 0:1] * SECTOR_SIN.astype(np.float32) + nrm[:, 1:2] * SECTOR_COS.astype(np.float32))
     v = nrm[:, 2:3] * _interp(table_g, levels) + tilt * _interp(table_h, levels)
     return v.sum(1, dtype=np.float32)
+
+
+def open_terms(table_h) -> np.ndarray:
+    """Per row of a tilt table (:func:`sky_table`'s ``H``, (n, 36, 10)): ``sum_k sin a_k
+    H[k, 0]`` and ``sum_k cos a_k H[k, 0]``, (n, 2) float32: an open roof of unit normal
+    ``n`` receives the share ``n_z + n_x A + n_y B`` (:func:`open_share`)."""
+    h0 = np.asarray(table_h, np.float64)[:, :, 0]
+    return np.stack([h0 @ SECTOR_SIN, h0 @ SECTOR_COS], 1).astype(np.float32)
+
+
+def open_share(terms, normal) -> np.ndarray:
+    """The share of DHI an open roof of unit *normal* (n, 3) receives, from rows of
+    :func:`open_terms` (n, 2): float32 (n,)."""
+    nrm = np.asarray(normal, np.float32)
+    t = np.asarray(terms, np.float32)
+    return nrm[:, 2] + (nrm[:, 0] * t[:, 0] + nrm[:, 1] * t[:, 1])

@@ -17,7 +17,7 @@ import pandas as pd
 from ..errors import InputError
 from ..inputs.cams import _GRID_S, COLUMNS, ingest_cams
 from ..store import DataDir, RadiationDir, write_npz
-from .sky import SKY_STEP_S, perez_table, sky_table
+from .sky import SKY_STEP_S, open_terms, perez_table, sky_table
 
 log = logging.getLogger(__name__)
 
@@ -94,10 +94,11 @@ def _sky_tables(grid_t0: float, n_steps: int, table: "RadiationTable", k: int) -
     out = {"rows": rows}
     for sfx, name in (("", "all"), ("_clear", "clear")):
         out[name], out[name + "_h"] = sky_table(v["dhi" + sfx][day], v["dni" + sfx][day], e0, sun[day])
+        out[name + "_open"] = open_terms(out[name + "_h"])
     return out
 
 
-_SKY_KEYS = ("rows", "all", "all_h", "clear", "clear_h")
+_SKY_KEYS = ("rows", "all", "all_h", "all_open", "clear", "clear_h", "clear_open")
 
 
 # --------------------------------------------------------------------------- lookup
@@ -279,10 +280,12 @@ class RadiationTable:
     def sky(self) -> dict:
         """The Perez (1993) sky's visible-share tables of every location, every
         :data:`vipvflow.models.sky.SKY_STEP_S` from the grid's start (``diffuse_model:
-        perez_svf``): ``t0``, ``step``, ``rows`` (K, n_steps) int32 into ``all``, ``all_h``,
-        ``clear`` and ``clear_h`` (rows, 36, 9) float32 (-1 at night; the ``_h`` tables the
-        tilt term, :func:`vipvflow.models.sky.sky_table`).  Computed once per table (a few seconds for a
-        year) and kept beside the radiation file where it came from one (:meth:`load`)."""
+        perez_svf``): ``t0``, ``step``, ``rows`` (K, n_steps) int32 (-1 at night) into
+        ``all``, ``all_h``, ``clear`` and ``clear_h`` (rows, 36, 10) float32 (the ``_h``
+        tables the tilt term, :func:`vipvflow.models.sky.sky_table`) and ``all_open``,
+        ``clear_open`` (rows, 2) (:func:`vipvflow.models.sky.open_terms`).  Computed once per
+        table (a few seconds for a year) and kept beside the radiation file where it came
+        from one (:meth:`load`)."""
         cache = self.__dict__.get("_sky")
         if cache is not None:
             return cache
@@ -291,7 +294,7 @@ class RadiationTable:
         key = None
         if path is not None:
             st = Path(path).stat()
-            key = json.dumps(["sky-2", st.st_size, st.st_mtime_ns, self.t0, self.n, SKY_STEP_S,
+            key = json.dumps(["sky-4", st.st_size, st.st_mtime_ns, self.t0, self.n, SKY_STEP_S,
                               np.round(self.lat, 8).tolist(), np.round(self.lon, 8).tolist()])
             file = RadiationDir(Path(path).parent).root / f"sky_{int(self.t0)}_{self.n}.npz"
             try:
@@ -319,30 +322,29 @@ class RadiationTable:
         """The share of DHI a roof point receives from the Perez (1993) sky it sees, and
         the same in the open: two float32 (n,) arrays, at times *t_utc* (Unix s), for
         horizons *levels* (n, 36) (:func:`vipvflow.models.sky.sky_levels`) and roof unit
-        *normal* (n, 3), from the tables of :meth:`sky` interpolated linearly in time;
-        all-sky or *clear*-sky.  Where no table row is near (night) both are 0."""
+        *normal* (n, 3), from the table row of :meth:`sky` nearest in time (the sun moves
+        at most 1.9 deg from it); all-sky or *clear*-sky.  At night both are 0."""
         sky = self.sky()
-        f = np.clip((np.asarray(t_utc, np.float64) - sky["t0"]) / sky["step"], 0, sky["rows"].shape[1] - 1.000001)
-        j = f.astype(np.int64)
-        w = (f - j).astype(np.float32)
-        loc = np.zeros(len(f), np.int64) if location is None else np.broadcast_to(np.asarray(location, np.int64), f.shape)
-        r0, r1 = sky["rows"][loc, j], sky["rows"][loc, j + 1]
-        r0, r1 = np.where(r0 < 0, r1, r0), np.where(r1 < 0, r0, r1)
+        rows = sky["rows"]
+        j = self.sky_steps(t_utc)
+        loc = np.zeros(len(j), np.int64) if location is None else np.broadcast_to(np.asarray(location, np.int64), j.shape)
+        r = rows[loc, j]
         name = "clear" if clear else "all"
-        tg, th = sky[name], sky[name + "_h"]
-        from .sky import SKY_AZIMUTH_BINS, sky_share as share
+        from .sky import open_share, sky_share as share
 
-        out, open_ = np.zeros(len(f), np.float32), np.zeros(len(f), np.float32)
-        ok = r0 >= 0
+        out, open_ = np.zeros(len(j), np.float32), np.zeros(len(j), np.float32)
+        ok = r >= 0
         if ok.any():
-            lv = np.asarray(levels, np.float32)[ok]
             nrm = np.asarray(normal, np.float32)[ok]
-            zero = np.zeros((len(lv), SKY_AZIMUTH_BINS), np.float32)
-            a, b = r0[ok], r1[ok]
-            for res, x in ((out, lv), (open_, zero)):
-                s0, s1 = share(tg[a], th[a], x, nrm), share(tg[b], th[b], x, nrm)
-                res[ok] = s0 + w[ok] * (s1 - s0)
+            out[ok] = share(sky[name][r[ok]], sky[name + "_h"][r[ok]], np.asarray(levels, np.float32)[ok], nrm)
+            open_[ok] = open_share(sky[name + "_open"][r[ok]], nrm)
         return out, open_
+
+    def sky_steps(self, t_utc) -> np.ndarray:
+        """The sky tables' step nearest each time (int64, within the tables)."""
+        sky = self.sky()
+        f = (np.asarray(t_utc, np.float64) - sky["t0"]) / sky["step"]
+        return np.clip(np.floor(f + 0.5), 0, sky["rows"].shape[1] - 1).astype(np.int64)
 
     def nearest_location(self, lat, lon) -> np.ndarray:
         """Index of the nearest table location for each point (degrees; great-circle)."""

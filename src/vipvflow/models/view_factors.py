@@ -14,6 +14,7 @@ import pandas as pd
 
 from .params import IrradianceCfg
 from .mesh import SURFACE_CODE
+from .sky import SKY_AZIMUTH_BINS as _SKY_SECTORS
 
 _GOLDEN = (np.sqrt(5.0) - 1.0) / 2.0
 
@@ -528,7 +529,7 @@ def segment_geometry(scene, segments: pd.DataFrame, cfg: IrradianceCfg | None = 
 
 
 #: the geometry table's columns of the roof point's horizon per sky sector (perez_svf)
-SKY_COLUMNS = [f"sky_x{k:02d}" for k in range(36)]
+SKY_COLUMNS = [f"sky_x{k:02d}" for k in range(_SKY_SECTORS)]
 
 
 def _no_reflectors(origin, G: int, P: int) -> dict:
@@ -975,8 +976,7 @@ def pack_geometry(geometry: pd.DataFrame, cfg: IrradianceCfg, ground_albedo: flo
            "n": np.ascontiguousarray(geometry[["nx", "ny", "nz"]].to_numpy(f32)),
            "svf": geometry["svf"].to_numpy(f32),
            "hbv": (geometry["hbv"].to_numpy(f32) if "hbv" in cols else np.zeros(s, f32)),
-           "sky_x": (np.ascontiguousarray(geometry[SKY_COLUMNS].to_numpy(f32))
-                     if set(SKY_COLUMNS) <= cols else np.zeros((s, 0), f32)),
+           **_sky_terms(geometry, cols),
            "refl_sky": (m * src_sky).sum(1).astype(f32), "refl_ghi": (m * src_ghi).sum(1).astype(f32),
            "refl_hor": (m * f_h).sum(1).astype(f32),
            "wn": ((m * beam_len)[..., None] * nrm).astype(f32), "group_p": pts.reshape(s * J, -1, 3)}
@@ -985,6 +985,28 @@ def pack_geometry(geometry: pd.DataFrame, cfg: IrradianceCfg, ground_albedo: flo
         geo["p_local"] = scene.to_local(geo["p"])
         geo["group_p_local"] = scene.to_local(geo["group_p"])
     return geo
+
+
+def _sky_terms(geometry: pd.DataFrame, cols: set) -> dict:
+    """The roof points' horizon levels per sky sector (``sky_x``, (s, 36) float32, (s, 0)
+    without them) and, for the compiled kernel, each sector's cell in a table row
+    (``sky_cell``: ``10 k + level``, int64), its interpolation weight (``sky_f``) and the
+    roof's tilt weight ``n_x sin a_k + n_y cos a_k`` (``sky_t``; ``sky_tilted`` where any)."""
+    from .sky import SECTOR_COS, SECTOR_SIN, SKY_LEVELS
+
+    f32 = np.float32
+    s = len(geometry)
+    if not set(SKY_COLUMNS) <= cols:
+        z = np.zeros((s, 0), f32)
+        return {"sky_x": z, "sky_cell": np.zeros((s, 0), np.int64), "sky_f": z, "sky_t": z,
+                "sky_tilted": np.zeros(s, bool)}
+    x = np.ascontiguousarray(geometry[SKY_COLUMNS].to_numpy(f32))
+    i = x.astype(np.int64)
+    n = geometry[["nx", "ny"]].to_numpy(f32)
+    t = (n[:, 0:1] * SECTOR_SIN.astype(f32) + n[:, 1:2] * SECTOR_COS.astype(f32)).astype(f32)
+    return {"sky_x": x, "sky_cell": np.arange(len(SKY_COLUMNS))[None, :] * (SKY_LEVELS + 1) + i,
+            "sky_f": (x - i.astype(f32)).astype(f32), "sky_t": t,
+            "sky_tilted": np.abs(n).max(1) > 0}
 
 
 def isotropic_sky_view(normal_z):
