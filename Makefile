@@ -11,17 +11,25 @@ RUN    ?= out/demo/$(YEAR)
 DB_DIR ?= data/pg
 # Debian packages of the database and browser tests (make system-deps)
 SYSTEM_PACKAGES := postgresql-15 postgresql-15-postgis-3 chromium
+# Citus for `make db CITUS_WORKERS=N` and the Citus tests (make citus): the installed one, else
+# built from CITUS_SOURCE (a citus-*.tar.gz or a folder of them; by default ../shared/vendor/citus
+# when it is beside the clone) with these Debian packages, as root
+CITUS_SOURCE ?= $(wildcard ../shared/vendor/citus)
+CITUS_BUILD_PACKAGES := postgresql-server-dev-15 liblz4-dev libzstd-dev libkrb5-dev libssl-dev \
+	libselinux1-dev libxslt1-dev libpam0g-dev libreadline-dev
+CITUS_WORKERS ?=
 
-.PHONY: setup system-deps simulate test bench data app db db-stop clean help
+.PHONY: setup system-deps citus simulate test bench data app db db-stop clean help
 help:
 	@echo "make setup                    system-deps, then $(VENV) with vipvflow[test,db,app]"
 	@echo "make system-deps              apt-get install $(SYSTEM_PACKAGES) (Debian, root or sudo)"
+	@echo "make citus [CITUS_SOURCE=citus-13.x.tar.gz]  the installed Citus, else build and install it (root)"
 	@echo "make simulate YEAR=2024 [CONF=demo|luxembourg|my.yaml] [SCHEDULER=tcp://host:8786] [WORKERS=N] [QUIET=1]"
 	@echo "make test                     run the test suite"
 	@echo "make bench                    run benchmarks/, write benchmarks/results/*.json"
 	@echo "make data                     fetch the real datasets of data_manifest.yaml (needs a network)"
 	@echo "make app [RUN=out/demo/2024]  start the web app on a finished run"
-	@echo "make db / make db-stop        start / stop a local PostgreSQL+PostGIS for mirroring"
+	@echo "make db [CITUS_WORKERS=N] / make db-stop   start / stop a local PostgreSQL+PostGIS (or Citus cluster) for mirroring"
 
 setup: $(VENV)/.installed
 
@@ -37,11 +45,18 @@ $(VENV)/.installed: pyproject.toml
 system-deps:
 	@sh .ci/system-deps $(SYSTEM_PACKAGES)
 
+# Never part of setup: a build (about a minute on 2 cores, then cached) runs on `make citus` and
+# `make test` only, not on `make simulate`. Without Citus and without a source it says in one
+# line how to get it, and the Citus tests skip naming it.
+citus: setup
+	@$(if $(CITUS_SOURCE),$(BIN)/vipvflow db citus >/dev/null 2>&1 || sh .ci/system-deps $(CITUS_BUILD_PACKAGES);) \
+	$(BIN)/vipvflow db citus $(if $(CITUS_SOURCE),--source $(CITUS_SOURCE)) || true
+
 simulate: setup
 	$(BIN)/vipvflow simulate --config $(CONF) --year $(YEAR) \
 		$(if $(SCHEDULER),--scheduler $(SCHEDULER)) $(if $(WORKERS),--workers $(WORKERS)) $(if $(QUIET),--quiet)
 
-test: setup
+test: setup citus
 	$(BIN)/python -m pytest $(PYTEST_ARGS)
 
 bench: setup
@@ -54,7 +69,7 @@ app: setup
 	$(BIN)/vipvflow app $(RUN)
 
 db: setup
-	$(BIN)/vipvflow db start --dir $(DB_DIR)
+	$(BIN)/vipvflow db start --dir $(DB_DIR) $(if $(CITUS_WORKERS),--citus-workers $(CITUS_WORKERS))
 
 db-stop: setup
 	$(BIN)/vipvflow db stop --dir $(DB_DIR)

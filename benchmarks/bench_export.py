@@ -54,31 +54,10 @@ def _export(run_dir: Path, out: Path, **kw) -> dict:
     return json.loads(res.stdout.strip().splitlines()[-1])
 
 
-def _finished(run_dir: Path) -> bool:
-    return all((run_dir / f).exists() for f in ("manifest.json", "segment_month.parquet", "segments.parquet"))
-
-
-def _demo_run(tiny: bool) -> tuple[Path, str]:
-    from .common import demo_config, fresh_dir, prepare_demo, run_pipeline
-
-    env = os.environ.get("VIPVFLOW_BENCH_EXPORT_RUN")
-    if env and not tiny:
-        return Path(env), "VIPVFLOW_BENCH_EXPORT_RUN"
-    local = ROOT / "out" / "demo" / "2024"
-    if not tiny and _finished(local):
-        return local, "out/demo/2024"
-    size = "small" if tiny else "full"
-    prepare_demo(size)
-    # a fresh output folder (deleted after the export): never a run of an older configuration
-    cfg = demo_config(size, months=[6] if tiny else None, scenario=f"bench-export-{size}",
-                      out_dir=fresh_dir(f"export-{size}"))
-    return run_pipeline(cfg)["run_dir"], f"fresh {size} demo run"
-
-
 def run(tiny: bool = False) -> dict:
-    from .common import remove
+    from .common import demo_run, remove
 
-    run_dir, source = _demo_run(tiny)
+    run_dir, source = demo_run(tiny, "VIPVFLOW_BENCH_EXPORT_RUN", "export")
     try:
         return _measure(run_dir, source)
     finally:

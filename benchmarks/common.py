@@ -5,7 +5,8 @@
 - :func:`prepare_demo`: the demo scenario generated and ingested once into
   ``benchmarks/work/demo-<size>/`` (gitignored), timed the first time and cached after;
 - :func:`demo_config` / :func:`run_pipeline`: a configuration for a part of the demo and one
-  timed :func:`vipvflow.simulation.run.run_simulation` of it from a fresh output folder.
+  timed :func:`vipvflow.simulation.run.run_simulation` of it from a fresh output folder;
+- :func:`demo_run`: a finished demo run to read (the repository's, or a fresh one).
 """
 from __future__ import annotations
 
@@ -131,6 +132,30 @@ def prepare_demo(size: str = "full", year: int = YEAR) -> dict:
     info = json.loads(stamp.read_text())
     info["cached"] = cached
     return info
+
+
+def _finished(run_dir: Path) -> bool:
+    return all((run_dir / f).exists() for f in ("manifest.json", "segment_month.parquet", "segments.parquet"))
+
+
+def demo_run(tiny: bool, env: str, name: str) -> tuple[Path, str]:
+    """A finished demo run for a benchmark that reads one, and where it came from: ``$<env>``;
+    the repository's ``out/demo/2024`` when a demo run is there (``vipvflow simulate
+    --config demo --year 2024``); else a fresh run of the full demo for the year made here
+    (~3 min; the caller deletes it when the source starts with "fresh"). *tiny*: a fresh run
+    of the small demo, June."""
+    given = os.environ.get(env)
+    if given and not tiny:
+        return Path(given), env
+    local = HERE.parent / "out" / "demo" / "2024"
+    if not tiny and _finished(local):
+        return local, "out/demo/2024"
+    size = "small" if tiny else "full"
+    prepare_demo(size)
+    # a fresh output folder (deleted after use): never a run of an older configuration
+    cfg = demo_config(size, months=[6] if tiny else None, scenario=f"bench-{name}-{size}",
+                      out_dir=fresh_dir(f"{name}-{size}"))
+    return run_pipeline(cfg)["run_dir"], f"fresh {size} demo run"
 
 
 def fresh_dir(name: str) -> Path:

@@ -280,7 +280,7 @@ def test_app_in_browser(chromium, app_url, trip_model, tmp_path):
             # the run's three fleet yields in the header, as summary.json has them
             sm = json.loads((Path(trip_model.run_dir) / "summary.json").read_text())
             yields = page.locator(".run-yields").inner_text()
-            for label, key in (("driving", "kwh_per_kwp_allsky"), ("in service", "kwh_per_kwp_in_service"),
+            for label, key in (("driving", "kwh_per_kwp_driving"), ("in service", "kwh_per_kwp_in_service"),
                                ("whole day", "kwh_per_kwp_whole_day")):
                 assert f"{label} {sm[key]:,.0f}" in yields, yields
             exp = _expected(trip_model, first)

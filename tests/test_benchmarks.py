@@ -28,7 +28,7 @@ def _postgres_available() -> bool:
 @pytest.fixture(scope="module")
 def tiny_results(tmp_path_factory):
     results = tmp_path_factory.mktemp("bench-results")
-    names = [n for n in NAMES if n != "postgis" or _postgres_available()]
+    names = [n for n in NAMES if n not in ("postgis", "mirror") or _postgres_available()]
     proc = subprocess.run([sys.executable, "-m", "benchmarks", *names, "--tiny", "--results", str(results)],
                           cwd=ROOT, capture_output=True, text=True, timeout=1800,
                           env={**os.environ, "PYTHONPATH": str(ROOT)})
@@ -56,6 +56,11 @@ def test_facts_in_the_tiny_results(tiny_results):
     assert len(scaling["machine_speedup_2_processes_probes"]) == 2
     assert len(scaling["machine_speedup_2_processes_numpy_probes"]) == 2
     assert scaling["machine_speedup_2_processes"] > 0
+    if "mirror" in names:  # the same rows in both servers; Citus's shards on both workers
+        mirror = json.loads((results / "mirror.tiny.json").read_text())
+        assert mirror["figures"]["rows"] == sum(mirror["rows_per_table"].values()) > 0
+        for table, per_worker in (mirror["citus_placement"] or {}).items():
+            assert set(per_worker) == {"worker1", "worker2"}, table
     line = json.loads((results / "line_year.tiny.json").read_text())["figures"]
     assert line["passes"] > 0 and line["partitions"] > 0
     if "postgis" in names:

@@ -20,6 +20,9 @@ import yaml
 
 from gtfs_probe_feeds import vbb_like_tables, write_feed
 
+#: the ground height (m) of feeds ingested without a city model or radiation file
+GROUND_M = 0.0
+
 HERE = Path(__file__).resolve().parent
 # CAMS McClear, 1 min, 60 rows (12:00-13:00 UTC of a declared day): TOA, then the clear-sky
 # GHI, BHI, DHI, BNI columns
@@ -135,7 +138,11 @@ GTFS_PROBES = {
 def test_gtfs_probe(name, tmp_path):
     tables, args, error, repair = GTFS_PROBES[name]
     feed = write_feed(tmp_path / "feed.zip", tables())
-    res = vipvflow("ingest", "gtfs", feed, "--data-dir", tmp_path / "data", *args)
+    # every route type of the probe feed (bus 3 and 700, tram 900) is kept
+    conf = tmp_path / "all_types.yaml"
+    conf.write_text("run:\n  route_types: all\n")
+    res = vipvflow("ingest", "gtfs", "--ground-elevation", str(GROUND_M), feed, "--data-dir",
+                   tmp_path / "data", "--config", conf, *args)
     if error is not None:
         one_line_error(res, *error)
         assert not (tmp_path / "data" / "gtfs" / "feed.json").exists()
@@ -154,10 +161,15 @@ def test_shapeless_vbb_like_feed_segments(tmp_path):
     from vipvflow.inputs.gtfs import ingest_gtfs
 
     feed = write_feed(tmp_path / "vbb.zip", vbb_like_tables())
-    report = ingest_gtfs(feed, tmp_path / "data", TrajectoryCfg())
+    report = ingest_gtfs(feed, tmp_path / "data", TrajectoryCfg(ground_elevation_m=GROUND_M),
+                         route_types="all")
     c = report["counts"]
     assert c["shapes_built_from_stops"] == 2 and c["trips"] == 4
     assert c["route_types"] == {"3": 2, "700": 1, "900": 1}
+    # buses by default: the tram (900) is dropped and counted
+    bus = ingest_gtfs(feed, tmp_path / "bus", TrajectoryCfg(ground_elevation_m=GROUND_M))
+    assert bus["counts"]["route_types"] == {"3": 2, "700": 1}
+    assert "1 trips of route types [900] outside run.route_types (bus); dropped" in bus["problems"]
     lats, lons = [s[1] for s in STOPS], [s[2] for s in STOPS]
     geodesic = Geod(ellps="WGS84").line_length(lons, lats)
     seg = pd.read_parquet(tmp_path / "data" / "gtfs" / "segments.parquet")
@@ -172,13 +184,13 @@ def test_route_types_choose(tmp_path):
     feed = write_feed(tmp_path / "vbb.zip", vbb_like_tables())
     conf = tmp_path / "c.yaml"
     conf.write_text(yaml.safe_dump({"run": {"route_types": [3, 700]}}))
-    res = vipvflow("ingest", "gtfs", feed, "--data-dir", tmp_path / "data", "--config", conf)
-    repaired(res, "1 trips of route types outside run.route_types [3, 700]; dropped", "trips 3")
+    res = vipvflow("ingest", "gtfs", "--ground-elevation", str(GROUND_M), feed, "--data-dir", tmp_path / "data", "--config", conf)
+    repaired(res, "1 trips of route types [900] outside run.route_types ([3, 700]); dropped", "trips 3")
     conf.write_text(yaml.safe_dump({"run": {"route_types": [4]}}))
-    one_line_error(vipvflow("ingest", "gtfs", feed, "--data-dir", tmp_path / "d2", "--config", conf),
-                   "no trip has a route_type in run.route_types [4]; the feed has [3, 700, 900]")
+    one_line_error(vipvflow("ingest", "gtfs", "--ground-elevation", str(GROUND_M), feed, "--data-dir", tmp_path / "d2", "--config", conf),
+                   "no trip has a route_type in run.route_types ([4]); the feed has [3, 700, 900]")
     conf.write_text(yaml.safe_dump({"run": {"route_types": [99]}}))
-    one_line_error(vipvflow("ingest", "gtfs", feed, "--data-dir", tmp_path / "d2", "--config", conf),
+    one_line_error(vipvflow("ingest", "gtfs", "--ground-elevation", str(GROUND_M), feed, "--data-dir", tmp_path / "d2", "--config", conf),
                    "key 'run.route_types'", "not GTFS route types", "[99]")
 
 
@@ -191,7 +203,7 @@ def test_frequencies_exact_times(tmp_path):
     t = vbb_like_tables()
     t["frequencies.txt"] = ("trip_id,start_time,end_time,headway_secs,exact_times\n"
                             "T1,08:00:00,09:00:00,600,1\nT3,10:00:00,11:00:00,1200,0\n")
-    report = ingest_gtfs(write_feed(tmp_path / "f.zip", t), tmp_path / "data", TrajectoryCfg())
+    report = ingest_gtfs(write_feed(tmp_path / "f.zip", t), tmp_path / "data", TrajectoryCfg(ground_elevation_m=GROUND_M))
     trips = pd.read_parquet(tmp_path / "data" / "gtfs" / "trips.parquet")
     r100 = trips[trips["route_id"] == "R100"]["start_s"].sort_values().to_numpy()
     # T1 expanded to 6 runs, T2 (first departure 09:00:30) kept
@@ -206,10 +218,10 @@ def test_corrupt_and_truncated_zip(tmp_path):
     data = good.read_bytes()
     cut = tmp_path / "truncated.zip"
     cut.write_bytes(data[: len(data) // 2])
-    one_line_error(vipvflow("ingest", "gtfs", cut, "--data-dir", tmp_path / "d"), str(cut))
+    one_line_error(vipvflow("ingest", "gtfs", "--ground-elevation", str(GROUND_M), cut, "--data-dir", tmp_path / "d"), str(cut))
     noise = tmp_path / "noise.zip"
     noise.write_bytes(b"PK\x03\x04" + bytes(range(256)) * 40)
-    one_line_error(vipvflow("ingest", "gtfs", noise, "--data-dir", tmp_path / "d"), str(noise))
+    one_line_error(vipvflow("ingest", "gtfs", "--ground-elevation", str(GROUND_M), noise, "--data-dir", tmp_path / "d"), str(noise))
     # a member whose compressed bytes are damaged (CRC / inflate error)
     bad = bytearray(data)
     with zipfile.ZipFile(good) as zf:
@@ -218,7 +230,7 @@ def test_corrupt_and_truncated_zip(tmp_path):
     bad[start:start + 40] = b"\xff" * 40
     broken = tmp_path / "broken.zip"
     broken.write_bytes(bytes(bad))
-    one_line_error(vipvflow("ingest", "gtfs", broken, "--data-dir", tmp_path / "d"), str(broken))
+    one_line_error(vipvflow("ingest", "gtfs", "--ground-elevation", str(GROUND_M), broken, "--data-dir", tmp_path / "d"), str(broken))
 
 
 def test_200_mb_stop_times_line(tmp_path):
@@ -236,7 +248,7 @@ def test_200_mb_stop_times_line(tmp_path):
                 fh.write(block)
             fh.write(b"\n")
     before = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
-    res = vipvflow("ingest", "gtfs", feed, "--data-dir", tmp_path / "d")
+    res = vipvflow("ingest", "gtfs", "--ground-elevation", str(GROUND_M), feed, "--data-dir", tmp_path / "d")
     one_line_error(res, "stop_times.txt line 18 is longer than 1024 kB")
     peak_kib = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
     if peak_kib > before:            # this child set the maximum: it stayed well below 1 GB
@@ -385,16 +397,17 @@ def test_unknown_routes_and_city_elsewhere_stop(ingested, tmp_path):
     res = vipvflow("simulate", "--config", path, "--year", "2024")
     one_line_error(res, "run.routes", "R-does-not-exist")
     _no_cluster(res)
-    # a city model whose tiles lie elsewhere (the tiles renamed far away)
+    # a city model elsewhere: no segment in the area it covers (the real case, a feed and a
+    # city model of different places, is test_real_city_e2e.test_lines_that_miss_the_city_model)
     conf = yaml.safe_load(path.read_text())
     conf["run"].pop("routes")
     path.write_text(yaml.safe_dump(conf))
-    tiles = tmp_path / "data" / "city" / "tiles.json"
-    meta = json.loads(tiles.read_text())
-    meta["tiles"] = {f"E9{i:03d}N9999": v for i, v in enumerate(meta["tiles"].values())}
-    tiles.write_text(json.dumps(meta))
+    segs = tmp_path / "data" / "gtfs" / "segments.parquet"
+    import geopandas as gpd
+
+    gpd.read_parquet(segs).assign(in_city_model=False).to_parquet(segs)
     res = vipvflow("simulate", "--config", path, "--year", "2024")
-    one_line_error(res, "covers none of the routes")
+    one_line_error(res, "the routes miss the city model", "route-km")
     _no_cluster(res)
 
 
@@ -435,13 +448,13 @@ def test_totals_zero_or_undefined_stop(tmp_path):
     from vipvflow.errors import InputError
     from vipvflow.simulation.reduce import _check_totals
 
-    ok = {"passes": 10, "pv_kwh_allsky": 5.0, "fleet_demand_mwh": 1.0, "coverage": 0.1,
+    ok = {"passes": 10, "pv_kwh_driving": 5.0, "fleet_demand_in_service_mwh": 1.0, "coverage": 0.1,
           "irradiation_kwh_m2": {"total_unshaded": 3.0}}
     _check_totals(ok, tmp_path)
-    with pytest.raises(InputError, match="pv_kwh_allsky is 0.0: no PV energy over 10 passes"):
-        _check_totals({**ok, "pv_kwh_allsky": 0.0}, tmp_path)
-    with pytest.raises(InputError, match="pv_kwh_allsky is nan"):
-        _check_totals({**ok, "pv_kwh_allsky": float("nan")}, tmp_path)
+    with pytest.raises(InputError, match="pv_kwh_driving is 0.0: no PV energy over 10 passes"):
+        _check_totals({**ok, "pv_kwh_driving": 0.0}, tmp_path)
+    with pytest.raises(InputError, match="pv_kwh_driving is nan"):
+        _check_totals({**ok, "pv_kwh_driving": float("nan")}, tmp_path)
     with pytest.raises(InputError, match=r"undefined figures in the summary: coverage, "
                                          r"irradiation_kwh_m2.total_unshaded"):
         _check_totals({**ok, "coverage": float("inf"),

@@ -91,7 +91,7 @@ def test_segments_hold_public_factors_and_their_year(small_run):
     # the fleet's specific yield is the segments' yearly yield weighted by the time spent on them
     # (the summary sums the trips' kWh, stored per partition in float32: 1e-7 relative)
     assert np.average(seg["kwh_per_kwp_year"], weights=seg["seconds"]) == pytest.approx(
-        summary["kwh_per_kwp_allsky"], rel=1e-7)
+        summary["kwh_per_kwp_driving"], rel=1e-7)
     assert summary["segments"] == len(seg)
 
 

@@ -113,7 +113,7 @@ def osaka_run(shared_data, tmp_path_factory):
         "inputs": {"citygml": [str(shared_data.joinpath(*PLATEAU))], "gtfs": str(root / "maishima_gtfs.zip"),
                    "cams": [str(root / "cams_maishima_dec.csv")]},
         # ground heights of PLATEAU are metres above Tokyo Bay mean sea level (0-13 m here)
-        "trajectory": {"default_elevation_m": 2.0},
+        "trajectory": {"ground_elevation_m": 2.0},
         "irradiance": {"diffuse_model": "isotropic", "reflection_rays": 16, "svf_rays": 32},
         "run": {"months": [MONTH]},
         "dask": {"n_workers": 1, "threads_per_worker": 1},

@@ -95,8 +95,9 @@ def test_get_scene_builds_once_per_tile(tmp_path):
     get_scene(tmp_path, "E0775N0750", cache_size=1)       # evicts the first
     get_scene(tmp_path, "E0770N0750", cache_size=1)
     assert shading.BVH_BUILDS[key] == before + 2
-    with pytest.raises(FileNotFoundError):
-        get_scene(tmp_path, "E0000N0000")
+    # a tile without a mesh (no building within the buffer: tiles.json does not list it) is
+    # an open field (test_study_area.test_a_tile_without_a_mesh_is_open_sky)
+    assert get_scene(tmp_path, "E0000N0000").n_triangles == 0
 
 
 def test_benchmark_tiny_writes_figures():

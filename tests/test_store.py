@@ -25,7 +25,7 @@ def _named_by_store(data_dir, run_dir) -> set:
     tiles = set(json.loads(data.city.tiles_json.read_text())["tiles"])
     tiles |= set(pd.read_parquet(data.gtfs.segments, columns=["tile"])["tile"].astype(str))
     city, gtfs, rad = data.city, data.gtfs, data.radiation
-    names = {city.tiles_json, city.report, city.stamp, city.terrain, gtfs.feed_json, gtfs.stamp,
+    names = {city.tiles_json, city.report, city.stamp, city.terrain, city.coverage, gtfs.feed_json, gtfs.stamp,
              rad.table, rad.report, rad.stamp, run.manifest, run.config_stamp, run.report,
              run.output("summary.json")}
     names |= {city.mesh(t) for t in tiles} | {city.surface_part(t) for t in tiles}

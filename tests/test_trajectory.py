@@ -18,6 +18,9 @@ from vipvflow.models.driving_cycle import driving_cycle, pattern_cycle
 from vipvflow.inputs.gtfs import ingest_gtfs, iter_passes, passes_for_trip, service_dates
 from vipvflow.inputs.gtfs.segments import build_segments
 
+#: the ground height (m) of feeds ingested without a city model or radiation file
+GROUND_M = 0.0
+
 HERE = Path(__file__).resolve().parent
 ISRAEL = HERE / "data" / "gtfs" / "israel_route_2126"
 LUX = HERE / "data" / "gtfs" / "lux_night"
@@ -33,13 +36,13 @@ def utc(*args) -> float:
 @pytest.fixture(scope="module")
 def israel(tmp_path_factory):
     d = tmp_path_factory.mktemp("israel")
-    return d, ingest_gtfs(ISRAEL, d, TrajectoryCfg())
+    return d, ingest_gtfs(ISRAEL, d, TrajectoryCfg(ground_elevation_m=GROUND_M))
 
 
 @pytest.fixture(scope="module")
 def lux(tmp_path_factory):
     d = tmp_path_factory.mktemp("lux")
-    return d, ingest_gtfs(LUX, d, TrajectoryCfg(), crs="EPSG:2169")
+    return d, ingest_gtfs(LUX, d, TrajectoryCfg(ground_elevation_m=GROUND_M), crs="EPSG:2169")
 
 
 def _read(d, name):
@@ -104,7 +107,7 @@ def test_israel_feed_real(israel):
 
 def test_cairns_feed_real(shared_data, tmp_path):
     path = shared_data / "gtfs" / "cairns_gtfs_kit" / "cairns_gtfs.zip"
-    report = ingest_gtfs(path, tmp_path, TrajectoryCfg())
+    report = ingest_gtfs(path, tmp_path, TrajectoryCfg(ground_elevation_m=GROUND_M))
     gfeed = gk.read_feed(path, dist_units="km")
     c = report["counts"]
     assert (c["trips"], c["shapes"], c["routes"]) == (1339, 54, 22)
@@ -322,7 +325,7 @@ def test_trapezoid_analytic_and_gradient():
 
 
 def test_driving_cycle_timing_mode(tmp_path):
-    cfg = TrajectoryCfg(timing="driving_cycle")
+    cfg = TrajectoryCfg(timing="driving_cycle", ground_elevation_m=GROUND_M)
     report = ingest_gtfs(LUX, tmp_path, cfg, crs="EPSG:2169")
     assert any("cannot keep their schedule" in p for p in report["problems"])
     p = passes_for_trip(tmp_path, "DAY", "2024-06-15")        # feasible: same first/last
@@ -347,7 +350,7 @@ class _Plane:
 def test_segments_heading_gradient_terrain():
     # an L-shaped line: 95 m east, then 43 m north
     pts = {"L": np.array([[0.0, 0.0], [95.0, 0.0], [95.0, 43.0]])}
-    segs, geom = build_segments(pts, 10.0, 3.2, 500.0, _Plane(), default_elevation_m=300.0)
+    segs, geom = build_segments(pts, 10.0, 3.2, 500.0, _Plane(), fallback=(300.0, "configured"))
     assert len(segs) == 14 and segs["length_m"].sum() == pytest.approx(138.0)
     east = segs[segs["y_end"] == 0.0]
     north = segs[segs["x"] >= 95.0 - 1e-9]
@@ -357,20 +360,25 @@ def test_segments_heading_gradient_terrain():
     # the piece around the corner keeps the corner vertex
     corner = geom[segs.index[(segs["x"] < 95) & (segs["y_end"] > 0)][0]]
     assert shapely.get_num_coordinates(corner) == 3
-    # NaN ground falls back to the default elevation
+    assert (segs["ground_source"] == 0).all()                 # relief
+    # NaN ground falls back to the fallback height, said in ground_source; without one the
+    # height is unknown (NaN, -1: the ingest refuses it)
     segs2, _ = build_segments({"W": np.array([[-50.0, 0.0], [-10.0, 0.0]])}, 10.0, 3.2, 500.0,
-                              _Plane(), default_elevation_m=300.0)
+                              _Plane(), fallback=(300.0, "configured"))
     assert (segs2["ground_z"] == 300.0).all() and segs2["tile"].iloc[0] == "E-005N0000"
+    assert (segs2["ground_source"] == 3).all()                # configured
+    segs3, _ = build_segments({"W": np.array([[-50.0, 0.0], [-10.0, 0.0]])}, 10.0, 3.2, 500.0, _Plane())
+    assert segs3["ground_z"].isna().all() and (segs3["ground_source"] == -1).all()
 
 
 def test_cli_ingest_gtfs(tmp_path, capsys):
     from vipvflow.cli import main
 
-    assert main(["ingest", "gtfs", str(LUX), "--data-dir", str(tmp_path),
+    assert main(["ingest", "gtfs", "--ground-elevation", str(GROUND_M), str(LUX), "--data-dir", str(tmp_path),
                  "--crs", "EPSG:2169"]) == 0
     out = capsys.readouterr().out
     assert "segments 1311" in out and "trips 8" in out and "patterns 4" in out
-    assert main(["ingest", "gtfs", str(tmp_path / "missing.zip"), "--data-dir",
+    assert main(["ingest", "gtfs", "--ground-elevation", str(GROUND_M), str(tmp_path / "missing.zip"), "--data-dir",
                  str(tmp_path)]) == 2
 
 
@@ -381,8 +389,9 @@ def test_demo_line_segments_and_trips_per_year(tmp_path):
     # the demo generator's own GTFS writer (what generate_demo writes as demo_gtfs.zip)
     layout = build_layout(seed=42, size="full")
     demo_gtfs.write_gtfs(tmp_path / "demo_gtfs.zip", layout, 2024)
-    report = ingest_gtfs(tmp_path / "demo_gtfs.zip", tmp_path, TrajectoryCfg(), crs="EPSG:2169")
-    assert report["problems"] == []
+    report = ingest_gtfs(tmp_path / "demo_gtfs.zip", tmp_path, TrajectoryCfg(ground_elevation_m=GROUND_M), crs="EPSG:2169")
+    assert report["problems"] == [f"no city model: the ground of all {report['counts']['segments']} "
+                                  "segments is trajectory.ground_elevation_m (0.0 m)"]
     segs = _read(tmp_path, "segments.parquet")
     trips = _read(tmp_path, "trips.parquet")
     line1 = trips[trips["route_short_name"] == "1"]
@@ -404,7 +413,7 @@ def test_reingest_replaces_gtfs_folder_as_a_whole(tmp_path):
     files, and the folder a killed ingest left (its process gone) is removed."""
     import subprocess
 
-    ingest_gtfs(LUX, tmp_path, TrajectoryCfg(), crs="EPSG:2169")
+    ingest_gtfs(LUX, tmp_path, TrajectoryCfg(ground_elevation_m=GROUND_M), crs="EPSG:2169")
     (tmp_path / "gtfs" / "left-over.parquet").write_bytes(b"old")
     proc = subprocess.Popen(["true"])          # a pid whose process has surely exited
     proc.wait()
@@ -412,7 +421,7 @@ def test_reingest_replaces_gtfs_folder_as_a_whole(tmp_path):
     stale.mkdir()
     (stale / "segments.parquet").write_bytes(b"half")
     before = json.loads((tmp_path / "gtfs" / "feed.json").read_text())["counts"]
-    ingest_gtfs(LUX, tmp_path, TrajectoryCfg(), crs="EPSG:2169")
+    ingest_gtfs(LUX, tmp_path, TrajectoryCfg(ground_elevation_m=GROUND_M), crs="EPSG:2169")
     assert not (tmp_path / "gtfs" / "left-over.parquet").exists()
     assert not stale.exists()
     assert json.loads((tmp_path / "gtfs" / "feed.json").read_text())["counts"] == before

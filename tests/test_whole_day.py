@@ -15,6 +15,9 @@ from vipvflow.models.shading import Scene, box_mesh
 from vipvflow.models.sun_sky import RadiationTable
 from vipvflow.simulation.standing import interval_integrals, open_scene, point_geometry
 
+#: the ground height (m) of feeds ingested without a city model or radiation file
+GROUND_M = 0.0
+
 LAT, LON, ALT = 49.61, 6.13, 300.0
 LONG = 3000.0        # half length of an "infinite" wall (m)
 
@@ -132,7 +135,7 @@ def _gtfs(folder):
 @pytest.fixture(scope="module")
 def small_feed(tmp_path_factory):
     d = tmp_path_factory.mktemp("whole_day")
-    ingest_gtfs(_gtfs(d / "feed"), d, TrajectoryCfg(), crs="EPSG:2169")
+    ingest_gtfs(_gtfs(d / "feed"), d, TrajectoryCfg(ground_elevation_m=GROUND_M), crs="EPSG:2169")
     return d
 
 
@@ -193,22 +196,6 @@ def test_timeline_partitions_every_block_day(small_feed):
     pd.testing.assert_frame_equal(bd.reset_index(drop=True), year)
 
 
-def test_block_day_balance_by_hand():
-    from vipvflow.models.vehicle import VehicleParams, block_day_balance
-
-    params = VehicleParams(curb_mass_kg=12000, cda_m2=6.0, crr=0.007, motor_power_kw=250,
-                           motor_torque_nm=2000, battery_kwh=100.0, soc_min=0.2, soc_max=0.9)
-    # day 0: -30, +5 (PV 15 > use 10: charges 0.6 -> 0.65), parked 40 -> room (0.9-0.65) x 100 = 25
-    # day 1: +8 at the ceiling: all 8 curtailed; parked 3, no room: curtailed
-    pv = np.array([[10.0, 15.0], [18.0, 0.0]])
-    use = np.array([[40.0, 10.0], [10.0, 0.0]])
-    out = block_day_balance(pv, use, [40.0, 3.0], params)
-    np.testing.assert_allclose(out["soc_end"], [0.65, 0.9])
-    np.testing.assert_allclose(out["curtailed_in_service_kwh"], [0.0, 8.0])
-    np.testing.assert_allclose(out["parked_usable_kwh"], [25.0, 0.0])
-    np.testing.assert_allclose(out["curtailed_parked_kwh"], [15.0, 3.0])
-
-
 def test_small_run_splits_every_block_day(small_run, small_config):
     import json
 
@@ -235,7 +222,6 @@ def test_small_run_splits_every_block_day(small_run, small_config):
     assert bd["demand_kwh"].sum() == pytest.approx(bd["consumption_kwh"].sum() + bd["layover_aux_kwh"].sum())
     # the fleet: both yields, the whole day includes the idle buses parked at the depot
     assert s["harvest"] == "whole_day"
-    assert s["kwh_per_kwp_driving"] == pytest.approx(s["kwh_per_kwp_allsky"])
     assert s["kwh_per_kwp_driving"] < s["kwh_per_kwp_in_service"] < s["kwh_per_kwp_whole_day"]
     parts = s["pv_kwh_driving"] + s["pv_kwh_layover"] + s["pv_kwh_parked"]
     assert s["pv_kwh_whole_day"] == pytest.approx(parts)
@@ -245,7 +231,7 @@ def test_small_run_splits_every_block_day(small_run, small_config):
     assert s["idle_bus_days"] == int((s["buses"] - days.reindex(pd.date_range("2024-06-01", "2024-06-30"),
                                                                    fill_value=0)).sum())
     # one month run: the annual figures are the month's x 12, coverage on what the battery takes
-    assert s["coverage"] == pytest.approx(s["pv_kwh_usable"] * 12 / (s["fleet_demand_mwh"] * 1000.0))
+    assert s["coverage"] == pytest.approx(s["pv_kwh_usable"] * 12 / (s["fleet_demand_in_service_mwh"] * 1000.0))
     monthly = pd.read_parquet(small_run / "monthly.parquet")
     assert monthly["pv_kwh_whole_day"].sum() == pytest.approx(s["pv_kwh_whole_day"])
 
@@ -285,32 +271,40 @@ def test_driving_only_run_keeps_the_papers_figures(small_run, small_config, tmp_
     full = json.loads((small_run / "summary.json").read_text())
     assert not (run / "parts" / "standing").exists()
     assert s["kwh_per_kwp_in_service"] is None and s["kwh_per_kwp_whole_day"] is None
-    assert s["kwh_per_kwp_allsky"] == pytest.approx(full["kwh_per_kwp_allsky"], rel=1e-12)
-    # every driving kWh counts, against the trips' demand alone
-    assert (s["pv_kwh_usable"], s["pv_kwh_curtailed"]) == (pytest.approx(s["pv_kwh_driving"]), 0.0)
+    assert s["pv_kwh_layover"] is None and s["pv_kwh_parked"] is None
+    assert s["kwh_per_kwp_driving"] == pytest.approx(full["kwh_per_kwp_driving"], rel=1e-12)
+    # the driving PV is what is harvested; a full battery curtails (almost) none of it
+    assert s["pv_kwh_harvested"] == pytest.approx(s["pv_kwh_driving"])
+    assert s["pv_kwh_usable"] + s["pv_kwh_curtailed"] == pytest.approx(s["pv_kwh_driving"])
+    # the paper's coverage: the driving PV against the trips' demand alone
     trips = pd.read_parquet(run / "trip_energy.parquet")
-    assert s["coverage"] == pytest.approx(trips["pv_kwh"].sum() / trips["consumption_kwh"].sum())
+    assert s["coverage_driving"] == pytest.approx(trips["pv_kwh"].sum() / trips["consumption_kwh"].sum())
 
 
-def test_depot_outside_the_city_model_is_one_clear_error(small_run, small_config):
+def test_depot_outside_the_city_model_stands_in_the_open(small_run, small_config):
+    """A depot where the city model has no building within its buffer (no mesh for its
+    tile) stands in the open with depot_shading: city, as with open: its roof sees the
+    whole sky (sky view factor 1, nothing to reflect), never a missing mesh."""
     from vipvflow.config import load_config
-    from vipvflow.errors import InputError
+    from vipvflow.models.shading import get_scene, modelled_tiles
     from vipvflow.simulation.standing import depot_point
 
     far = {"fleet": {"depot": {"lat": 49.9, "lon": 5.8}}}
     cfg = load_config(small_config, overrides=far)
-    with pytest.raises(InputError, match=r"fleet.depot \(49.9, 5.8\) lies outside the city model"):
-        depot_point(cfg, cfg.data_dir)
-    # in the open it stands anywhere: the roof height of the nearest road, an open field
-    cfg = load_config(small_config, overrides={"fleet": {**far["fleet"], "depot_shading": "open"}})
     x, y, z, tile = depot_point(cfg, cfg.data_dir)
     assert 40000 < x < 110000 and 50000 < y < 140000 and z > 0      # LUREF, Luxembourg
+    assert tile not in modelled_tiles(cfg.data_dir)
+    scene = get_scene(cfg.data_dir, tile)
+    assert scene.n_triangles == 0
+    geom = point_geometry(scene, pd.DataFrame({"point_id": [0], "x": [x], "y": [y], "z": [z]}),
+                          cfg.irradiance)
+    assert geom["svf"].iloc[0] == pytest.approx(1.0) and geom["refl_vf"].iloc[0] == 0.0
 
 
 def test_timeline_of_a_real_feed_without_blocks(shared_data, tmp_path):
     """Cairns (gtfs-kit's sample feed, no block_id: blocks inferred): every block-day of 2014
     is cut into driving, layover and parked time that add up to its window exactly."""
-    ingest_gtfs(shared_data / "gtfs" / "cairns_gtfs_kit" / "cairns_gtfs.zip", tmp_path, TrajectoryCfg())
+    ingest_gtfs(shared_data / "gtfs" / "cairns_gtfs_kit" / "cairns_gtfs.zip", tmp_path, TrajectoryCfg(ground_elevation_m=GROUND_M))
     tl = block_timeline(tmp_path, 2014)
     bd, iv = tl["block_days"], tl["intervals"]
     assert bd["trips"].sum() == len(tl["trip_runs"]) and (bd["overlap_s"] == 0).all()
@@ -363,7 +357,10 @@ def test_harvest_chooses_the_standing_work(small_run, small_config, tmp_path, ha
     cfg = load_config(small_config, overrides={"fleet": {"harvest": harvest}})
     tiles = write_timeline(cfg, 2024, tmp_path)
     iv = pd.read_parquet(timeline_dir(tmp_path) / "intervals.parquet")
-    assert set(iv["kind"]) == kinds and (len(tiles) > 0) == bool(kinds)
+    # every interval is in the timeline (the battery's balance needs them); the light is
+    # evaluated for those fleet.harvest counts
+    assert set(iv["kind"]) == {"layover", "parked"}
+    assert set(iv.loc[iv["harvested"], "kind"]) == kinds and (len(tiles) > 0) == bool(kinds)
     assert (iv["month"] == "2024-06").all()
     # the block-days' time is cut the same whatever is evaluated
     bd = pd.read_parquet(timeline_dir(tmp_path) / "block_days.parquet")

@@ -96,9 +96,20 @@ class CityCfg(_Model):
 class TrajectoryCfg(_Model):
     segment_length_m: float = Field(10.0, ge=0.5, le=1_000)
     roof_height_m: float = Field(3.2, ge=0, le=10)
-    default_elevation_m: float = 300.0
+    # the ground's height above sea level (m) where the city model has neither relief nor a
+    # building within 100 m; null: the radiation file's declared altitude
+    ground_elevation_m: float | None = Field(None, ge=-500, le=9_000)
     timing: Literal["stop_times", "driving_cycle"] = "stop_times"
     cycle: CycleCfg = Field(default_factory=CycleCfg)
+
+    @model_validator(mode="before")
+    @classmethod
+    def _renamed(cls, data):
+        if isinstance(data, dict) and "default_elevation_m" in data:
+            raise ValueError("default_elevation_m is gone (a constant put roads outside the "
+                             "city model at 300 m); the ground comes from the city model, else "
+                             "the radiation file's altitude, else ground_elevation_m")
+        return data
 
 
 
@@ -162,14 +173,20 @@ class RunCfg(_Model):
 
     months: list[int] = Field(default_factory=lambda: list(range(1, 13)), min_length=1)
     routes: list[str] | None = None
-    # GTFS route_type values to simulate (3 bus, 0 tram, 2 rail, 11 trolleybus, extended
-    # 100..1799 such as 700 bus service); null: every route of the feed
-    route_types: list[int] | None = Field(None, min_length=1)
+    # GTFS route_type values to simulate: "bus" (3 bus, 11 trolleybus, extended 700..716 bus
+    # services and 800 trolleybus), "all", or a list (0 tram, 1 subway, 2 rail, 109 suburban
+    # railway, ...: a building model knows no tunnels or viaducts, said at ingest)
+    route_types: Literal["bus", "all"] | list[int] = "bus"
 
-    @field_validator("route_types")
+    @field_validator("route_types", mode="before")
     @classmethod
     def _route_types(cls, v):
-        bad = [t for t in v or [] if not (0 <= t <= 12 or 100 <= t <= 1799)]
+        if v is None:
+            return "all"
+        if isinstance(v, list) and not v:
+            raise ValueError("an empty list keeps no route; use bus, all or a list of GTFS route types")
+        bad = [t for t in v if not isinstance(t, int) or isinstance(t, bool)
+               or not (0 <= t <= 12 or 100 <= t <= 1799)] if isinstance(v, list) else []
         if bad:
             raise ValueError(f"not GTFS route types (0..12 or extended 100..1799): {bad}")
         return v
@@ -211,6 +228,50 @@ class FleetCfg(_Model):
     depot_shading: Literal["open", "covered", "city"] = "city"
 
 
+class DepotChargingCfg(_Model):
+    """The depot's chargers: they restore each morning's SoC while the bus is parked."""
+
+    power_kw: float = Field(100.0, gt=0, le=2_000)        # drawn from the grid per bus
+    efficiency: float = Field(0.95, gt=0, le=1)           # battery energy / grid energy
+    # local hours [from, to) the chargers run (to < from: past midnight); null: whenever parked
+    hours: tuple[float, float] | None = None
+    target_soc: float | None = Field(None, ge=0, le=1)    # null: the vehicle's soc_max
+
+    @field_validator("hours")
+    @classmethod
+    def _hours(cls, v):
+        if v is not None and not all(0 <= h <= 24 for h in v):
+            raise ValueError("hours are local clock hours 0..24, e.g. [21, 5]")
+        return v
+
+
+class OpportunityChargingCfg(_Model):
+    """Chargers at terminals (pantographs): a charge during a layover long enough for it."""
+
+    # stop_ids of the terminals with a charger, "all" (every terminal a block lays over
+    # at), or null (no opportunity charging)
+    terminals: list[str] | Literal["all"] | None = None
+    min_layover_min: float = Field(10.0, ge=0)            # a shorter layover is not used
+    connect_min: float = Field(1.0, ge=0)                 # of each layover, docking and undocking
+    power_kw: float = Field(300.0, gt=0, le=2_000)
+    efficiency: float = Field(0.95, gt=0, le=1)
+    target_soc: float | None = Field(None, ge=0, le=1)    # null: the vehicle's soc_max
+
+    @field_validator("terminals", mode="before")
+    @classmethod
+    def _terminals(cls, v):
+        if isinstance(v, list):
+            return [str(t) for t in v]
+        return v
+
+
+class ChargingCfg(_Model):
+    """The charging plan the battery's balance runs under (docs/whole_day.md)."""
+
+    depot: DepotChargingCfg = Field(default_factory=DepotChargingCfg)
+    opportunity: OpportunityChargingCfg = Field(default_factory=OpportunityChargingCfg)
+
+
 class DbCfg(_Model):
     dsn: str | None = None
 
@@ -231,6 +292,7 @@ class Config(_Model):
     run: RunCfg = Field(default_factory=RunCfg)
     radiation: RadiationCfg = Field(default_factory=RadiationCfg)
     fleet: FleetCfg = Field(default_factory=FleetCfg)
+    charging: ChargingCfg = Field(default_factory=ChargingCfg)
     dask: DaskCfg = Field(default_factory=DaskCfg)
     db: DbCfg = Field(default_factory=DbCfg)
 

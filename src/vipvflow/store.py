@@ -78,6 +78,8 @@ class CityDir(_Ingested):
     meshes = _Entry("meshes")
     surfaces = _Entry("surfaces", "GeoParquet of every tile's own surfaces: "
                                   "``surfaces/tile=<T>/part-0.parquet``.")
+    coverage = _Entry("coverage.parquet", "GeoParquet, one row: the area the city model covers "
+                                          "(its footprints closed and widened).")
 
     def mesh(self, tile: str) -> Path:
         """Triangle mesh of *tile*, its own surfaces and the buffer around it."""

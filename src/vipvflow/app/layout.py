@@ -18,7 +18,7 @@ import pandas as pd
 from bokeh.layouts import column, row
 from bokeh.models import (ColorBar, ColumnDataSource, CustomJSTickFormatter, DatePicker, Div,
                           FactorRange, HoverTool, Legend, LinearColorMapper, RadioButtonGroup,
-                          RangeSlider, Select, Slider, Span, Spinner)
+                          Select, Slider, Span, Spinner)
 from bokeh.palettes import Category10_5, Viridis256
 from bokeh.plotting import figure
 from bokeh.transform import dodge
@@ -116,10 +116,17 @@ def numbers_html(res, fleet: dict | None = None) -> str:
     data = " ".join(f'data-{k}="{html.escape(str(v))}"' for k, v in attrs.items())
     fleet_html = ""
     if fleet:
-        fleet_html = (f'<div class="fleet">Fleet, simulated months (rescaled): '
+        run = fleet.get("run") or {}
+        headline = ""
+        if run.get("coverage") is not None:
+            headline = (f'the run: PV the batteries take covers <b><span class="fleet-coverage">'
+                        f'{100 * run["coverage"]:.2f}</span> %</b> of the fleet\'s demand in service '
+                        f'(trips and layovers; summary.json coverage); ')
+        fleet_html = (f'<div class="fleet">Fleet: {headline}driving, simulated months (rescaled): '
                       f'<b>{fleet["allsky"]:,.0f}</b> kWh PV all-sky, {fleet["clearsky"]:,.0f} clear-sky, '
                       f'shading loss {100 * fleet["shading_loss"]:.1f} %, '
-                      f'covers {100 * fleet["share"]:.2f} % of {fleet["consumption"]:,.0f} kWh</div>')
+                      f'{100 * fleet["share"]:.2f} % of the trips\' {fleet["consumption"]:,.0f} kWh '
+                      f'(coverage_driving)</div>')
     return (
         f'<div id="trip-numbers" class="trip-numbers" {data}>'
         f'<div class="trip-head">Trip <b>{html.escape(res.trip_id)}</b> on {res.date:%a %d %b %Y}, '
@@ -133,7 +140,9 @@ def numbers_html(res, fleet: dict | None = None) -> str:
         f'<td>{n["distance_km"]:.2f} km in {n["duration_min"]:.0f} min</td></tr>'
         f'<tr><td>PV share</td><td><span id="pv-share" class="pv-share">'
         f'{share:.{DECIMALS["share_percent"]}f}</span> %</td>'
-        f'<td>SoC at the end {100 * n["soc_end"]:.1f} % without PV, {100 * n["soc_end_pv"]:.1f} % with</td></tr>'
+        f'<td>SoC at departure <span class="soc-start">{100 * n["soc_start"]:.1f}</span> % '
+        f'({html.escape(n["soc_start_from"])}); at the end {100 * n["soc_end"]:.1f} % without PV, '
+        f'{100 * n["soc_end_pv"]:.1f} % with</td></tr>'
         f'</table>{fleet_html}'
         f'<div class="compute">recomputed in {1000 * n["compute_s"]:.0f} ms with the run\'s physics '
         f'(diffuse model {n.get("diffuse_model", "")}; stored horizons and geometry factors, '
@@ -165,7 +174,9 @@ def _controls(model: TripModel, start: dict) -> SimpleNamespace:
     """The PV, route, date and vehicle controls and the text panes, opened on *start*."""
     routes = model.routes()
     route_opts = [(f"{r.route_id}|{r.direction_id}",
-                   f"{r.route_short_name} direction {r.direction_id} ({r.trips} trips)")
+                   f"{r.route_short_name} " + (f"to {r.trip_headsign}" if r.trip_headsign
+                                               else f"direction {r.direction_id}")
+                   + f" ({r.trips} trips)")
                   for r in routes.itertuples()]
     run_pv = model.run_pv_choice
     w = _WIDTH
@@ -192,9 +203,9 @@ def _controls(model: TripModel, start: dict) -> SimpleNamespace:
                     format=CustomJSTickFormatter(code=_HHMM))
     aux = Spinner(title="auxiliary base load (kW; HVAC on top)", value=model.vehicle.aux_base_kw,
                   low=0, high=40, step=0.5, width=w, css_classes=["aux-kw"])
-    soc = RangeSlider(title="SoC limit (min) and SoC at departure", value=(model.vehicle.soc_min,
-                      model.vehicle.soc_max), start=0, end=1, step=0.01, width=w,
-                      css_classes=["soc-range"])
+    soc = Slider(title="SoC limit (min); the trip departs at its SoC in the run's balance",
+                 value=model.vehicle.soc_min, start=0, end=0.9, step=0.01, width=w,
+                 css_classes=["soc-min"])
     numbers = Div(text="", width=560, css_classes=["numbers-div"],
                   stylesheets=[":host .trip-table td { padding: 2px 10px 2px 0; }"
                                ":host .pv-kwh, :host .pv-share { font-size: 1.4em; font-weight: bold; color: #b35900; }"
@@ -307,7 +318,7 @@ def _wire(model: TripModel, c: SimpleNamespace, v: SimpleNamespace):
         fleet = model.monthly(None, None, pv)
         if len(fleet):
             tot = fleet[["allsky", "clearsky", "allsky_unshaded", "consumption"]].sum()
-            return {"allsky": tot["allsky"], "clearsky": tot["clearsky"],
+            return {"run": model.summary, "allsky": tot["allsky"], "clearsky": tot["clearsky"],
                     "shading_loss": float((fleet["shading_loss"] * fleet["allsky_unshaded"]).sum()
                                           / max(tot["allsky_unshaded"], 1e-12)),
                     "share": tot["allsky"] / tot["consumption"] if tot["consumption"] else np.nan,
@@ -321,9 +332,9 @@ def _wire(model: TripModel, c: SimpleNamespace, v: SimpleNamespace):
         try:
             pv = pv_choice()
             rid, d = selected()
-            lo, hi = soc.value
+            lo = float(soc.value)
             res = model.trip(rid, d, date.value, depart=int(depart.value), pv=pv,
-                             aux_kw=float(aux.value), soc_start=float(hi), soc_min=float(lo))
+                             aux_kw=float(aux.value), soc_min=lo)
             s = res.segments
             src_seg.data = {"time": s["time"].to_numpy(), "direct": s["direct"].to_numpy(),
                             "diffuse": s["diffuse"].to_numpy(), "reflected": s["reflected"].to_numpy(),
@@ -364,7 +375,8 @@ def _header(model: TripModel) -> Div:
     summary_path = RunDir(model.run_dir).output("summary.json")
     if summary_path.exists():
         sm = json.loads(summary_path.read_text())
-        parts = [(label, sm.get(key)) for label, key in (("driving", "kwh_per_kwp_allsky"),
+        parts = [(label, sm.get(key)) for label, key in (("the batteries take", "kwh_per_kwp_usable"),
+                                                         ("driving", "kwh_per_kwp_driving"),
                                                          ("in service", "kwh_per_kwp_in_service"),
                                                          ("whole day", "kwh_per_kwp_whole_day"))]
         shown = [f"{label} {value:,.0f}" for label, value in parts if isinstance(value, (int, float))]

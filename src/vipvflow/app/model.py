@@ -208,6 +208,8 @@ class TripModel:
         self._loc = geo["rad_location"].to_numpy(np.int64) if "rad_location" in geo else None
         self._tile = geo["tile"].astype(str).to_numpy()
         self.radiation = RadiationTable.load(self.data_dir, self.year)
+        summary = RunDir(self.run_dir).output("summary.json")
+        self.summary = json.loads(summary.read_text()) if summary.exists() else {}
 
         # timetable
         self.trips = pd.read_parquet(gdir.trips)
@@ -222,15 +224,45 @@ class TripModel:
                             if (self.run_dir / "route_month.parquet").exists() else pd.DataFrame())
         if len(self.route_month):
             self.route_month["route_id"] = self.route_month["route_id"].astype(str)
-        # routes actually simulated (their segments have geometry)
+        # each trip's SoC at departure in the run's battery balance (its block-day under the
+        # charging plan): a trip view starts from it
+        te = RunDir(self.run_dir).output("trip_energy.parquet")
+        self._soc_at_departure = {}
+        if te.exists():
+            import pyarrow.parquet as pq
+
+            if "soc_at_departure" in pq.read_schema(te).names:
+                t = pd.read_parquet(te, columns=["trip_id", "service_date", "soc_at_departure"])
+                days = pd.to_datetime(t["service_date"]).dt.normalize()
+                self._soc_at_departure = dict(zip(zip(t["trip_id"].astype(str), days),
+                                                  t["soc_at_departure"].astype(float)))
+        # the routes the run simulated: its run.routes, with trips in its outputs (a route
+        # that shares a shape with a simulated one is not one), on shapes with geometry
         have = set(geo["shape_id"].dropna())
-        self.trips = self.trips[self.trips["shape_id"].isin(have)].reset_index(drop=True)
+        keep = self.trips["shape_id"].isin(have)
+        if self.cfg.run.routes is not None:
+            keep &= self.trips["route_id"].isin({str(r) for r in self.cfg.run.routes})
+        if len(self.route_month):
+            keep &= self.trips["route_id"].isin(set(self.route_month["route_id"]))
+        self.trips = self.trips[keep].reset_index(drop=True)
 
     # ------------------------------------------------------------------ choices
     def routes(self) -> pd.DataFrame:
-        """Route-directions of the run: ``route_id, route_short_name, direction_id, trips``."""
-        return (self.trips.groupby(["route_id", "route_short_name", "direction_id"], sort=True)
-                .size().rename("trips").reset_index())
+        """Route-directions of the run: ``route_id, route_short_name, direction_id, trips`` and
+        ``route_long_name``, ``trip_headsign`` (the direction's most frequent; empty when the
+        feed has none)."""
+        t = self.trips.reindex(columns=[*self.trips.columns.drop(["route_long_name", "trip_headsign"],
+                                                                 errors="ignore"),
+                                        "route_long_name", "trip_headsign"])
+
+        def most(v):
+            v = v.dropna()
+            return v.mode().iloc[0] if len(v) else ""
+
+        return (t.groupby(["route_id", "route_short_name", "direction_id"], sort=True)
+                .agg(trips=("trip_id", "size"), route_long_name=("route_long_name", most),
+                     trip_headsign=("trip_headsign", most))
+                .reset_index())
 
     def departures(self, route_id, direction_id, date) -> pd.DataFrame:
         """Scheduled trips of a route-direction on a service date (``trip_id, start_s``),
@@ -470,7 +502,9 @@ class TripModel:
         aux_kw : auxiliary base load (kW), HVAC at the month's temperature on top
             (default: the vehicle's)
         soc_start, soc_min : SoC at the trip's start and the lower limit (0..1; defaults:
-            the vehicle's ``soc_max`` and ``soc_min``)
+            the SoC at that departure in the run's battery balance (``trip_energy``'s
+            ``soc_at_departure``; the vehicle's ``soc_max`` for a trip the run does not have
+            that day) and the vehicle's ``soc_min``)
         """
         from ..models.vehicle import soc_trace
 
@@ -506,6 +540,11 @@ class TripModel:
             "x": g["x"].to_numpy(), "y": g["y"].to_numpy(),
             "x_end": g["x_end"].to_numpy(), "y_end": g["y_end"].to_numpy()})
 
+        soc_from = "as chosen"
+        if soc_start is None:
+            soc_start = self._soc_at_departure.get((str(row["trip_id"]), date))
+            soc_from = ("the run's battery balance of its block-day" if soc_start is not None
+                        else "the vehicle's soc_max (the run has no such trip that day)")
         params, soc0, cons, cyc = self._vehicle_run(pid, month, origin, off, dt, energy,
                                                     aux_kw, soc_start, soc_min)
         pv_kwh = float(energy.sum())
@@ -522,6 +561,7 @@ class TripModel:
             # per reflector and pass), independent passes
             "pv_kwh_reflected_se": float(np.sqrt((parts["reflected_sd"] ** 2).sum())),
             "shading_loss": float(shading_loss(parts["direct"].sum(), parts["diffuse"].sum(), uns)),
+            "soc_start": float(soc0), "soc_start_from": soc_from,
             "soc_end": float(end["soc_end"].iloc[0]), "soc_end_pv": float(end["soc_end_pv"].iloc[0]),
             "soc_min": params.soc_min, "kwp": pv.peak_kw,
             "diffuse_model": self.cfg.irradiance.diffuse_model,

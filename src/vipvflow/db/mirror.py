@@ -91,6 +91,15 @@ def citus_mode(conn, log=print) -> bool:
     return True
 
 
+def _citus_layout(conn) -> str:
+    """The log's words for the Citus layout: the nodes that hold shards."""
+    workers = conn.execute("SELECT count(*) FROM pg_dist_node WHERE noderole = 'primary' AND "
+                           "isactive AND groupid <> 0").fetchone()[0]
+    nodes = f"{workers} worker(s)" if workers else "the coordinator alone (no workers registered)"
+    return (f"Citus on {nodes}: segment tables distributed by tile, trips and bus-days by "
+            "block, small tables replicated")
+
+
 def setup_schema(conn, citus: bool) -> None:
     """Create (idempotently) the schema, distribute it under Citus, create the views."""
     import psycopg
@@ -298,7 +307,9 @@ def load_partition(conn, table: S.Table, run_id: str, label: str, value, rows: p
     rows = rows.add_column(0, "run_id", pa.array([run_id] * rows.num_rows, pa.string()))
     payload = memoryview(to_csv(rows))
     with conn.transaction():
-        if citus:  # reference-table writes after multi-shard ones in one transaction
+        if citus:  # one connection per worker for the delete, the copy and the progress row
+            # (Citus's advice when a transaction writes a reference table after multi-shard
+            # statements; parallel mode was no faster on the demo run)
             conn.execute("SET LOCAL citus.multi_shard_modify_mode TO 'sequential'")
         args = (run_id, value) if table.partition_by else (run_id,)
         conn.execute(_delete_sql(table), args)
@@ -324,6 +335,18 @@ def _forget(conn, table: S.Table, run_id: str, citus: bool) -> None:
                      (run_id, table.name))
 
 
+def _add_columns(conn, table: S.Table, extra: dict[str, str]) -> None:
+    """Add the file's columns the table lacks, in one statement (on Citus each ALTER TABLE
+    runs on every shard: the columns already there are not asked for again)."""
+    have = {r[0] for r in conn.execute(
+        "SELECT attname FROM pg_attribute WHERE attrelid = %s::regclass AND attnum > 0 "
+        "AND NOT attisdropped", (table.qualified,))}
+    missing = [(n, t) for n, t in extra.items() if n not in have]
+    if missing:
+        conn.execute(f"ALTER TABLE {table.qualified} "
+                     + ", ".join(f"ADD COLUMN IF NOT EXISTS {_ident(n)} {t}" for n, t in missing))
+
+
 def mirror_table(conn, run_dir: Path, table: S.Table, run_id: str, citus: bool, force: bool,
                  log, on_partition) -> int:
     """Load one table of a run, partition by partition, skipping the ones already there."""
@@ -339,9 +362,7 @@ def mirror_table(conn, run_dir: Path, table: S.Table, run_id: str, citus: bool, 
                 f": replacing the run's rows")
         _forget(conn, table, run_id, citus)
         done = {}
-    for name, sql_type in extra.items():
-        conn.execute(f"ALTER TABLE {table.qualified} ADD COLUMN IF NOT EXISTS "
-                     f"{_ident(name)} {sql_type}")
+    _add_columns(conn, table, extra)
     parts = partitions(data, table.partition_by)
     todo = [p for p in parts if p[0] not in done]
     loaded = 0
@@ -393,9 +414,8 @@ def mirror_run(dsn: str, run_dir, log=print, force: bool = False,
     where = describe_dsn(dsn)
     try:
         citus = citus_mode(conn, log)
-        log(f"mirror {run_id} into {where}: "
-            + ("Citus (segment tables distributed by tile, trip tables by route)" if citus
-               else "plain PostGIS tables (no Citus)"))
+        log(f"mirror {run_id} into {where}: " + (_citus_layout(conn) if citus
+                                                 else "plain PostGIS tables (no Citus)"))
         setup_schema(conn, citus)
         with conn.transaction():
             conn.execute(
@@ -403,7 +423,7 @@ def mirror_run(dsn: str, run_dir, log=print, force: bool = False,
                 "status, mirrored_at, manifest, config, summary) "
                 "VALUES (%s, %s, %s, %s, %s, 'loading', now(), %s, %s, %s) "
                 "ON CONFLICT (run_id) DO UPDATE SET crs_epsg = EXCLUDED.crs_epsg, "
-                "status = 'loading', mirrored_at = now(), manifest = EXCLUDED.manifest, "
+                "status = 'loading', mirrored_at = EXCLUDED.mirrored_at, manifest = EXCLUDED.manifest, "
                 "config = EXCLUDED.config, summary = EXCLUDED.summary",
                 (run_id, manifest.get("scenario"), manifest.get("year"),
                  manifest.get("config_digest"), epsg, psycopg.types.json.Jsonb(manifest),

@@ -8,9 +8,11 @@ load with the type its Parquet column has, so the mirror never drops data silent
 
 With the Citus extension the segment-level tables are distributed by ``tile`` (colocated:
 a segment and its months live on the same worker, as the simulation's partitions do), the
-trip-level ones by ``route_id`` and ``block_day`` by ``block_id``; the small per-run tables
-are reference tables (a copy on every worker, cheap to join). Without Citus the same tables
-are plain PostGIS tables.
+trips and the bus-days by ``block_id`` (colocated: a bus's trips and its days on the same
+worker; a trip crosses many tiles, and there are many more blocks than routes); the small
+tables (runs, progress, fleet and route months, the hourly pattern, the summary) are
+reference tables (a copy on every node, cheap to join). Without Citus the same tables are
+plain PostGIS tables.
 """
 from __future__ import annotations
 
@@ -103,34 +105,35 @@ SEGMENT_MONTH = Table(
     drop=("geometry",), extra_indexes=(("run_id", "month"), ("run_id", "route_short_name", "month")))
 
 TRIP_ENERGY = Table(
-    "trip_energy", "trip_energy.parquet", ("route_id", "trip_id", "service_date"), [
+    "trip_energy", "trip_energy.parquet", ("block_id", "trip_id", "service_date"), [
         ("route_id", "text"), ("trip_id", "text"), ("service_date", "date"), ("month", "date"),
         ("route_short_name", "text"), ("direction_id", "integer"), ("shape_id", "text"),
         ("service_id", "text"), ("block_id", "text"), ("pattern_id", "bigint"), ("start_s", _F),
         ("seconds", _F), *_cols(_PV, _F),
         *_cols(["consumption_kwh", "traction_kwh", "recuperated_kwh", "aux_kwh", "coverage"], _F),
-    ], partition_by="month", distribute_by="route_id",
-    extra_indexes=(("run_id", "month"), ("run_id", "block_id", "service_date")))
+    ], partition_by="month", distribute_by="block_id",
+    extra_indexes=(("run_id", "month"), ("run_id", "route_id", "month"),
+                   ("run_id", "block_id", "service_date")))
 
 ROUTE_MONTH = Table(
     "route_month", "route_month.parquet", ("route_id", "direction_id", "month"), [
         ("route_id", "text"), ("direction_id", "integer"), ("month", "date"),
         ("route_short_name", "text"), ("trips", "bigint"), ("seconds", _F), *_cols(_PV, _F),
         ("consumption_kwh", _F), ("coverage", _F), ("shading_loss", _F),
-    ], partition_by="month", distribute_by="route_id", colocate_with="trip_energy")
+    ], partition_by="month")
 
 BLOCK_DAY = Table(
     "block_day", "block_day.parquet", ("block_id", "service_date"), [
         ("block_id", "text"), ("service_date", "date"), ("trips", "bigint"), ("pv_kwh", _F),
         ("pv_kwh_clear", _F), ("consumption_kwh", _F), ("first_departure_s", _F),
-    ], distribute_by="block_id")
+    ], distribute_by="block_id", colocate_with="trip_energy")
 
 FLEET_MONTH = Table(
     "fleet_month", "monthly.parquet", ("month",), [
         ("month", "date"), ("trips", "bigint"),
         *_cols(["pv_kwh", "pv_kwh_clear", "pv_kwh_unshaded", "pv_kwh_clear_unshaded",
-                "consumption_kwh", "avoided_charging_cycles", "kwh_per_kwp_allsky",
-                "kwh_per_kwp_clearsky"], _F),
+                "consumption_kwh", "avoided_charging_cycles", "kwh_per_kwp_driving",
+                "kwh_per_kwp_driving_clearsky"], _F),
     ])
 
 HOURLY_PATTERN = Table(
@@ -144,11 +147,14 @@ FLEET_SUMMARY = Table(
         ("scenario", "text"), ("year", "integer"), ("pv_mode", "text"), ("diffuse_model", "text"),
         ("routes", "bigint"), ("trips", "bigint"), ("buses", "bigint"), ("segments", "bigint"),
         ("passes", "bigint"), ("kwp_per_bus", _F),
-        *_cols(["pv_kwh_allsky", "pv_kwh_clearsky", "pv_kwh_allsky_unshaded",
-                "kwh_per_kwp_allsky", "kwh_per_kwp_clearsky", "shading_loss_allsky",
+        *_cols(["pv_kwh_driving", "pv_kwh_driving_clearsky", "pv_kwh_driving_unshaded",
+                "pv_kwh_usable", "pv_kwh_curtailed", "kwh_per_kwp_usable", "kwh_per_kwp_driving",
+                "kwh_per_kwp_driving_clearsky", "shading_loss_allsky",
                 "shading_loss_clearsky", "unshaded_to_ghi_allsky", "unshaded_to_ghi_clearsky",
-                "reflected_share", "coverage", "fleet_demand_mwh",
-                "avoided_charging_cycles_per_bus", "payback_years"], _F),
+                "reflected_share", "coverage", "coverage_driving", "fleet_demand_in_service_mwh",
+                "fleet_demand_driving_mwh", "grid_kwh_avoided", "avoided_charging_cycles_per_bus",
+                "payback_years"], _F),
+        ("block_days_infeasible", "bigint"),
     ])
 
 #: tables filled from the run's files, in load order
@@ -213,9 +219,12 @@ def citus_statements(distributed: set[str] = frozenset()) -> list[str]:
             out.append(f"SELECT create_reference_table('{t.qualified}')")
         else:
             assert t.distribute_by in t.key, f"{t.name}: distribution column not in the key"
-            colo = f", colocate_with => '{SCHEMA}.{t.colocate_with}'" if t.colocate_with else ""
+            # a group's first table starts its own colocation group: Citus would otherwise
+            # put every table distributed by a text column in one group (tile and route
+            # shards side by side, as if their keys were related)
+            colo = f"'{SCHEMA}.{t.colocate_with}'" if t.colocate_with else "'none'"
             out.append(f"SELECT create_distributed_table('{t.qualified}', "
-                       f"'{t.distribute_by}'{colo})")
+                       f"'{t.distribute_by}', colocate_with => {colo})")
     return out
 
 

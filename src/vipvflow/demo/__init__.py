@@ -31,7 +31,7 @@ from pyproj import Transformer
 from ..progress import Progress
 from ..store import atomic_path, write_text
 from .cams import write_cams_csv
-from .city import SRS_NAME, Terrain, place_buildings, write_citygml
+from .city import SRS_NAME, Terrain, place_buildings, terminus_ends, write_citygml
 from .gtfs import AVERAGE_SPEED_KMH, AGENCY_TZ, stop_positions, stop_offsets, trips_per_year, write_gtfs
 from .layout import CENTRE_XY, CRS, Layout, build_layout
 
@@ -90,8 +90,12 @@ def layout_document(layout: Layout, year: int, buildings, terrain: Terrain) -> d
             "centerline": _rounded(st.xy, 3),
             "polygon": _rounded(shapely.get_coordinates(shapely.get_exterior_ring(poly)), 2),
         })
+    termini = [{"line": t.line, "end": "first stop" if t.end == 0 else "last stop",
+                "xy": [round(t.xy[0], 2), round(t.xy[1], 2)],
+                "n_buildings": len(by_stretch.get(t.stretch_id, []))} for t in terminus_ends(layout)]
     return {
         "crs": CRS, "srs_name": SRS_NAME, "size": layout.size, "seed": layout.seed, "year": year,
+        "termini_among_buildings": termini,
         "agency_timezone": AGENCY_TZ,
         "centre": {"x": CENTRE_XY[0], "y": CENTRE_XY[1], "lon": round(lon, 6), "lat": round(lat, 6)},
         "terrain": {"spacing_m": terrain.spacing, "bounds": _rounded(terrain.bounds, 2),

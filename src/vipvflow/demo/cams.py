@@ -164,16 +164,26 @@ def radiation_year(year: int, latitude: float, longitude: float, altitude: float
 
 
 def write_cams_csv(path: Path, year: int, latitude: float, longitude: float, altitude: float,
-                   seed: int) -> dict:
-    """Write the CAMS-format CSV for *year*; return rows and annual sums (kWh/m2)."""
+                   seed: int, months=None) -> dict:
+    """Write the CAMS-format CSV for *year* (only *months*, 1..12, when given: a contiguous
+    range, the header's dates follow); return rows and the written period's sums (kWh/m2)."""
     data = radiation_year(year, latitude, longitude, altitude, seed)
+    begin, end = pd.Timestamp(f"{year}-01-01"), pd.Timestamp(f"{year + 1}-01-01")
+    if months is not None:
+        months = sorted(months)
+        if months != list(range(months[0], months[-1] + 1)):
+            raise ValueError(f"months must be a contiguous range, got {months}")
+        begin = pd.Timestamp(year, months[0], 1)
+        end = begin + pd.offsets.MonthBegin(len(months))
+        data = data[(data.index >= begin.tz_localize(data.index.tz))
+                    & (data.index < end.tz_localize(data.index.tz))]
     values = data.round(4)
     t0 = data.index.strftime("%Y-%m-%dT%H:%M:%S.0")
     t1 = (data.index + pd.Timedelta(minutes=1)).strftime("%Y-%m-%dT%H:%M:%S.0")
     values.insert(0, "Observation period", np.char.add(np.char.add(t0.to_numpy().astype(str), "/"),
                                                          t1.to_numpy().astype(str)))
-    header = _HEADER.format(seed=seed, begin=f"{year}-01-01T00:00:00.0",
-                            end=f"{year + 1}-01-01T00:00:00.0", lat=latitude, lon=longitude,
+    header = _HEADER.format(seed=seed, begin=f"{begin:%Y-%m-%dT%H:%M:%S}.0",
+                            end=f"{end:%Y-%m-%dT%H:%M:%S}.0", lat=latitude, lon=longitude,
                             alt=altitude, year=year, columns=";".join(COLUMNS))
     with open(path, "w", encoding="utf-8", newline="\n") as fh:
         fh.write(header)

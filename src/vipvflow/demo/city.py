@@ -39,7 +39,16 @@ SCHEMA_LOCATION = (
 # roof type codes of the SIG3D/AdV code list used by German and Luxembourg LoD2 data
 ROOF_TYPE_CODE = {"flat": "1000", "gabled": "1030", "hipped": "1040"}
 _ROOF_MIX = {"canyon": {"flat": 0.35, "gabled": 0.5, "hipped": 0.15},
-             "suburban": {"flat": 0.15, "gabled": 0.55, "hipped": 0.30}}
+             "suburban": {"flat": 0.15, "gabled": 0.55, "hipped": 0.30},
+             "terminus": {"flat": 0.5, "gabled": 0.4, "hipped": 0.1}}
+
+#: line ends with a terminus among buildings (line, end: 0 first stop, 1 last stop), per demo
+#: size: a bus turns at a village square or a station forecourt, not only in an open field
+#: (the other ends stay in the open: a park-and-ride at the edge of town)
+TERMINUS_ENDS = {"full": (("1", 0), ("2", 0)), "small": (("1", 1),)}
+#: a terminus square: building rows along the last TERMINUS_BACK_M of the line and
+#: TERMINUS_AHEAD_M beyond its end (the turning loop), TERMINUS_OFFSET_M beyond the road edge
+TERMINUS_BACK_M, TERMINUS_AHEAD_M, TERMINUS_OFFSET_M = 110.0, 40.0, 6.0
 TERRAIN_SPACING_M = 50.0
 TERRAIN_TILE_M = 1000.0
 
@@ -194,8 +203,54 @@ def _row(a, b, offset, side, depth_fn, width_fn, gap_fn, skip_p, rng):
     return out
 
 
+@dataclass(frozen=True)
+class Terminus:
+    """A line end among buildings (``kind`` and ``stretch_id`` as a street stretch's)."""
+
+    line: str
+    end: int
+    xy: tuple
+    kind: str = "terminus"
+
+    @property
+    def stretch_id(self) -> str:
+        return f"L{self.line}_terminus_{self.end}"
+
+
+def terminus_ends(layout: Layout) -> list[Terminus]:
+    """The line ends of :data:`TERMINUS_ENDS` (where the buses lay over among buildings)."""
+    out = []
+    for line in layout.lines:
+        for name, end in TERMINUS_ENDS.get(layout.size, ()):
+            if name == line.name:
+                p = line.xy[0] if end == 0 else line.xy[-1]
+                out.append(Terminus(line.name, end, (float(p[0]), float(p[1]))))
+    return out
+
+
+def _terminus_candidates(layout: Layout, rng) -> list:
+    """Building rows on both sides of the last street piece at each terminus, running
+    :data:`TERMINUS_AHEAD_M` past the line's end (the square the buses turn in)."""
+    out = []
+    by_name = {line.name: line for line in layout.lines}
+    for t in terminus_ends(layout):
+        line = by_name[t.line]
+        xy = line.xy if t.end == 1 else line.xy[::-1]
+        end, prev = xy[-1], xy[-2]
+        u = (end - prev) / np.hypot(*(end - prev))
+        a, b = end - TERMINUS_BACK_M * u, end + TERMINUS_AHEAD_M * u
+        width = next(st.width_m for st in (line.stretches if t.end == 1 else line.stretches[::-1]))
+        off = width / 2 + TERMINUS_OFFSET_M
+        for side in (1, -1):
+            for fp in _row(a, b, off, side, lambda: rng.uniform(12.0, 15.0),
+                           lambda: rng.uniform(12.0, 20.0), lambda: rng.uniform(0.0, 4.0), 0.0, rng):
+                out.append((t, np.round(fp, 3)))
+    return out
+
+
 def place_buildings(layout: Layout, terrain: Terrain, seed: int) -> list[Building]:
-    """Buildings along the canyon and suburban stretches, none overlapping a street.
+    """Buildings along the canyon and suburban stretches and around the termini among
+    buildings (:data:`TERMINUS_ENDS`), none overlapping a street.
 
     Candidates are laid out in rows along every straight street piece; any candidate that
     reaches into a street (of any line) or overlaps an earlier one is dropped.
@@ -223,6 +278,7 @@ def place_buildings(layout: Layout, terrain: Terrain, seed: int) -> list[Buildin
                     for fp in _row(a, b, off, side, dfn, wfn, gfn, skip, rng):
                         cands.append((st, np.round(fp, 3)))
 
+    cands += _terminus_candidates(layout, rng)
     polys = shapely.polygons([fp for _, fp in cands])
     shrunk = shapely.buffer(polys, -0.05, join_style="mitre")
     # streets: the road (and the front gardens of suburban stretches) of every stretch
@@ -251,6 +307,9 @@ def place_buildings(layout: Layout, terrain: Terrain, seed: int) -> list[Buildin
         if st.kind == "canyon":
             storeys = int(rng.integers(4, 7))
             eaves_h = 3.0 * storeys + 2.0
+        elif st.kind == "terminus":
+            storeys = int(rng.integers(3, 5))
+            eaves_h = 3.0 * storeys + 1.5
         else:
             eaves_h = float(rng.uniform(*EAVES_RANGE["suburban"]))
             storeys = 2 if eaves_h < 8.5 else 3

@@ -127,7 +127,12 @@ def _scan_header(path: Path) -> dict:
             where = f"line {info['lines'][full]}" if full else "header"
             raise InputError(f"{path}: {where}: {key} missing or not a number") from None
     alt = next((k for k in info if isinstance(k, str) and k.startswith("Altitude")), None)
-    info["altitude"] = float(info[alt]) if alt else 0.0
+    try:
+        info["altitude"] = float(info[alt]) if alt else 0.0
+        info["altitude_declared"] = alt is not None
+    except (TypeError, ValueError):
+        raise InputError(f"{path}: line {info['lines'][alt]}: Altitude {info[alt]!r} is not a "
+                         "number") from None
     if first_data is None:
         raise InputError(f"{path}: no data rows after the header")
     no, line = first_data
@@ -271,7 +276,8 @@ def read_cams_file(path, clear_sky_margin=CLEAR_SKY_MARGIN) -> tuple[pd.DataFram
         flag |= FLAG_NO_ALLSKY
     out["flag"] = flag
     meta = {"file": str(path), "latitude": info["latitude"], "longitude": info["longitude"],
-            "altitude": info["altitude"], "time_step": info["time_step"],
+            "altitude": info["altitude"], "altitude_declared": info["altitude_declared"],
+            "time_step": info["time_step"],
             "time_reference": info["time_reference"], "has_all_sky": has_all,
             "rows": int(len(data)), "gaps": int(((flag & FLAG_GAP) > 0).sum()),
             "negative": int(neg.sum()), "ghi_above_toa": int(above_toa.sum()),
@@ -478,14 +484,16 @@ def ingest_cams(paths, data_dir, clear_sky_margin=CLEAR_SKY_MARGIN) -> dict:
             raise InputError(f"{p}: time step {meta['time_step']} (daily/monthly means) cannot "
                              "drive a per-pass simulation; give 1 min, 15 min or 1 h data")
         key = (round(meta["latitude"], 4), round(meta["longitude"], 4))
-        by_loc.setdefault(key, {"frames": [], "alt": meta["altitude"]})["frames"].append(frame)
+        by_loc.setdefault(key, {"frames": [], "alt": meta["altitude"],
+                                "alt_declared": meta["altitude_declared"]})["frames"].append(frame)
         files.append(meta)
     parts, locations = [], []
     for (lat, lon), item in by_loc.items():
         grid = _to_minute_grid(item["frames"])
         grid["lat"], grid["lon"], grid["altitude"] = lat, lon, item["alt"]
         parts.append(grid)
-        locations.append({"lat": lat, "lon": lon, "altitude": item["alt"], "minutes": len(grid),
+        locations.append({"lat": lat, "lon": lon, "altitude": item["alt"],
+                          "altitude_declared": item["alt_declared"], "minutes": len(grid),
                           "start_utc": int(grid["t_utc"].iloc[0]) - _GRID_S // 2,
                           "end_utc": int(grid["t_utc"].iloc[-1]) + _GRID_S // 2,
                           "flagged_minutes": int((grid["flag"] & ~np.uint8(FLAG_NO_ALLSKY) > 0).sum()),

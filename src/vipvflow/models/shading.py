@@ -190,12 +190,31 @@ _cache: "collections.OrderedDict[tuple, Scene]" = collections.OrderedDict()
 _cache_lock = threading.Lock()
 
 
+def modelled_tiles(data_dir) -> frozenset:
+    """The tiles the city model of *data_dir* has a mesh for (``city/tiles.json``): every
+    tile within ``city.buffer_m`` of a modelled surface; empty without a city model."""
+    import json
+
+    path = DataDir(data_dir).city.tiles_json
+    if not path.exists():
+        return frozenset()
+    return frozenset(json.loads(path.read_text()).get("tiles", {}))
+
+
 def get_scene(data_dir, tile: str, cache_size: int = 8, n_threads: int | None = None) -> Scene:
     """The :class:`Scene` of a tile, from a bounded LRU cache of this process.
 
     Loads ``city/meshes/<tile>.npz`` and builds the BVH on a miss; each build is counted in
     :data:`BVH_BUILDS` under the key ``(data_dir, tile)``.  *n_threads* sets the ray-casting
-    threads of a new scene (default: the cores available).
+    threads of a new scene (default: the cores available).  A tile the city model has no
+    mesh for (no modelled surface within the buffer: a line that leaves the model) is an
+    open field: a scene without surfaces, the sky unobstructed.
+
+    Raises
+    ------
+    InputError
+        When ``city/tiles.json`` lists the tile but its mesh file is missing (a damaged
+        data dir: ingest the city again).
     """
     key = (str(Path(data_dir).resolve()), tile)
     with _cache_lock:
@@ -203,7 +222,17 @@ def get_scene(data_dir, tile: str, cache_size: int = 8, n_threads: int | None = 
         if scene is not None:
             _cache.move_to_end(key)
             return scene
-    scene = Scene(TileMesh.load(DataDir(data_dir).city.mesh(tile)), n_threads=n_threads)
+    path = DataDir(data_dir).city.mesh(tile)
+    if path.exists():
+        mesh = TileMesh.load(path)
+    elif tile in modelled_tiles(data_dir):
+        from ..errors import InputError
+
+        raise InputError(f"{path}: missing, though {DataDir(data_dir).city.tiles_json} lists tile "
+                         f"{tile}; run `vipvflow ingest city` again")
+    else:
+        mesh = box_mesh([], name=tile)
+    scene = Scene(mesh, n_threads=n_threads)
     with _cache_lock:
         BVH_BUILDS[key] += 1
         _cache[key] = scene

@@ -228,7 +228,77 @@ def fig_cycles(monthly: pd.DataFrame):
     fig, ax = plt.subplots(figsize=(8, 3.5))
     ax.bar(_months(monthly["month"]).strftime("%b"), monthly["avoided_charging_cycles"], color="#0f9d58")
     ax.set_ylabel("avoided charging cycles (fleet)")
-    ax.set_title("Charging cycles avoided by PV (usable SoC window)")
+    ax.set_title("Charging cycles PV saves the chargers (the battery's balance)")
+    return fig
+
+
+def fig_balance(monthly: pd.DataFrame):
+    """Per month: the PV the batteries take and the PV curtailed (battery full), and the
+    block-days the charging plan cannot serve."""
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(9.5, 3.8))
+    x = np.arange(len(monthly))
+    usable = monthly["pv_kwh_usable"].to_numpy(float) / 1000.0
+    curtailed = monthly["pv_kwh_curtailed"].to_numpy(float) / 1000.0
+    ax.bar(x, usable, 0.6, color="#4285f4", label="taken by the batteries")
+    ax.bar(x, curtailed, 0.6, bottom=usable, color="#c8c8c8", label="curtailed (battery full)")
+    ax.set_xticks(x, _months(monthly["month"]).strftime("%b"))
+    ax.set_ylabel("PV energy (MWh)")
+    bad = monthly["block_days_infeasible"].to_numpy(float)
+    ax2 = ax.twinx()
+    ax2.plot(x, bad, "o-", color="#d62728", label="block-days the plan cannot serve")
+    ax2.set_ylabel("infeasible block-days", color="#d62728")
+    ax2.set_ylim(0, max(1.0, bad.max() * 1.2))
+    h1, l1 = ax.get_legend_handles_labels()
+    h2, l2 = ax2.get_legend_handles_labels()
+    ax.legend(h1 + h2, l1 + l2, loc="upper left", bbox_to_anchor=(1.08, 1.0), fontsize=8)
+    ax.set_title(f"The batteries' month: PV taken and curtailed; block-days not served "
+                 f"({int(bad.sum())} in all)", fontsize=10)
+    return fig
+
+
+def fig_soc(traces: pd.DataFrame, soc_min: float):
+    """The SoC through a typical and the worst block-day, with PV and without, under the
+    charging plan (``traces`` from the reduce: ``which, block_id, service_date, t_utc,
+    soc_pv, soc_nopv``)."""
+    plt = _pyplot()
+    fig, axes = plt.subplots(1, 2, figsize=(12, 3.8), sharey=True)
+    for ax, which in zip(axes, ("typical", "worst")):
+        t = traces[traces["which"] == which]
+        if t.empty:
+            ax.set_visible(False)
+            continue
+        hours = (t["t_utc"].to_numpy(float) - t["t_utc"].min()) / 3600.0
+        ax.plot(hours, 100 * t["soc_nopv"], color="#7f7f7f", label="without PV")
+        ax.plot(hours, 100 * t["soc_pv"], color="#ff7f0e", label="with PV")
+        ax.axhline(100 * soc_min, color="#d62728", ls="--", lw=1, label="SoC minimum")
+        first = pd.Timestamp(t["t_utc"].min(), unit="s", tz="UTC")
+        ax.set_xlabel(f"hours after the first departure ({first:%H:%M} UTC)")
+        ax.set_title(f"{which} block-day: {t['block_id'].iloc[0]}, "
+                     f"{pd.Timestamp(t['service_date'].iloc[0]):%Y-%m-%d}", fontsize=10)
+    axes[0].set_ylabel("state of charge (%)")
+    axes[0].legend(loc="lower left", fontsize=8)
+    fig.suptitle("Battery state of charge through the day, under the charging plan")
+    return fig
+
+
+def fig_ranking(ranking: pd.DataFrame, top: int = 12):
+    """The blocks and routes where PV saves the most grid energy per kWp (and their payback)."""
+    plt = _pyplot()
+    fig, axes = plt.subplots(1, 2, figsize=(12, 4.2))
+    for ax, kind in zip(axes, ("block", "route")):
+        r = ranking[ranking["kind"] == kind].sort_values("rank").head(top)
+        if r.empty:
+            ax.set_visible(False)
+            continue
+        y = np.arange(len(r))[::-1]
+        ax.barh(y, r["kwh_avoided_per_kwp_year"], color="#0f9d58")
+        ax.set_yticks(y, [f"{n} ({'never' if not np.isfinite(p) else f'{p:.1f} y'})"
+                          for n, p in zip(r["name"], r["payback_years"])], fontsize=8)
+        ax.set_xlabel("grid energy avoided (kWh per kWp and year)")
+        ax.set_title(f"{kind}s: where PV pays first (payback)", fontsize=10)
+    fig.suptitle("Which buses to equip: grid energy avoided per installed kWp")
+    fig.tight_layout()
     return fig
 
 
@@ -246,22 +316,28 @@ def fig_hourly(hp: pd.DataFrame):
     return fig
 
 
-def fig_routes(rm: pd.DataFrame):
+def fig_routes(rm: pd.DataFrame, coverage: float | None = None):
+    """Per route and direction: the driving PV's share of the trips' consumption
+    (coverage_driving) and the shading loss; the fleet's headline coverage in the title."""
     plt = _pyplot()
-    r = rm.groupby(["route_short_name", "direction_id"]).agg(
+    r = rm.groupby(["route_short_name", "direction_id"], dropna=False).agg(
         trips=("trips", "sum"), pv_kwh=("pv_kwh", "sum"), consumption_kwh=("consumption_kwh", "sum"),
         pv_kwh_unshaded=("pv_kwh_unshaded", "sum"), pv_kwh_direct=("pv_kwh_direct", "sum"),
         pv_kwh_diffuse=("pv_kwh_diffuse", "sum")).reset_index()
     labels = [f"{a} / dir {b}" for a, b in zip(r["route_short_name"], r["direction_id"])]
     fig, ax = plt.subplots(1, 2, figsize=(10, 3.8))
     ax[0].bar(labels, 100 * r["pv_kwh"] / r["consumption_kwh"], color="#4285f4")
-    ax[0].set_ylabel("PV share of consumption (%)")
+    ax[0].set_ylabel("driving PV / trips' consumption (%)")
     ax[1].bar(labels, 100 * shading_loss(r["pv_kwh_direct"], r["pv_kwh_diffuse"], r["pv_kwh_unshaded"]),
               color="#db4437")
     ax[1].set_ylabel("shading loss (%)")
     for a in ax:
         a.tick_params(axis="x", rotation=30)
-    fig.suptitle("Route comparison")
+    title = "Route comparison (driving)"
+    if coverage is not None:
+        title += (f"; the fleet: the PV the batteries take covers {100 * coverage:.2f} % "
+                  "of the demand in service")
+    fig.suptitle(title, fontsize=11)
     return fig
 
 
@@ -279,22 +355,27 @@ _SECTIONS = {
     },
     "PV yield": {
         "kwp_per_bus": "PV installed per bus",
-        "kwh_per_kwp_allsky": "specific yield while driving, all-sky",
-        "kwh_per_kwp_clearsky": "specific yield while driving, clear-sky",
-        "kwh_per_kwp_in_service": "specific yield in service (driving + layovers), all-sky",
-        "kwh_per_kwp_whole_day": "specific yield over the whole day (+ parked), all-sky",
+        "kwh_per_kwp_usable": "specific yield the batteries take (all-sky)",
+        "kwh_per_kwp_harvested": "specific yield harvested (fleet.harvest's time)",
+        "kwh_per_kwp_driving": "of which while driving, all-sky",
+        "kwh_per_kwp_driving_clearsky": "while driving, clear-sky",
+        "kwh_per_kwp_in_service": "in service (driving + layovers), all-sky",
+        "kwh_per_kwp_whole_day": "over the whole day (+ parked), all-sky",
+        "pv_kwh_usable": "PV energy the batteries take",
+        "pv_kwh_curtailed": "PV energy the batteries could not take (curtailed)",
+        "pv_kwh_driving": "PV energy while driving, all-sky",
         "pv_kwh_layover": "PV energy at terminals between trips",
         "pv_kwh_parked": "PV energy parked at the depot",
-        "pv_kwh_curtailed": "PV energy the batteries could not take (curtailed)",
-        "pv_kwh_allsky": "PV energy of the fleet, all-sky",
-        "pv_kwh_clearsky": "the same under a cloudless sky",
-        "pv_kwh_allsky_unshaded": "the same, all-sky, without buildings",
+        "pv_kwh_driving_clearsky": "PV energy while driving, under a cloudless sky",
+        "pv_kwh_driving_unshaded": "PV energy while driving, all-sky, without buildings",
     },
     "Buildings": {
         "shading_loss_allsky": "shading loss, all-sky",
         "shading_loss_clearsky": "shading loss, clear-sky",
         "reflection_gain_allsky": "gain from reflections, all-sky",
         "net_building_effect_allsky": "net effect of the buildings, all-sky",
+        "route_km_in_city_model_share": "route-km inside the city model",
+        "shading_loss_allsky_in_city_model": "shading loss inside the city model, all-sky",
     },
     "Light": {
         "site_ghi_kwh_m2_year": "global horizontal irradiation of the site",
@@ -302,13 +383,26 @@ _SECTIONS = {
         "roof_irradiation_unshaded_kwh_m2_per_bus": "on a bus roof, without buildings",
         "roof_irradiation_kwh_m2_per_bus": "on a bus roof, with buildings",
     },
+    "Battery and charging plan": {
+        "fleet_demand_in_service_mwh": "battery energy the fleet uses in service (trips and layovers)",
+        "coverage": "share of it the PV the batteries take covers",
+        "fleet_demand_driving_mwh": "battery energy of the trips alone",
+        "coverage_driving": "share of it the driving PV covers (the paper's accounting)",
+        "block_days": "block-days (a bus's day of service)",
+        "block_days_infeasible": "block-days the charging plan cannot serve, with PV",
+        "block_days_infeasible_without_pv": "the same without PV",
+        "soc_lowest_pv": "lowest state of charge of any block-day, with PV",
+        "grid_kwh_avoided": "grid energy PV avoids at the chargers",
+        "grid_kwh_avoided_depot": "of which at the depot",
+        "grid_kwh_avoided_opportunity": "of which at the terminals",
+    },
     "Energy and cost": {
-        "fleet_demand_mwh": "battery energy the fleet uses",
-        "coverage": "share of it the roofs supply",
-        "avoided_charging_cycles_fleet": "charging cycles avoided, fleet",
-        "avoided_charging_cycles_per_bus": "charging cycles avoided per bus",
+        "avoided_charging_cycles_fleet": "charging cycles avoided, fleet (the battery's balance)",
+        "avoided_charging_cycles_per_bus": "charging cycles avoided per bus (the battery's balance)",
+        "avoided_charging_cycles_per_bus_paper": "the same by the paper's formula (PV taken / cycle)",
         "system_cost_eur_per_bus": "PV system cost per bus",
-        "payback_years": "simple payback",
+        "payback_years": "simple payback (grid energy avoided x tariff)",
+        "payback_years_paper": "the same from the PV the batteries take (the paper's)",
     },
     "Model": {
         "pv_mode": "PV model",
@@ -317,8 +411,9 @@ _SECTIONS = {
     },
 }
 #: decimals of the table's values where the default (0; 1 for a percentage) would hide them
-_DECIMALS = {"kwp_per_bus": 2, "coverage": 2, "avoided_charging_cycles_per_bus": 1,
-             "payback_years": 1}
+_DECIMALS = {"kwp_per_bus": 2, "coverage": 2, "coverage_driving": 2,
+             "avoided_charging_cycles_per_bus": 1, "avoided_charging_cycles_per_bus_paper": 1,
+             "payback_years": 1, "payback_years_paper": 1, "soc_lowest_pv": 1}
 #: how a data-dictionary unit reads in the table (sums over the run say so)
 _UNIT_SHOWN = {"count": "", "fraction": "%", "kWh": "kWh (simulated months)",
                "h": "h (simulated months)"}
@@ -391,14 +486,20 @@ def _how_to_read(summary: dict) -> str:
         "(10 m by default) a bus passes, vipvflow computes the sun and sky light on the roof from CAMS radiation, with the "
         "3D city model's buildings casting shadows, hiding sky and reflecting light, and turns it "
         "into PV energy. <b>Specific yield</b> is the PV energy per installed kWp in a year: "
-        f"{_fmt(s.get('kwh_per_kwp_allsky'), 0)} kWh/kWp here under the real (all-sky) weather, "
-        f"{_fmt(s.get('kwh_per_kwp_clearsky'), 0)} under a cloudless sky, counting the minutes "
-        "the buses drive their trips. The roof keeps harvesting while a bus stands at a terminal "
+        f"{_fmt(s.get('kwh_per_kwp_usable'), 0)} kWh/kWp is what the batteries take, the figure "
+        "coverage, cycles and payback rest on. The roofs harvest "
+        f"{_fmt(s.get('kwh_per_kwp_driving'), 0)} kWh/kWp under the real (all-sky) weather "
+        f"({_fmt(s.get('kwh_per_kwp_driving_clearsky'), 0)} under a cloudless sky) in the minutes "
+        "the buses drive their trips, and keep harvesting while a bus stands at a terminal "
         "between trips and while it is parked: "
         f"{_fmt(s.get('kwh_per_kwp_in_service'), 0)} kWh/kWp in service (driving and layovers) and "
         f"{_fmt(s.get('kwh_per_kwp_whole_day'), 0)} over the whole day (fleet.harvest: "
-        f"{html.escape(str(s.get('harvest', 'driving')))}); coverage, cycles and payback use what the "
-        "batteries can take. A bus roof is partly in the streets' shade, so it collects "
+        f"{html.escape(str(s.get('harvest', 'driving')))}); a full battery takes nothing, so "
+        "some of it is curtailed. Each bus's day is run through its battery under the charging "
+        "plan (depot, terminals): the grid energy PV saves there gives the avoided charging "
+        f"cycles and the payback, and {_fmt(s.get('block_days_infeasible'))} of "
+        f"{_fmt(s.get('block_days'))} block-days cannot be served by the plan (the SoC would "
+        "fall below its minimum). A bus roof is partly in the streets' shade, so it collects "
         "less than a fixed panel at the site would. The <b>shading loss</b> "
         f"({pct('shading_loss_allsky')} %) is the direct and sky light the buildings take away; the "
         f"light they reflect onto the roof is counted apart ({pct('reflection_gain_allsky')} %). "
@@ -482,20 +583,35 @@ def add_hourly(figures: Figures, hp) -> None:
     figures.add("hourly_pattern", "Daily irradiance pattern by hour and month", fig_hourly, hp)
 
 
-def add_routes(figures: Figures, rm) -> None:
-    """Start the chart comparing the routes (*rm*: ``route_month``)."""
-    figures.add("routes", "Route comparison", fig_routes, rm)
+def add_routes(figures: Figures, rm, coverage: float | None = None) -> None:
+    """Start the chart comparing the routes (*rm*: ``route_month``; *coverage*: the fleet's)."""
+    figures.add("routes", "Route comparison", fig_routes, rm, coverage)
+
+
+def add_battery(figures: Figures, traces, soc_min: float) -> None:
+    """Start the chart of the SoC through a typical and the worst block-day."""
+    figures.add("soc_day", "Battery state of charge: a typical and the worst block-day", fig_soc,
+                traces, soc_min)
+
+
+def add_ranking(figures: Figures, ranking) -> None:
+    """Start the chart of the blocks and routes where PV pays first (``ranking.parquet``)."""
+    figures.add("ranking", "Which buses to equip: grid energy avoided per kWp, and payback",
+                fig_ranking, ranking)
 
 
 def add_charts(figures: Figures, summary: dict, monthly) -> None:
     """Start the charts of the fleet's months (*monthly*, *summary*)."""
     figures.add("monthly_yield", ("Monthly yield: driving, in service and whole day (all-sky), "
                                   "with the shading loss on the road"), fig_monthly, monthly, summary)
+    figures.add("battery_month", "PV the batteries take and curtail, and block-days not served, "
+                "per month", fig_balance, monthly)
     figures.add("avoided_cycles", "Avoided charging cycles per month", fig_cycles, monthly)
 
 
 #: the figures in the report's order
-FIGURE_ORDER = ("monthly_yield", "map_yield", "map_shading", "avoided_cycles", "hourly_pattern", "routes")
+FIGURE_ORDER = ("monthly_yield", "battery_month", "soc_day", "ranking", "map_yield", "map_shading",
+                "avoided_cycles", "hourly_pattern", "routes")
 
 
 def write_report(run_dir: Path, summary: dict, figures: list[tuple[str, str, bytes]], cfg=None,
@@ -530,10 +646,39 @@ p{{line-height:1.45;max-width:900px}}</style></head><body>
 <h1>Bus-roof PV, fleet-year: {html.escape(title)}</h1>
 <p>{html.escape(_model_note(summary))}</p>
 <h2>How to read this</h2>{_how_to_read(summary)}
+<h2>The charging plan</h2>{_plan_note(cfg, summary)}
 <h2>Summary</h2>{summary_table(summary)}
 <h2>Inputs</h2>{_inputs_table(cfg, crs, len(tiles) if tiles else None)}
 {''.join(parts)}</body></html>"""
     return write_text(doc, RunDir(run_dir).report)
+
+
+def _plan_note(cfg, summary: dict) -> str:
+    """The charging plan the battery's balance ran under, and the block-days it cannot serve."""
+    parts = []
+    if cfg is not None:
+        d, o = cfg.charging.depot, cfg.charging.opportunity
+        hours = "whenever parked" if d.hours is None else f"from {d.hours[0]:g} h to {d.hours[1]:g} h"
+        parts.append(f"Depot: {d.power_kw:g} kW per bus, {hours}, efficiency {d.efficiency:g}, "
+                     f"to SoC {_fmt(d.target_soc, 2) if d.target_soc is not None else 'soc_max'}.")
+        if o.terminals is None:
+            parts.append("No charging at terminals.")
+        else:
+            where = "every terminal" if o.terminals == "all" else "terminals " + ", ".join(o.terminals)
+            parts.append(f"Terminals: {o.power_kw:g} kW at {where}, during layovers of at least "
+                         f"{o.min_layover_min:g} min ({o.connect_min:g} min to dock), efficiency "
+                         f"{o.efficiency:g}.")
+    n_bad = summary.get("block_days_infeasible", 0)
+    if n_bad:
+        first = "; ".join(summary.get("infeasible_block_days_first") or [])
+        parts.append(f"<b>{n_bad} of {summary.get('block_days')} block-days cannot be served</b> "
+                     f"under this plan (first: {html.escape(first)}); block_day.parquet "
+                     "(feasible, infeasible_at_utc, infeasible_soc) lists them all.")
+    else:
+        parts.append(f"The plan serves all {summary.get('block_days')} block-days.")
+    parts.append("ranking.parquet ranks the blocks and routes by the grid energy PV avoids per "
+                 "kWp, with the payback of one bus's system.")
+    return "<p>" + " ".join(parts) + "</p>"
 
 
 def _model_note(summary: dict) -> str:

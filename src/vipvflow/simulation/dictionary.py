@@ -55,9 +55,9 @@ _PV = {
     "pv_kwh_driving": "PV energy while driving timetabled trips (whole-day model)",
     "pv_kwh_layover": "PV energy while standing at terminals between trips (whole-day model)",
     "pv_kwh_parked": "PV energy while parked out of service, e.g. at the depot (whole-day model)",
-    "pv_kwh_curtailed": "PV energy the battery could not take (full), lost (whole-day model)",
-    "pv_kwh_whole_day": "PV energy over the whole day: driving + layover + parked (whole-day model)",
-    "pv_kwh_usable": "PV energy the battery takes: pv_kwh_whole_day - pv_kwh_curtailed (whole-day model)",
+    "pv_kwh_curtailed": "PV energy the battery could not take (at its SoC ceiling), lost",
+    "pv_kwh_whole_day": "PV energy over the whole day: driving + layover + parked (0 where fleet.harvest does not count them)",
+    "pv_kwh_usable": "PV energy the battery takes: pv_kwh_whole_day - pv_kwh_curtailed",
     "pv_kwh_clear_layover": "clear-sky PV energy while standing at terminals between trips",
     "pv_kwh_clear_parked": "clear-sky PV energy while parked out of service",
 }
@@ -79,7 +79,12 @@ COLUMNS: dict[str, Column] = {
     "month": Column("date", "month, as its first day (local calendar of the feed)"),
     "hour": Column("h", "local clock hour, 0..23 (hour starting then)"),
     "route_id": Column("", "GTFS route_id"),
-    "route_short_name": Column("", "GTFS route_short_name (the line's public name)"),
+    "route_short_name": Column("", "GTFS route_short_name (the line's public name; its long name, "
+                                   "else its route_id, when the feed gives none); on a segment: "
+                                   "every route that drives it, sorted, joined by ', '"),
+    "route_long_name": Column("", "GTFS route_long_name (empty when the feed gives none)"),
+    "trip_headsign": Column("", "GTFS trip_headsign: where the trip goes (per route and "
+                                "direction: the most frequent)"),
     "direction_id": Column("", "GTFS direction_id (0 or 1)"),
     "service_id": Column("", "GTFS service_id (the trip's calendar)"),
     "block_id": Column("", "GTFS block_id: one vehicle's sequence of trips in a day"),
@@ -104,13 +109,35 @@ COLUMNS: dict[str, Column] = {
                                        "buildings take away (reflections not counted; see reflection_gain)"),
     "shading_loss_clear": Column("fraction", "shading_loss under clear sky"),
     "reflection_gain": Column("fraction", "reflected / total_unshaded, all-sky: light the buildings add"),
-    "avoided_charging_cycles": Column("cycles", "pv_kwh / (battery capacity x usable SoC window), fleet"),
+    "avoided_charging_cycles": Column("cycles", "battery energy the chargers need not put in (the "
+                                                "battery's balance) / (battery capacity x the economics "
+                                                "SoC window), fleet"),
     "layover_aux_kwh": Column("kWh", "auxiliaries and HVAC drawn from the battery during the layovers "
                                      "(month's mean temperature, discharge efficiency)"),
-    "demand_kwh": Column("kWh", "battery energy the block-day needs: trips' consumption_kwh + layover_aux_kwh"),
-    "soc_end_pv": Column("fraction", "battery state of charge at the end of the block-day with PV "
-                                     "(starting full at the SoC ceiling; below soc_min: the block overruns "
-                                     "the battery's window)"),
+
+    "soc_start": Column("fraction", "battery state of charge at the block-day's first departure: the "
+                                    "depot charge's target (charging.depot.target_soc)"),
+    "soc_end_pv": Column("fraction", "state of charge at the block-day's last arrival, with PV, under the "
+                                     "charging plan (never below 0)"),
+    "soc_lowest_pv": Column("fraction", "lowest state of charge of the block-day with PV (never below 0)"),
+    "soc_lowest_nopv": Column("fraction", "the same without PV"),
+    "feasible": Column("", "true when the charging plan serves the block-day with PV: the SoC stays at "
+                           "or above the vehicle's soc_min and the depot restores the morning's SoC"),
+    "feasible_without_pv": Column("", "the same without PV"),
+    "infeasible_at_utc": Column("UTC", "when the SoC (with PV) crosses soc_min, linear in time within the "
+                                       "trip or layover; null when it never does"),
+    "infeasible_soc": Column("fraction", "SoC (with PV) at the end of the trip or layover where it falls "
+                                         "below soc_min"),
+    "depot_short_kwh": Column("kWh", "battery energy the depot's charging hours cannot restore before "
+                                     "the next morning (with PV)"),
+    "grid_kwh_depot": Column("kWh", "grid energy of the depot charge with PV (at the charger: battery "
+                                    "energy / charging.depot.efficiency)"),
+    "grid_kwh_depot_without_pv": Column("kWh", "the same without PV"),
+    "grid_kwh_opportunity": Column("kWh", "grid energy of the charges at terminals during layovers, with PV"),
+    "grid_kwh_opportunity_without_pv": Column("kWh", "the same without PV"),
+    "grid_kwh_avoided": Column("kWh", "grid energy PV saves: (depot + terminals) without PV - with PV"),
+    "soc_at_departure": Column("fraction", "the trip's battery state of charge at departure in its "
+                                           "block-day's balance with PV (the web app starts from it)"),
     "window_start_utc": Column("s (Unix)", "start of the block-day's time window (its GTFS service day)"),
     "window_end_utc": Column("s (Unix)", "end of the block-day's time window (stretched to the last "
                                          "arrival past the service day)"),
@@ -121,8 +148,15 @@ COLUMNS: dict[str, Column] = {
     "seconds_driving": Column("s", "time on trips (first departure to last arrival of each trip)"),
     "seconds_layover": Column("s", "time standing at terminals between the block's trips"),
     "seconds_parked": Column("s", "time parked at the depot before the first and after the last trip"),
-    "kwh_per_kwp_allsky": Column("kWh/kWp", "all-sky PV energy per installed kWp of the fleet (specific yield)"),
-    "kwh_per_kwp_clearsky": Column("kWh/kWp", "clear-sky PV energy per installed kWp of the fleet"),
+    "kwh_per_kwp_driving": Column("kWh/kWp", "all-sky PV energy while driving per installed kWp of the fleet"),
+    "kwh_per_kwp_driving_clearsky": Column("kWh/kWp", "clear-sky PV energy while driving per installed kWp"),
+    "kwh_per_kwp_usable": Column("kWh/kWp", "PV energy the batteries take per installed kWp of the fleet"),
+    "demand_kwh": Column("kWh", "battery energy the block-days need in service: trips' consumption_kwh + "
+                                "layover_aux_kwh"),
+    "block_days": Column("count", "block-days (vehicle block x service date)"),
+    "block_days_infeasible": Column("count", "block-days the charging plan cannot serve (with PV)"),
+    "grid_kwh_avoided_depot": Column("kWh", "grid energy PV saves at the depot"),
+    "grid_kwh_avoided_opportunity": Column("kWh", "grid energy PV saves at the terminals"),
     # segment geometry (gtfs/segments.parquet)
     "x": Column("m", "segment start, easting in the city CRS"),
     "y": Column("m", "segment start, northing in the city CRS"),
@@ -131,6 +165,21 @@ COLUMNS: dict[str, Column] = {
     "y_end": Column("m", "segment end, northing"),
     "z_end": Column("m", "roof height at the segment end"),
     "ground_z": Column("m", "ground (terrain) height at the segment start"),
+    "ground_source": Column("", "where ground_z comes from: 'relief' (the city model's TIN), "
+                                "'buildings' (its buildings' ground surfaces within 100 m, blended "
+                                "with the fallback), 'radiation_header' (the CAMS file's altitude) or "
+                                "'configured' (trajectory.ground_elevation_m): the last two are roads "
+                                "more than 100 m from any building of the model"),
+    "in_city_model": Column("", "true when the segment's midpoint lies in the area the city model "
+                                "covers (its buildings' footprints closed by 60 m and widened by 20 m); "
+                                "outside it the road is computed under the open sky"),
+    "in_building": Column("", "true when the segment's midpoint lies inside a building footprint "
+                              "(a straight line between stops of a feed without shapes): its light is "
+                              "taken at light_dx_m, light_dy_m from the midpoint, outside the block, "
+                              "and it is left out of the summary's shading statistics"),
+    "light_dx_m": Column("m", "easting offset of the point the segment's light is taken from "
+                              "(0 unless in_building)"),
+    "light_dy_m": Column("m", "northing offset of that point (0 unless in_building)"),
     "heading_deg": Column("deg", "driving direction, clockwise from grid north"),
     "gradient": Column("m/m", "road gradient dz/ds of the ground (positive uphill)"),
     "length_m": Column("m", "segment length along the shape"),
@@ -182,14 +231,18 @@ _WHOLE_DAY = "pv_kwh_driving pv_kwh_layover pv_kwh_parked pv_kwh_curtailed"
 OUTPUTS: dict[str, Output] = {
     "trip_energy": _out(
         "PV and consumption per trip", "one row per trip and service date",
-        f"trip_id service_date month route_id route_short_name direction_id shape_id service_id "
+        f"trip_id service_date month route_id route_short_name route_long_name trip_headsign "
+        f"direction_id shape_id service_id "
         f"block_id pattern_id start_s seconds {_PVS} consumption_kwh consumption_source "
-        f"traction_kwh recuperated_kwh aux_kwh coverage"),
+        f"traction_kwh recuperated_kwh aux_kwh coverage soc_at_departure",
+        coverage=Column("fraction", "pv_kwh / consumption_kwh: the trip's driving PV over its own "
+                                    "consumption")),
     "segments": _out(
         "The network's segments, their geometry factors and their year (GeoParquet)",
         "one row per segment of the simulated routes (about 10 m of road); totals over the run's months",
         f"segment_id shape_id route_short_name direction_id seg_index tile geometry x y z x_end y_end "
-        f"z_end ground_z heading_deg gradient length_m cum_dist_m tilt_deg azimuth_deg svf refl_vf "
+        f"z_end ground_z ground_source heading_deg gradient length_m cum_dist_m in_city_model "
+        f"in_building light_dx_m light_dy_m tilt_deg azimuth_deg svf refl_vf "
         f"n_passes seconds pv_kwh pv_kwh_unshaded h_total h_total_unshaded g_total_in_service "
         f"g_total_unshaded_in_service shading_loss reflection_gain kwh_per_kwp_year "
         f"irradiation_kwh_m2_year"),
@@ -199,20 +252,51 @@ OUTPUTS: dict[str, Output] = {
         f"{_PVS} {_HS} shading_loss shading_loss_clear reflection_gain"),
     "route_month": _out(
         "Routes per direction and month", "one row per route, direction and month",
-        f"route_id route_short_name direction_id month trips seconds {_PVS} {_WHOLE_DAY} "
-        f"consumption_kwh coverage shading_loss"),
+        f"route_id route_short_name route_long_name direction_id trip_headsign month trips seconds "
+        f"{_PVS} {_WHOLE_DAY} pv_kwh_usable consumption_kwh coverage shading_loss",
+        coverage=Column("fraction", "pv_kwh / consumption_kwh: the driving PV over the trips' "
+                                    "consumption (coverage_driving of the route)"),
+        pv_kwh_layover=Column("kWh", "PV at layovers of the block-days serving the route, shared by "
+                                     "the trips' time in each block-day"),
+        pv_kwh_parked=Column("kWh", "PV parked at the depot on those block-days, shared the same way"),
+        pv_kwh_curtailed=Column("kWh", "PV curtailed on those block-days, shared the same way"),
+        pv_kwh_usable=Column("kWh", "PV the batteries take on those block-days, shared the same way")),
     "block_day": _out(
         "Vehicles per day", "one row per vehicle block and service date",
         f"block_id service_date month trips window_start_utc window_end_utc first_departure_utc "
         f"last_arrival_utc overlap_s pv_kwh pv_kwh_clear consumption_kwh first_departure_s "
         f"pv_kwh_driving seconds_driving pv_kwh_layover pv_kwh_clear_layover seconds_layover "
         f"pv_kwh_parked pv_kwh_clear_parked seconds_parked pv_kwh_whole_day window_s layover_aux_kwh "
-        f"demand_kwh pv_kwh_curtailed pv_kwh_usable soc_end_pv"),
+        f"demand_kwh soc_start soc_lowest_pv soc_end_pv soc_lowest_nopv feasible feasible_without_pv "
+        f"infeasible_at_utc infeasible_soc depot_short_kwh pv_kwh_curtailed grid_kwh_depot "
+        f"grid_kwh_depot_without_pv grid_kwh_opportunity grid_kwh_opportunity_without_pv "
+        f"grid_kwh_avoided pv_kwh_usable"),
     "monthly": _out(
         "The fleet per month", "one row per month, the whole fleet",
-        f"month trips {_PVS} {_WHOLE_DAY} pv_kwh_whole_day pv_kwh_usable layover_aux_kwh "
-        f"consumption_kwh shading_loss avoided_charging_cycles "
-        f"kwh_per_kwp_allsky kwh_per_kwp_clearsky"),
+        f"month trips {_PVS} consumption_kwh shading_loss {_WHOLE_DAY} pv_kwh_usable layover_aux_kwh "
+        f"demand_kwh grid_kwh_avoided grid_kwh_avoided_depot grid_kwh_avoided_opportunity block_days "
+        f"block_days_infeasible pv_kwh_whole_day avoided_charging_cycles coverage kwh_per_kwp_usable "
+        f"kwh_per_kwp_driving kwh_per_kwp_driving_clearsky",
+        coverage=Column("fraction", "pv_kwh_usable / demand_kwh: the month's share of the demand in "
+                                    "service the PV the batteries take covers")),
+    "ranking": _out(
+        "Which buses to equip: blocks and routes by grid energy avoided per kWp",
+        "one row per vehicle block and per route",
+        "kind id name block_days grid_kwh_avoided_per_year pv_kwh_usable_per_year "
+        "kwh_avoided_per_kwp_year payback_years rank",
+        kind=Column("", "'block' (a bus's daily duty) or 'route'"),
+        id=Column("", "block_id or route_id"),
+        name=Column("", "the block's id or the route's route_short_name"),
+        block_days=Column("count", "block-days of the block in the run; for a route, bus-days it takes "
+                                   "(the trips' share of their block-days' time)"),
+        grid_kwh_avoided_per_year=Column("kWh per year", "grid energy one bus's PV avoids in a year on "
+                                                         "this block (its block-days scaled to a year) or "
+                                                         "route (per bus it keeps busy)"),
+        pv_kwh_usable_per_year=Column("kWh per year", "PV the battery takes, the same way"),
+        kwh_avoided_per_kwp_year=Column("kWh/kWp per year", "grid_kwh_avoided_per_year per installed kWp"),
+        payback_years=Column("years", "simple payback of one bus's PV system from the grid energy it "
+                                      "avoids (inf: it avoids none)"),
+        rank=Column("", "1: the most grid energy avoided per kWp, within its kind")),
     "hourly_pattern": _out(
         "Daily pattern by hour and month", "one row per month and local clock hour, the whole fleet",
         f"month hour seconds {_HS} {_GS}",
@@ -232,12 +316,15 @@ SUMMARY: dict[str, Column] = {
     "segments": Column("count", "segments of the simulated routes"),
     "passes": Column("count", "segment passes evaluated"),
     "kwp_per_bus": Column("kWp", "installed PV per bus"),
-    "pv_kwh_allsky": Column("kWh", "fleet PV energy over the simulated months, all-sky, with buildings"),
-    "pv_kwh_clearsky": Column("kWh", "the same, clear-sky"),
-    "pv_kwh_allsky_unshaded": Column("kWh", "the same, all-sky, without buildings"),
+    "pv_kwh_driving_clearsky": Column("kWh", "fleet PV energy while driving over the simulated months, "
+                                             "clear-sky, with buildings"),
+    "pv_kwh_driving_unshaded": Column("kWh", "the same all-sky, without buildings"),
     "annualised_from_months": Column("", "true when the yearly figures are scaled by 12 / months"),
-    "kwh_per_kwp_allsky": Column("kWh/kWp per year", "specific yield of the fleet, all-sky"),
-    "kwh_per_kwp_clearsky": Column("kWh/kWp per year", "specific yield of the fleet, clear-sky"),
+    "kwh_per_kwp_usable": Column("kWh/kWp per year", "specific yield the batteries take (the headline: "
+                                                     "harvested PV minus what a full battery curtails)"),
+    "kwh_per_kwp_harvested": Column("kWh/kWp per year", "specific yield harvested in the time "
+                                                        "fleet.harvest counts"),
+    "kwh_per_kwp_driving_clearsky": Column("kWh/kWp per year", "specific yield while driving, clear-sky"),
     "irradiation_kwh_m2": Column("kWh/m2", "per component: light on the roofs summed over every pass of "
                                            "every bus in the simulated months - a fleet total, not a site "
                                            "figure (see roof_irradiation_kwh_m2_per_bus, site_ghi_kwh_m2_year)"),
@@ -250,7 +337,8 @@ SUMMARY: dict[str, Column] = {
                                                       "calendar year (CAMS radiation file; mean of its "
                                                       "locations); null when the file covers less than 99 %"),
     "service_hours_per_bus_year": Column("h per year", "time a bus spends on its trips in a year"),
-    "shading_loss_allsky": Column("fraction", "1 - (direct + diffuse) / unshaded light on the roofs, all-sky"),
+    "shading_loss_allsky": Column("fraction", "1 - (direct + diffuse) / unshaded light on the roofs, all-sky "
+                                              "(segments inside building footprints left out)"),
     "shading_loss_clearsky": Column("fraction", "the same, clear-sky"),
     "reflection_gain_allsky": Column("fraction", "reflected / unshaded light, all-sky"),
     "net_building_effect_allsky": Column("fraction", "light with buildings / without - 1 (shading and "
@@ -258,21 +346,49 @@ SUMMARY: dict[str, Column] = {
     "unshaded_to_ghi_allsky": Column("ratio", "unshaded roof light / GHI at the same times, all-sky"),
     "unshaded_to_ghi_clearsky": Column("ratio", "the same, clear-sky"),
     "reflected_share": Column("fraction", "reflected / total light on the roofs, all-sky"),
-    "fleet_demand_mwh": Column("MWh per year", "battery energy the fleet uses in a year"),
-    "coverage": Column("fraction", "PV energy / battery energy of the fleet"),
-    "avoided_charging_cycles_fleet": Column("cycles per year", "fleet PV energy / usable battery energy"),
+    "fleet_demand_in_service_mwh": Column("MWh per year", "battery energy the fleet uses in service in "
+                                                          "a year: trips and layover auxiliaries"),
+    "fleet_demand_driving_mwh": Column("MWh per year", "battery energy of the trips alone"),
+    "coverage": Column("fraction", "PV the batteries take / fleet_demand_in_service (the headline)"),
+    "coverage_driving": Column("fraction", "PV while driving / the trips' consumption (the paper's "
+                                           "accounting)"),
+    "block_days": Column("count", "block-days (a bus's day of service) in the run"),
+    "block_days_infeasible": Column("count", "block-days the charging plan cannot serve with PV (the SoC "
+                                             "would fall below soc_min, or the depot cannot restore it)"),
+    "block_days_infeasible_without_pv": Column("count", "the same without PV"),
+    "infeasible_block_days_first": Column("", "the first infeasible block-days: block, date and the time "
+                                              "the SoC crosses soc_min"),
+    "soc_lowest_pv": Column("fraction", "lowest state of charge of any block-day, with PV"),
+    "grid_kwh_without_pv": Column("kWh", "grid energy of the depot and terminal chargers without PV, "
+                                         "over the simulated months"),
+    "grid_kwh_avoided": Column("kWh", "grid energy PV saves at the chargers over the simulated months "
+                                      "(the battery's balance with PV against without)"),
+    "grid_kwh_avoided_depot": Column("kWh", "of which at the depot"),
+    "grid_kwh_avoided_opportunity": Column("kWh", "of which at the terminals"),
+    "avoided_charging_cycles_fleet": Column("cycles per year", "battery energy the chargers need not put "
+                                                               "in (the balance) / (battery capacity x the "
+                                                               "economics SoC window), fleet"),
     "avoided_charging_cycles_per_bus": Column("cycles per year", "the same per bus"),
+    "avoided_charging_cycles_per_bus_paper": Column("cycles per year", "the paper's formula: PV the "
+                                                                       "battery takes / (capacity x SoC "
+                                                                       "window), per bus"),
     "system_cost_eur_per_bus": Column("EUR", "PV system cost per bus"),
-    "payback_years": Column("years", "simple payback of one bus's PV system at the configured tariff"),
+    "payback_years": Column("years", "simple payback of one bus's PV system from the grid energy it "
+                                     "avoids at the configured tariff"),
+    "payback_years_paper": Column("years", "the paper's: from the PV the battery takes x the tariff"),
     # the whole day (docs/whole_day.md)
     "harvest": Column("", "fleet.harvest: which time counts (driving | in_service | whole_day)"),
     "depot_shading": Column("", "fleet.depot_shading: open | covered | city"),
-    "pv_kwh_driving": Column("kWh", "fleet PV energy on trips over the simulated months (= pv_kwh_allsky)"),
-    "pv_kwh_layover": Column("kWh", "fleet PV energy at terminals between trips"),
-    "pv_kwh_parked": Column("kWh", "fleet PV energy parked at the depot (idle buses included)"),
-    "pv_kwh_in_service": Column("kWh", "driving + layover"),
-    "pv_kwh_whole_day": Column("kWh", "driving + layover + parked"),
-    "kwh_per_kwp_driving": Column("kWh/kWp per year", "specific yield counting the trips only (the paper's accounting)"),
+    "pv_kwh_driving": Column("kWh", "fleet PV energy on trips over the simulated months, all-sky"),
+    "pv_kwh_layover": Column("kWh", "fleet PV energy at terminals between trips (null: fleet.harvest "
+                                    "does not count it)"),
+    "pv_kwh_parked": Column("kWh", "fleet PV energy parked at the depot, idle buses included (null: not "
+                                   "counted)"),
+    "pv_kwh_in_service": Column("kWh", "driving + layover (null: not counted)"),
+    "pv_kwh_whole_day": Column("kWh", "driving + layover + parked (null: not counted)"),
+    "pv_kwh_harvested": Column("kWh", "PV harvested in the time fleet.harvest counts"),
+    "kwh_per_kwp_driving": Column("kWh/kWp per year", "specific yield counting the trips only (the paper's "
+                                                      "accounting), all-sky"),
     "kwh_per_kwp_in_service": Column("kWh/kWp per year", "specific yield of driving + layovers"),
     "kwh_per_kwp_whole_day": Column("kWh/kWp per year", "specific yield of the whole day (driving, layovers, parked)"),
     "pv_kwh_usable": Column("kWh", "PV energy the batteries take (coverage, cycles and payback use it)"),
@@ -281,6 +397,31 @@ SUMMARY: dict[str, Column] = {
     "layover_hours": Column("h", "fleet time standing at terminals over the simulated months"),
     "parked_hours": Column("h", "fleet time parked at the depot over the simulated months"),
     "layover_aux_kwh": Column("kWh", "auxiliaries and HVAC during the layovers (in the demand)"),
+    # the study area (the city model covers part of the lines)
+    "route_km": Column("km", "length of the simulated routes' segments (each shape once)"),
+    "route_km_in_city_model": Column("km", "of which in the area the city model covers (in_city_model)"),
+    "route_km_in_city_model_share": Column("fraction", "route_km_in_city_model / route_km"),
+    "driving_time_in_city_model_share": Column("fraction", "share of the buses' time on the road spent "
+                                                           "in the city model"),
+    "pv_kwh_driving_in_city_model_share": Column("fraction", "share of the driving PV harvested in the "
+                                                             "city model"),
+    "kwh_per_kwp_driving_in_city_model": Column("kWh/kWp per year", "driving yield of a bus that drove "
+                                                                    "only the modelled streets (the "
+                                                                    "fleet's driving yield x PV per "
+                                                                    "second inside / PV per second)"),
+    "kwh_per_kwp_driving_outside_city_model": Column("kWh/kWp per year", "the same outside the city model "
+                                                                         "(open sky)"),
+    "shading_loss_allsky_in_city_model": Column("fraction", "shading_loss_allsky of the segments in the "
+                                                            "city model (null: none)"),
+    "shading_loss_allsky_outside_city_model": Column("fraction", "the same outside it (no building to "
+                                                                 "shade: about 0)"),
+    "segments_in_buildings": Column("count", "segments whose midpoint lies inside a building footprint "
+                                             "(in_building: lit as the street next to them, left out of "
+                                             "the shading statistics)"),
+    "route_km_in_buildings_share": Column("fraction", "their share of route_km"),
+    "driving_time_in_buildings_share": Column("fraction", "their share of the buses' time on the road"),
+    "ground_sources": Column("count", "segments by the source of their ground height (see "
+                                      "segments.parquet ground_source)"),
     "radiation_gaps_interpolated": Column("count", "gaps in the radiation data within the run's months, "
                                                    "interpolated (each shorter than radiation.max_gap_minutes)"),
     "radiation_gap_minutes_interpolated": Column("min", "minutes of those gaps"),

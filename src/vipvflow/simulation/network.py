@@ -9,14 +9,15 @@ from ..store import DataDir
 
 
 def selected_network(cfg: Config) -> tuple[pd.DataFrame, tuple | None, list[str]]:
-    """The trips (``trip_id, route_id, shape_id``), shapes (``None``: all) and tiles that
+    """The trips (``trip_id, route_id, route_short_name, shape_id``), shapes (``None``: all)
+    and tiles that
     the run covers, after ``run.routes``; needs the ingested GTFS in ``cfg.data_dir``.
 
     The tiles come largest first: by their segments' passes in the feed (each segment
     counted once per trip of its shape), then by name.  A run computes them in that order,
     so the cluster's last tasks are small ones (a tile's months are one task)."""
     gtfs = DataDir(cfg.data_dir).gtfs
-    trips = pd.read_parquet(gtfs.trips, columns=["trip_id", "route_id", "shape_id"])
+    trips = pd.read_parquet(gtfs.trips, columns=["trip_id", "route_id", "route_short_name", "shape_id"])
     routes = cfg.run.routes
     shapes = None
     if routes is not None:

@@ -56,9 +56,21 @@ class RunContext:
 
 @lru_cache(maxsize=4)
 def _segments(data_dir: str) -> pd.DataFrame:
+    """The segments' roof planes as the physics sees them: a segment inside a building
+    footprint (``in_building``) is moved by ``light_dx_m, light_dy_m`` to the street point
+    its light is taken from (docs/physics.md)."""
     cols = ["segment_id", "shape_id", "x", "y", "z", "x_end", "y_end", "z_end", "heading_deg",
             "gradient", "length_m", "tile"]
-    seg = pd.read_parquet(DataDir(data_dir).gtfs.segments, columns=cols)
+    path = DataDir(data_dir).gtfs.segments
+    import pyarrow.parquet as pq
+
+    names = set(pq.read_schema(path).names)
+    shift = [c for c in ("light_dx_m", "light_dy_m") if c in names]
+    seg = pd.read_parquet(path, columns=cols + shift)
+    if len(shift) == 2:
+        dx, dy = seg.pop("light_dx_m").to_numpy(), seg.pop("light_dy_m").to_numpy()
+        for a, d in (("x", dx), ("x_end", dx), ("y", dy), ("y_end", dy)):
+            seg[a] = seg[a].to_numpy() + d
     return seg.set_index("segment_id", drop=False).sort_index()
 
 

@@ -26,11 +26,15 @@ def _cached(stamp: Path, fp: dict) -> bool:
 
 #: written beside the demo inputs: the year, seed and size they were generated for
 DEMO_MARKER = "demo_generated.json"
+#: the demo generator's version: inputs of an older generator are made again (2: termini
+#: among buildings)
+DEMO_VERSION = 2
 
 
 def mark_demo(folder, year: int, seed: int, size: str) -> None:
     """Record what the demo inputs in *folder* were generated for (see :func:`ensure_demo`)."""
-    _stamp(Path(folder) / DEMO_MARKER, {"year": year, "seed": seed, "size": size})
+    _stamp(Path(folder) / DEMO_MARKER, {"year": year, "seed": seed, "size": size,
+                                        "generator": DEMO_VERSION})
 
 
 def _read_marker(path: Path) -> dict | None:
@@ -56,13 +60,13 @@ def ensure_demo(cfg: Config, year: int, say=print) -> None:
     inputs = [*cfg.inputs.citygml, cfg.inputs.gtfs, *cfg.inputs.cams]
     folder = Path(cfg.inputs.gtfs).parent
     marker = folder / DEMO_MARKER
-    want = {"year": year, "seed": cfg.demo.seed, "size": cfg.demo.size}
+    want = {"year": year, "seed": cfg.demo.seed, "size": cfg.demo.size, "generator": DEMO_VERSION}
     if all(Path(p).exists() for p in inputs):
         if _cached(marker, want):
             return
         made = _read_marker(marker)
-        if made and made.get("year") != year and {k: made.get(k) for k in ("seed", "size")} == {
-                "seed": cfg.demo.seed, "size": cfg.demo.size}:
+        if made and made.get("year") != year and {k: made.get(k) for k in ("seed", "size", "generator")} == {
+                "seed": cfg.demo.seed, "size": cfg.demo.size, "generator": DEMO_VERSION}:
             # the demo of another year is kept: a run for a year its timetable does not
             # serve stops with the calendar's range (make a new one with `demo-data --year`)
             say(f"the demo inputs in {folder} are for {made['year']} (new ones: vipvflow "
@@ -91,8 +95,10 @@ def ensure_ingested(cfg: Config, say=print) -> dict:
     if gtfs is None or not cams_files:
         raise InputError(f"{cfg._source}: inputs.gtfs and inputs.cams are required")
 
+    # the ingests' format versions: a data dir ingested before (city: no meshes for the
+    # tiles within the buffer, no coverage area; GTFS: no ground sources) is ingested again
     city_fp = _fingerprint(city_files, {"city": cfg.city.model_dump(mode="json"),
-                                        "crs": cfg.inputs.citygml_crs})
+                                        "crs": cfg.inputs.citygml_crs, "format": 2})
     data = DataDir(data_dir)
     stamp = data.city.stamp
     if city_files and not _cached(stamp, city_fp):
@@ -100,27 +106,10 @@ def ensure_ingested(cfg: Config, say=print) -> dict:
         report = ingest_city(city_files, data_dir, cfg.city, crs=cfg.inputs.citygml_crs)
         say("  " + report.summary())
         _stamp(stamp, city_fp)
-    gtfs_fp = _fingerprint([gtfs], {"trajectory": cfg.trajectory.model_dump(mode="json"), "city": city_fp,
-                                    "timezone": cfg.inputs.gtfs_timezone,
-                                    "route_types": cfg.run.route_types})
-    stamp = data.gtfs.stamp
-    if not _cached(stamp, gtfs_fp):
-        from ..commands.ingest_gtfs import findings
-
-        say(f"ingesting GTFS feed {gtfs}")
-        report = ingest_gtfs(gtfs, data_dir, cfg.trajectory, crs=cfg.inputs.citygml_crs,
-                             timezone=cfg.inputs.gtfs_timezone, route_types=cfg.run.route_types)
-        c = report["counts"]
-        say(f"  shapes {c['shapes']} ({c['shapes_built_from_stops']} built from stops), segments "
-            f"{c['segments']}, tiles {c['tiles']}, trips {c['trips']}, patterns {c['patterns']}, "
-            f"routes {c['routes']}; timezone {report['timezone']}, CRS {report['crs']}")
-        for line in findings(report):
-            say("  " + line)
-        _stamp(stamp, gtfs_fp)
-    else:
-        _earlier(data.gtfs.feed_json, "problems", say)
+    # the radiation before the timetable: its header's altitude is the ground where the
+    # city model has none
     # the checks' version: data ingested before gaps were listed is read again
-    cams_fp = _fingerprint(cams_files, {"checks": 2})
+    cams_fp = _fingerprint(cams_files, {"checks": 3})
     stamp = data.radiation.stamp
     if not _cached(stamp, cams_fp):
         say(f"ingesting {len(cams_files)} CAMS file(s)")
@@ -132,6 +121,23 @@ def ensure_ingested(cfg: Config, say=print) -> dict:
         _stamp(stamp, cams_fp)
     else:
         _earlier(data.radiation.report, "gaps", say)
+    gtfs_fp = _fingerprint([gtfs], {"trajectory": cfg.trajectory.model_dump(mode="json"), "city": city_fp,
+                                    "radiation": cams_fp, "timezone": cfg.inputs.gtfs_timezone,
+                                    "route_types": cfg.run.route_types, "format": 2})
+    stamp = data.gtfs.stamp
+    if not _cached(stamp, gtfs_fp):
+        from ..commands.ingest_gtfs import findings, summary_lines
+
+        say(f"ingesting GTFS feed {gtfs}")
+        report = ingest_gtfs(gtfs, data_dir, cfg.trajectory, crs=cfg.inputs.citygml_crs,
+                             timezone=cfg.inputs.gtfs_timezone, route_types=cfg.run.route_types)
+        for line in summary_lines(report):
+            say("  " + line)
+        for line in findings(report):
+            say("  " + line)
+        _stamp(stamp, gtfs_fp)
+    else:
+        _earlier(data.gtfs.feed_json, "problems", say)
     return {str(p): sha256(p) for p in [*city_files, gtfs, *cams_files]}
 
 
@@ -205,7 +211,8 @@ def preflight(cfg: Config, year: int, say=print) -> dict:
                                      "start_s"])
     trips = _run_trips(cfg, trips)
     sd = _run_service_dates(data_dir, trips, year, set(cfg.run.months))
-    _check_city_covers(data_dir, trips, say)
+    # the shapes the run drives: of the trips with service in its months
+    _check_city_covers(data_dir, trips[trips["service_id"].isin(set(sd["service_id"]))], say)
     days, lo, hi = _hours_on_the_road(gdir, trips, sd, feed["timezone"])
     n_short, short_min = _check_radiation(data_dir, days, lo, hi, cfg.radiation.max_gap_minutes)
     if n_short:
@@ -223,9 +230,13 @@ def _run_trips(cfg: Config, trips):
     unknown = sorted(set(routes) - set(trips["route_id"].astype(str)))
     if unknown:
         known = sorted(trips["route_id"].astype(str).unique())
+        types = cfg.run.route_types
+        kept = "" if types == "all" else (
+            f"; ingest kept only route types {'bus' if types == 'bus' else types} "
+            "(run.route_types)")
         raise InputError(f"{cfg._source}: run.routes: route_id(s) not in the feed: "
                          f"{', '.join(unknown)} (the feed has {', '.join(known[:10])}"
-                         f"{' ...' if len(known) > 10 else ''})")
+                         f"{' ...' if len(known) > 10 else ''}{kept})")
     return trips[trips["route_id"].astype(str).isin(routes)]
 
 
@@ -246,8 +257,9 @@ def _run_service_dates(data_dir: Path, trips, year: int, months: set):
 
 
 def _check_city_covers(data_dir: Path, trips, say) -> None:
-    """The city model, when ingested, must cover some of the routes' segments (the share
-    outside it is said)."""
+    """The city model, when ingested, must cover some of the routes (else the run is
+    refused: a city model of another place, or in another CRS); the share of the route-km
+    outside it, computed under the open sky, is said."""
     import pandas as pd
 
     data = DataDir(data_dir)
@@ -255,17 +267,28 @@ def _check_city_covers(data_dir: Path, trips, say) -> None:
     if not tiles_json.exists():
         return
     city = json.loads(tiles_json.read_text())
-    seg = pd.read_parquet(data.gtfs.segments, columns=["tile", "shape_id"])
+    seg = pd.read_parquet(data.gtfs.segments)
     seg = seg[seg["shape_id"].isin(set(trips["shape_id"]))]
-    inside = seg["tile"].isin(set(city.get("tiles", {})))
-    if len(seg) and not inside.any():
-        raise InputError(f"{tiles_json}: the city model ({len(city.get('tiles', {}))} tiles "
-                         f"in {city.get('crs')}) covers none of the routes' {len(seg)} "
-                         f"segments (tiles {', '.join(sorted(seg['tile'].unique())[:3])} ...); "
-                         "is the city the one the feed serves, in the same CRS?")
-    if len(seg) and not inside.all():
-        say(f"  {100 * (1 - inside.mean()):.0f} % of the route segments lie outside the city "
-            "model's tiles (nothing shades them there)")
+    if not len(seg):
+        return
+    if "in_city_model" in seg:
+        inside = seg["in_city_model"].to_numpy(bool)
+    else:                          # segments ingested before the coverage area existed
+        inside = seg["tile"].isin(set(city.get("tiles", {}))).to_numpy()
+    km = seg["length_m"].to_numpy(float)
+    if not inside.any():
+        raise InputError(f"{tiles_json}: the routes miss the city model: none of their "
+                         f"{km.sum() / 1000:.1f} route-km ({len(seg)} segments, tiles "
+                         f"{', '.join(sorted(seg['tile'].unique())[:3])} ...) lies in the area its "
+                         f"buildings cover ({len(city.get('tiles', {}))} tiles in {city.get('crs')}); "
+                         "is the city the one the feed serves, in the same CRS? (Without "
+                         "inputs.citygml every road is computed under the open sky.)")
+    if not inside.all():
+        share = km[~inside].sum() / km.sum()
+        say(f"  {100 * share:.0f} % of the route-km ({km[~inside].sum() / 1000:.1f} of "
+            f"{km.sum() / 1000:.1f} km) lie outside the city model: computed under the open "
+            "sky there (no building known to shade them); summary.json gives the figures "
+            "inside and outside it")
 
 
 def _hours_on_the_road(gdir: Path, trips, sd, timezone: str):

@@ -383,8 +383,8 @@ def _check_totals(summary: dict, run_dir: Path) -> None:
         return isinstance(v, float) and not np.isfinite(v)
 
     irr = summary.get("irradiation_kwh_m2", {})
-    for key, why in (("pv_kwh_allsky", "no PV energy"),
-                     ("fleet_demand_mwh", "no consumption")):
+    for key, why in (("pv_kwh_driving", "no PV energy"),
+                     ("fleet_demand_in_service_mwh", "no consumption")):
         v = summary.get(key)
         if v is None or bad(v) or v <= 0:
             raise InputError(f"{run_dir}: the run's {key} is {v}: {why} over {summary['passes']} "
@@ -401,20 +401,19 @@ def _check_totals(summary: dict, run_dir: Path) -> None:
 
 def block_day_table(cfg: Config, run_dir: Path, trip: pd.DataFrame, vehicle, placed: pd.DataFrame):
     """Per block-day: PV driving, at layovers and parked (kWh), the time of each, the
-    layovers' auxiliaries, and the PV the battery takes (``pv_kwh_usable``) or not
-    (``pv_kwh_curtailed``) under ``fleet.harvest``; the idle buses' parked days; and
+    layovers' auxiliaries, and the battery's day under the charging plan (``charging``):
+    the SoC at departure, lowest and at the end, whether the plan serves the block
+    (``feasible``; else when and at what SoC it fails), the PV the battery takes
+    (``pv_kwh_usable``) or not (``pv_kwh_curtailed``), and the grid energy of the depot and
+    the terminals' chargers with PV and without (:func:`vipvflow.models.charging.block_day_soc`).
+    Also the idle buses' parked days (their battery is full: their PV is curtailed), and
     *trip* (the reduce's per-trip table: ``pv_kwh``, ``consumption_kwh``) with the
-    timeline's ``block_id`` (the GTFS block, or the inferred one).  The
-    layovers' auxiliaries draw the vehicle's base load and HVAC at the month's mean
-    temperature through the battery's discharge efficiency.  Balance: the bus leaves the
-    depot at ``soc_max``; PV offsets each trip and layover, a surplus charges up to
-    ``soc_max`` (the rest is curtailed); PV parked at the depot replaces depot charging up to
-    what the block-day used (:func:`vipvflow.models.vehicle.block_day_balance`).  An idle bus's
-    battery is full: its PV is all curtailed.  With ``harvest: driving`` (the paper's
-    accounting) all the driving PV counts and nothing is curtailed.
+    timeline's ``block_id`` (the GTFS block, or the inferred one) and each trip's SoC at
+    departure.  The layovers' auxiliaries draw the vehicle's base load and HVAC at the
+    month's mean temperature through the battery's discharge efficiency; the PV of layovers
+    and parking counts only when ``fleet.harvest`` evaluates it.
     """
     from ..inputs.gtfs.schedule import IDLE_BLOCK
-    from ..models.vehicle import block_day_balance
 
     run = RunDir(run_dir)
     tl = pd.read_parquet(run.timeline_table("block_days"))
@@ -432,7 +431,7 @@ def block_day_table(cfg: Config, run_dir: Path, trip: pd.DataFrame, vehicle, pla
     idle = st[st["block_id"] == IDLE_BLOCK].copy()
     st = st[st["block_id"] != IDLE_BLOCK]
     idle["month"] = pd.to_datetime(idle["service_date"]).dt.strftime("%Y-%m")
-    idle["pv_kwh_curtailed"] = idle["pv_kwh"] if cfg.fleet.harvest != "driving" else 0.0
+    idle["pv_kwh_curtailed"] = idle["pv_kwh"]            # an idle bus's battery is full
 
     bd = tl[key + ["month", "trips", "window_start_utc", "window_end_utc", "first_departure_utc",
                    "last_arrival_utc", "driving_s", "layover_s", "parked_s", "overlap_s"]
@@ -456,6 +455,16 @@ def block_day_table(cfg: Config, run_dir: Path, trip: pd.DataFrame, vehicle, pla
     bd["pv_kwh_whole_day"] = bd["pv_kwh_driving"] + bd["pv_kwh_layover"] + bd["pv_kwh_parked"]
     bd["window_s"] = bd["window_end_utc"] - bd["window_start_utc"]
 
+    # the layovers (every one, with its terminal and PV) and the parked time at the depot
+    iv = pd.read_parquet(run.timeline_table("intervals"))
+    iv = iv[iv["block_id"].astype(str) != IDLE_BLOCK]
+    points = pd.read_parquet(run.timeline_table("points"), columns=["point_id", "stop_id"])
+    iv = iv.merge(points, on="point_id", how="left")
+    ikey = key + ["kind", "after_trip"]
+    lit = st.groupby(ikey)["pv_kwh"].sum()
+    iv["pv_kwh"] = lit.reindex(pd.MultiIndex.from_frame(iv[ikey].astype({"kind": str}))).fillna(0.0).to_numpy()
+    iv["seconds"] = (iv["t1_utc"] - iv["t0_utc"]).to_numpy(float)
+
     # the layovers' auxiliaries (kWh from the battery) at the month's temperature
     temps = np.asarray(cfg.monthly_temperature_c(), float)
 
@@ -464,35 +473,128 @@ def block_day_table(cfg: Config, run_dir: Path, trip: pd.DataFrame, vehicle, pla
         return (np.asarray(vehicle.aux_kw(temps[month_no - 1]), float) * np.asarray(seconds, float)
                 / 3600.0 / vehicle.discharge_efficiency)
 
-    lay = st[st["kind"] == "layover"]
-    lay = lay.assign(aux_kwh=aux_kwh(lay["service_date"], lay["seconds"]))
-    bd["layover_aux_kwh"] = aux_kwh(bd["service_date"], bd["seconds_layover"])
-    in_service = cfg.fleet.harvest != "driving"
-    bd["demand_kwh"] = bd["consumption_kwh"] + (bd["layover_aux_kwh"] if in_service else 0.0)
-
-    # the battery's share: steps (a trip and the layover after it) per block-day
-    if cfg.fleet.harvest == "driving":
-        bd["pv_kwh_curtailed"] = 0.0
-        bd["pv_kwh_usable"] = bd["pv_kwh_driving"]
-        bd["soc_end_pv"] = np.nan
-        return bd, idle, trip
-    row = pd.Series(np.arange(len(bd)), index=idx)
-    n_steps = int(bd["trips"].max()) if len(bd) else 0
-    pv_steps = np.zeros((len(bd), max(n_steps, 1)))
-    use_steps = np.zeros_like(pv_steps)
-    t_row = row.reindex(pd.MultiIndex.from_frame(trip[key])).to_numpy()
-    t_pos = position
-    np.add.at(pv_steps, (t_row, t_pos), trip["pv_kwh"].to_numpy(float))
-    np.add.at(use_steps, (t_row, t_pos), trip["consumption_kwh"].to_numpy(float))
-    l_row = row.reindex(pd.MultiIndex.from_frame(lay[key])).to_numpy()
-    l_pos = lay["after_trip"].to_numpy(np.int64)
-    np.add.at(pv_steps, (l_row, l_pos), lay["pv_kwh"].to_numpy(float))
-    np.add.at(use_steps, (l_row, l_pos), lay["aux_kwh"].to_numpy(float))
-    bal = block_day_balance(pv_steps, use_steps, bd["pv_kwh_parked"].to_numpy(), vehicle)
-    bd["pv_kwh_curtailed"] = bal["curtailed_in_service_kwh"] + bal["curtailed_parked_kwh"]
+    lay = iv[iv["kind"] == "layover"].copy()
+    lay["aux_kwh"] = aux_kwh(lay["service_date"], lay["seconds"])
+    bd["layover_aux_kwh"] = (lay.groupby(key)["aux_kwh"].sum().reindex(idx, fill_value=0.0)
+                             .to_numpy())
+    # the battery's demand in service: the trips and the layovers' auxiliaries
+    bd["demand_kwh"] = bd["consumption_kwh"] + bd["layover_aux_kwh"]
+    balance = _battery_day(cfg, run_dir, bd, idx, trip, position, lay, iv, vehicle)
+    for c, v in balance.items():
+        if c not in ("soc_at_departure", "traces"):
+            bd[c] = v
+    trip["soc_at_departure"] = balance["soc_at_departure"]
     bd["pv_kwh_usable"] = bd["pv_kwh_whole_day"] - bd["pv_kwh_curtailed"]
-    bd["soc_end_pv"] = bal["soc_end"]
-    return bd, idle, trip
+    return bd, idle, trip, balance["traces"]
+
+
+def _battery_day(cfg: Config, run_dir: Path, bd: pd.DataFrame, idx, trip: pd.DataFrame,
+                 position: np.ndarray, lay: pd.DataFrame, iv: pd.DataFrame, vehicle) -> dict:
+    """The block-days' battery under the charging plan, with PV and without
+    (:func:`vipvflow.models.charging.block_day_soc`): the columns of ``block_day`` it gives,
+    and ``soc_at_departure`` row by row with *trip*."""
+    import json
+
+    from ..inputs.gtfs.schedule import service_day_origin_utc
+    from ..models.charging import Charger, Vehicle, block_day_soc, window_overlap_s
+
+    plan = cfg.charging
+    tz = json.loads(DataDir(cfg.data_dir).gtfs.feed_json.read_text())["timezone"]
+    n, K = len(bd), max(int(bd["trips"].max()) if len(bd) else 1, 1)
+    row = pd.Series(np.arange(n), index=idx)
+    key = ["block_id", "service_date"]
+
+    def grid(frame, values, pos, fill=0.0):
+        out = np.full((n, K), fill, float)
+        r = row.reindex(pd.MultiIndex.from_frame(frame[key])).to_numpy()
+        ok = np.isfinite(r.astype(float)) & (pos >= 0) & (pos < K)
+        out[r[ok].astype(np.int64), pos[ok]] = np.asarray(values, float)[ok]
+        return out
+
+    t0 = (service_day_origin_utc(trip["service_date"].to_numpy(), tz)
+          + trip["start_s"].to_numpy(float))
+    t1 = t0 + trip["seconds"].to_numpy(float)
+    trip_pv = grid(trip, trip["pv_kwh"], position)
+    trip_use = grid(trip, trip["consumption_kwh"], position)
+    trip_t0, trip_t1 = grid(trip, t0, position, np.nan), grid(trip, t1, position, np.nan)
+    lpos = lay["after_trip"].to_numpy(np.int64)
+    opp = plan.opportunity
+    at_charger = (np.ones(len(lay), bool) if opp.terminals == "all" else
+                  lay["stop_id"].astype(str).isin(opp.terminals or []).to_numpy())
+    charge = at_charger & (lay["seconds"].to_numpy() >= opp.min_layover_min * 60.0)
+    lay_pv, lay_use = grid(lay, lay["pv_kwh"], lpos), grid(lay, lay["aux_kwh"], lpos)
+    lay_t0, lay_t1 = grid(lay, lay["t0_utc"], lpos), grid(lay, lay["t1_utc"], lpos)
+    lay_charge = grid(lay, charge, lpos) > 0
+    # the depot's hours: the parked time within the chargers' local hours
+    parked = iv[iv["kind"] == "parked"]
+    if plan.depot.hours is None:
+        hours_s = parked["seconds"].to_numpy(float)
+    else:
+        offset = (pd.DatetimeIndex(pd.to_datetime(parked["t0_utc"], unit="s", utc=True))
+                  .tz_convert(tz).tz_localize(None)
+                  - pd.to_datetime(parked["t0_utc"], unit="s")).total_seconds().to_numpy()
+        hours_s = window_overlap_s(parked["t0_utc"].to_numpy(float) + offset,
+                                   parked["t1_utc"].to_numpy(float) + offset, *plan.depot.hours)
+    depot_hours = (pd.Series(hours_s, index=pd.MultiIndex.from_frame(parked[key]))
+                   .groupby(level=[0, 1]).sum().reindex(idx, fill_value=0.0).to_numpy())
+    car = Vehicle(vehicle.battery_kwh, vehicle.soc_min, vehicle.soc_max)
+    depot = Charger(plan.depot.power_kw, plan.depot.efficiency,
+                    plan.depot.target_soc if plan.depot.target_soc is not None else vehicle.soc_max)
+    opportunity = None if opp.terminals is None else Charger(
+        opp.power_kw, opp.efficiency, opp.target_soc if opp.target_soc is not None else vehicle.soc_max)
+    common = dict(trip_t0=trip_t0, trip_t1=trip_t1, lay_t0=lay_t0, lay_t1=lay_t1, lay_charge=lay_charge,
+                  depot_hours_s=depot_hours, depot=depot, opportunity=opportunity,
+                  connect_s=opp.connect_min * 60.0)
+    with_pv = block_day_soc(car, trip_pv, trip_use, lay_pv=lay_pv, lay_use=lay_use,
+                            parked_pv=bd["pv_kwh_parked"].to_numpy(), trace=True, **common)
+    no_pv = block_day_soc(car, np.zeros_like(trip_pv), trip_use, lay_pv=np.zeros_like(lay_pv),
+                          lay_use=lay_use, parked_pv=np.zeros(n), trace=True, **common)
+    # each trip's SoC at its departure: the morning's, or after the layover before it
+    before = np.column_stack([with_pv["soc_start"], with_pv["soc_after_layover"][:, :-1]])
+    r = row.reindex(pd.MultiIndex.from_frame(trip[key])).to_numpy()
+    soc_dep = before[r, np.clip(position, 0, K - 1)]
+    fail = pd.to_datetime(with_pv["fail_utc"], unit="s", utc=True)
+    grid_pv = with_pv["depot_grid_kwh"] + with_pv["opportunity_grid_kwh"]
+    grid_nopv = no_pv["depot_grid_kwh"] + no_pv["opportunity_grid_kwh"]
+    return {
+        "soc_start": with_pv["soc_start"], "soc_lowest_pv": with_pv["soc_lowest"],
+        "soc_end_pv": with_pv["soc_end"], "soc_lowest_nopv": no_pv["soc_lowest"],
+        "feasible": with_pv["feasible"], "feasible_without_pv": no_pv["feasible"],
+        "infeasible_at_utc": fail, "infeasible_soc": with_pv["fail_soc"],
+        "depot_short_kwh": with_pv["depot_short_kwh"],
+        "pv_kwh_curtailed": with_pv["curtailed_in_service_kwh"] + with_pv["curtailed_parked_kwh"],
+        "grid_kwh_depot": with_pv["depot_grid_kwh"], "grid_kwh_depot_without_pv": no_pv["depot_grid_kwh"],
+        "grid_kwh_opportunity": with_pv["opportunity_grid_kwh"],
+        "grid_kwh_opportunity_without_pv": no_pv["opportunity_grid_kwh"],
+        "grid_kwh_avoided": grid_nopv - grid_pv,
+        "soc_at_departure": soc_dep,
+        "traces": _soc_traces(bd, with_pv, no_pv, trip_t0, trip_t1, lay_t1),
+    }
+
+
+def _soc_traces(bd: pd.DataFrame, with_pv: dict, no_pv: dict, trip_t0, trip_t1, lay_t1) -> pd.DataFrame:
+    """The SoC through two block-days, with PV and without, at each trip's departure and
+    arrival and each layover's end: the worst (lowest SoC with PV) and a typical one (the
+    median lowest SoC): ``which, block_id, service_date, t_utc, soc_pv, soc_nopv``."""
+    if not len(bd):
+        return pd.DataFrame(columns=["which", "block_id", "service_date", "t_utc", "soc_pv", "soc_nopv"])
+    low = with_pv["soc_lowest"]
+    order = np.argsort(low, kind="stable")
+    picks = {"worst": int(order[0]), "typical": int(order[len(order) // 2])}
+    rows = []
+    for which, i in picks.items():
+        k_n = int(bd["trips"].iloc[i])
+        pts = [(trip_t0[i, 0], with_pv["soc_start"][i], no_pv["soc_start"][i])]
+        for k in range(k_n):
+            pts.append((trip_t1[i, k], with_pv["soc_after_trip"][i, k], no_pv["soc_after_trip"][i, k]))
+            if k < k_n - 1:
+                pts.append((lay_t1[i, k], with_pv["soc_after_layover"][i, k],
+                            no_pv["soc_after_layover"][i, k]))
+        for t, a, b in pts:
+            rows.append({"which": which, "block_id": str(bd["block_id"].iloc[i]),
+                         "service_date": bd["service_date"].iloc[i], "t_utc": float(t),
+                         "soc_pv": float(a), "soc_nopv": float(b)})
+    return pd.DataFrame(rows)
 
 
 def reduce_run(cfg: Config, year: int, run_dir: Path, say=print, client=None, cluster_done=None,
@@ -526,12 +628,19 @@ def reduce_run(cfg: Config, year: int, run_dir: Path, say=print, client=None, cl
                                        totals, n_buses, trips_meta)
     report.add_maps(figures, run_dir, cfg)
     clock("segments")
-    trip, bd, idle = _trip_outputs(cfg, year, run_dir, totals, placed, trips_meta, say, consumption)
+    trip, bd, idle, traces = _trip_outputs(cfg, year, run_dir, totals, placed, trips_meta, say,
+                                           consumption)
     clock("trips")
-    rm = _route_month(trip)
-    report.add_routes(figures, rm)
+    rm = _route_month(trip, bd)
+    # the fleet's coverage (summary.json's: annual scaling cancels) beside the routes'
+    coverage = float(bd["pv_kwh_usable"].sum() / bd["demand_kwh"].sum()) if len(bd) else None
+    report.add_routes(figures, rm, coverage)
+    report.add_battery(figures, traces, cfg.vehicle_params().soc_min)
     write_parquet(rm, RunDir(run_dir).output("route_month.parquet"))
     write_parquet(bd, RunDir(run_dir).output("block_day.parquet"))
+    ranking = _ranking(cfg, bd, trip, 12.0 / len(cfg.run.months))
+    write_parquet(ranking, RunDir(run_dir).output("ranking.parquet"))
+    report.add_ranking(figures, ranking)
     write_parquet(hp, RunDir(run_dir).output("hourly_pattern.parquet"))
     monthly, summary = _fleet_year(cfg, year, run_dir, trip, bd, idle, sm, segments, n_buses)
     write_parquet(monthly, RunDir(run_dir).output("monthly.parquet"))
@@ -579,9 +688,10 @@ def _trip_outputs(cfg: Config, year: int, run_dir: Path, totals: pd.DataFrame, p
     *totals*: the joins here keep their rows' order) and per block-day (driving, layovers,
     parked; the battery's share); writes ``trip_energy.parquet``.  Returns the trips, the
     block-days and the idle buses' days."""
-    trip = totals.merge(trips_meta[["trip_id", "route_id", "route_short_name", "direction_id",
-                                  "shape_id", "service_id", "block_id", "pattern_id", "start_s"]],
-                      on="trip_id", how="left", validate="many_to_one")
+    meta = trips_meta.reindex(columns=["trip_id", "route_id", "route_short_name", "route_long_name",
+                                       "trip_headsign", "direction_id", "shape_id", "service_id",
+                                       "block_id", "pattern_id", "start_s"])
+    trip = totals.merge(meta, on="trip_id", how="left", validate="many_to_one")
     trip["month"] = pd.to_datetime(trip["service_date"]).dt.strftime("%Y-%m")
     cons = trip_consumption(cfg, Path(cfg.data_dir), year, trip["pattern_id"].unique(),
                             vecto_dir=RunDir(run_dir).vecto, say=say, made=consumption)
@@ -589,9 +699,9 @@ def _trip_outputs(cfg: Config, year: int, run_dir: Path, totals: pd.DataFrame, p
     trip["coverage"] = trip["pv_kwh"] / trip["consumption_kwh"]
     # vehicle block per day: driving, layovers, parked; the battery's share (sets the
     # trips' block_id to the timeline's: the GTFS block or the inferred one)
-    bd, idle, trip = block_day_table(cfg, run_dir, trip, cfg.vehicle_params(), placed)
+    bd, idle, trip, traces = block_day_table(cfg, run_dir, trip, cfg.vehicle_params(), placed)
     write_parquet(trip, RunDir(run_dir).output("trip_energy.parquet"))
-    return trip, bd, idle
+    return trip, bd, idle, traces
 
 
 def _segment_outputs(cfg: Config, run_dir: Path, sm: pd.DataFrame, geo: pd.DataFrame | None,
@@ -612,7 +722,8 @@ def _segment_outputs(cfg: Config, run_dir: Path, sm: pd.DataFrame, geo: pd.DataF
     sm["shading_loss_clear"] = shading_loss(sm["h_direct_clear"], sm["h_diffuse_clear"],
                                             sm["h_total_clear_unshaded"])
     sm["reflection_gain"] = sm["h_reflected"] / sm["h_total_unshaded"].where(sm["h_total_unshaded"] > 0)
-    shape_route = (trips_meta.drop_duplicates("shape_id")[["shape_id", "route_short_name", "direction_id"]])
+    shape_route = shape_routes(trips_meta[trips_meta["trip_id"].isin(totals["trip_id"].unique())])
+    shape_route = shape_route[["shape_id", "route_short_name", "direction_id"]]
     smg = segments[["segment_id", "shape_id", "geometry"]].merge(sm, on="segment_id", how="inner")
     smg = gpd.GeoDataFrame(smg.merge(shape_route, on="shape_id", how="left"),
                            geometry="geometry", crs=segments.crs)
@@ -625,15 +736,95 @@ def _segment_outputs(cfg: Config, run_dir: Path, sm: pd.DataFrame, geo: pd.DataF
     return smg, segments, sm
 
 
-def _route_month(trip: pd.DataFrame) -> pd.DataFrame:
-    """Per route, direction and month: trips, time, kWh, consumption, coverage, shading loss."""
+def shape_routes(trips: pd.DataFrame) -> pd.DataFrame:
+    """Per shape, every route that drives it: ``route_short_name`` and ``route_id`` (the
+    routes' names and ids, sorted, joined by ", ": a shape shared by several routes carries
+    them all) and ``direction_id`` (null when its trips run in both directions)."""
+    def joined(v):
+        return ", ".join(sorted({str(x) for x in v.dropna()}))
+
+    g = trips.groupby("shape_id", sort=True)
+    out = pd.DataFrame({"route_short_name": g["route_short_name"].agg(joined).astype("string"),
+                        "route_id": g["route_id"].agg(joined).astype("string")})
+    direction = g["direction_id"].agg(lambda v: v.iloc[0] if v.nunique(dropna=False) == 1 else pd.NA)
+    out["direction_id"] = direction.astype("Int32")
+    return out.reset_index()
+
+
+def _route_month(trip: pd.DataFrame, bd: pd.DataFrame) -> pd.DataFrame:
+    """Per route, direction and month: trips, time, kWh, consumption, coverage, shading loss,
+    and the block-days' PV at layovers, parked, curtailed and taken by the batteries, shared
+    among the routes by their trips' time in each block-day."""
+    key = ["block_id", "service_date"]
+    share = trip["seconds"] / trip.groupby(key)["seconds"].transform("sum")
+    day = bd.set_index(key)[["pv_kwh_layover", "pv_kwh_parked", "pv_kwh_curtailed", "pv_kwh_usable"]]
+    shared = trip[key].join(day, on=key).drop(columns=key).mul(share, axis=0)
+    trip = pd.concat([trip.drop(columns=[c for c in shared.columns if c in trip]), shared], axis=1)
+    trip = trip.assign(pv_kwh_driving=trip["pv_kwh"])
     kwh_cols = [c for c in trip.columns if c.startswith("pv_kwh")] + ["seconds"]
-    rm = (trip.groupby(["route_id", "route_short_name", "direction_id", "month"], sort=True)
+    key = ["route_id", "route_short_name", "direction_id", "month"]
+    rm = (trip.groupby(key, sort=True, dropna=False)
           .agg(trips=("trip_id", "size"), **{c: (c, "sum") for c in kwh_cols + ["consumption_kwh"]})
           .reset_index())
+    # the route's long name and the direction's most frequent headsign
+    names = (trip.groupby(key[:3], sort=True, dropna=False)
+             .agg(route_long_name=("route_long_name", "first"),
+                  trip_headsign=("trip_headsign", lambda v: v.mode().iloc[0] if v.notna().any() else pd.NA))
+             .reset_index())
+    rm = rm.merge(names, on=key[:3], how="left")
+    rm.insert(2, "route_long_name", rm.pop("route_long_name").astype("string"))
+    rm.insert(4, "trip_headsign", rm.pop("trip_headsign").astype("string"))
     rm["coverage"] = rm["pv_kwh"] / rm["consumption_kwh"]
     rm["shading_loss"] = shading_loss(rm["pv_kwh_direct"], rm["pv_kwh_diffuse"], rm["pv_kwh_unshaded"])
     return rm
+
+
+def _ranking(cfg: Config, bd: pd.DataFrame, trip: pd.DataFrame, annualise: float) -> pd.DataFrame:
+    """Which buses to equip first: the blocks (a bus's daily duty) and the routes ranked by
+    the grid energy PV avoids per installed kWp and year, with the simple payback of one
+    bus's system on it.  A block's year is its block-days in the run (scaled to a year); a
+    route gets each block-day's avoided energy in proportion to its trips' time in that
+    block-day, per bus on the route (its share of the block-days, per service day).
+
+    Returns
+    -------
+    DataFrame, one row per block and per route: ``kind`` (block | route), ``id``, ``name``,
+    ``block_days`` (or bus-days on the route), ``grid_kwh_avoided_per_year`` (per bus),
+    ``kwh_avoided_per_kwp_year``, ``pv_kwh_usable_per_year`` (per bus), ``payback_years``,
+    ``rank`` (1: the most avoided per kWp, within its kind).
+    """
+    pv = cfg.pv_system()
+    cost = cfg.economics.cost_eur_per_wp * 1000.0 * pv.kwp
+    tariff = cfg.economics.tariff_eur_per_kwh
+    days = max(bd["service_date"].nunique(), 1)
+    period_days = days                         # the service days of the run's months
+    blk = bd.groupby("block_id").agg(block_days=("service_date", "size"),
+                                     grid=("grid_kwh_avoided", "sum"), usable=("pv_kwh_usable", "sum"))
+    # per bus on the block: its year is its block-days scaled to a year
+    blocks = pd.DataFrame({"kind": "block", "id": blk.index.astype(str), "name": blk.index.astype(str),
+                           "block_days": blk["block_days"].to_numpy(),
+                           "grid_kwh_avoided_per_year": blk["grid"].to_numpy() * annualise,
+                           "pv_kwh_usable_per_year": blk["usable"].to_numpy() * annualise})
+    key = ["block_id", "service_date"]
+    share = trip["seconds"] / trip.groupby(key)["seconds"].transform("sum")
+    per = bd.set_index(key)[["grid_kwh_avoided", "pv_kwh_usable"]]
+    t = trip[key + ["route_id", "route_short_name"]].join(per, on=key)
+    t = t.assign(grid=t["grid_kwh_avoided"] * share, usable=t["pv_kwh_usable"] * share,
+                 bus_days=share)
+    rt = t.groupby("route_id").agg(name=("route_short_name", "first"), bus_days=("bus_days", "sum"),
+                                   grid=("grid", "sum"), usable=("usable", "sum"))
+    buses = rt["bus_days"] / period_days       # buses the route keeps busy, on average
+    routes = pd.DataFrame({"kind": "route", "id": rt.index.astype(str), "name": rt["name"].astype(str).to_numpy(),
+                           "block_days": rt["bus_days"].to_numpy(),
+                           "grid_kwh_avoided_per_year": (rt["grid"] / buses).to_numpy() * annualise,
+                           "pv_kwh_usable_per_year": (rt["usable"] / buses).to_numpy() * annualise})
+    out = pd.concat([blocks, routes], ignore_index=True)
+    out["kwh_avoided_per_kwp_year"] = out["grid_kwh_avoided_per_year"] / pv.kwp
+    saving = out["grid_kwh_avoided_per_year"] * tariff
+    out["payback_years"] = np.where(saving > 0, cost / saving.where(saving > 0, 1.0), np.inf)
+    out["rank"] = (out.groupby("kind")["kwh_avoided_per_kwp_year"].rank(ascending=False, method="first")
+                   .astype(np.int64))
+    return out.sort_values(["kind", "rank"], ignore_index=True)
 
 
 def _hourly_pattern(hourly: pd.DataFrame) -> pd.DataFrame:
@@ -647,23 +838,33 @@ def _hourly_pattern(hourly: pd.DataFrame) -> pd.DataFrame:
 
 
 def _harvest(cfg: Config, bd: pd.DataFrame, idle: pd.DataFrame, kwp_fleet: float, annualise: float) -> dict:
-    """The summary's split of the PV by when it is harvested (driving, layover, parked) and
-    what the battery takes."""
+    """The summary's PV by when it is harvested (driving, layover, parked: each null when
+    ``fleet.harvest`` does not count it), what the batteries take and curtail, and the yields
+    of each accounting (the headline: ``kwh_per_kwp_usable``, what the batteries take)."""
+    harvest = cfg.fleet.harvest
     parts = {"driving": float(bd["pv_kwh_driving"].sum()), "layover": float(bd["pv_kwh_layover"].sum()),
              "parked": float(bd["pv_kwh_parked"].sum() + idle["pv_kwh"].sum())}
+    in_service = parts["driving"] + parts["layover"]
+    whole_day = sum(parts.values())
+    counts_layover, counts_parked = harvest != "driving", harvest == "whole_day"
+    usable = float(bd["pv_kwh_usable"].sum())
+    harvested = whole_day if counts_parked else in_service if counts_layover else parts["driving"]
     return {
-        "harvest": cfg.fleet.harvest, "depot_shading": cfg.fleet.depot_shading,
-        **{f"pv_kwh_{k}": v for k, v in parts.items()},
-        "pv_kwh_in_service": parts["driving"] + parts["layover"],
-        "pv_kwh_whole_day": sum(parts.values()),
+        "harvest": harvest, "depot_shading": cfg.fleet.depot_shading,
+        "pv_kwh_driving": parts["driving"],
+        "pv_kwh_layover": parts["layover"] if counts_layover else None,
+        "pv_kwh_parked": parts["parked"] if counts_parked else None,
+        "pv_kwh_in_service": in_service if counts_layover else None,
+        "pv_kwh_whole_day": whole_day if counts_parked else None,
+        "pv_kwh_harvested": harvested,
+        "pv_kwh_usable": usable,
+        "pv_kwh_curtailed": float(bd["pv_kwh_curtailed"].sum() + idle["pv_kwh_curtailed"].sum()),
+        "kwh_per_kwp_usable": usable * annualise / kwp_fleet,
+        "kwh_per_kwp_harvested": harvested * annualise / kwp_fleet,
         "kwh_per_kwp_driving": parts["driving"] * annualise / kwp_fleet,
         # the yields of the time the run evaluated (null: not computed under fleet.harvest)
-        "kwh_per_kwp_in_service": ((parts["driving"] + parts["layover"]) * annualise / kwp_fleet
-                                   if cfg.fleet.harvest != "driving" else None),
-        "kwh_per_kwp_whole_day": (sum(parts.values()) * annualise / kwp_fleet
-                                  if cfg.fleet.harvest == "whole_day" else None),
-        "pv_kwh_usable": float(bd["pv_kwh_usable"].sum()),
-        "pv_kwh_curtailed": float(bd["pv_kwh_curtailed"].sum() + idle["pv_kwh_curtailed"].sum()),
+        "kwh_per_kwp_in_service": in_service * annualise / kwp_fleet if counts_layover else None,
+        "kwh_per_kwp_whole_day": whole_day * annualise / kwp_fleet if counts_parked else None,
         "idle_bus_days": int(idle["buses"].sum()),
         "layover_hours": float(bd["seconds_layover"].sum() / 3600.0),
         "parked_hours": float((bd["seconds_parked"].sum() + idle["seconds"].sum()) / 3600.0),
@@ -671,22 +872,59 @@ def _harvest(cfg: Config, bd: pd.DataFrame, idle: pd.DataFrame, kwp_fleet: float
     }
 
 
+#: block-days named in the summary (and the console line, the report) when infeasible
+_NAMED_BLOCKS = 5
+
+
 def _economics(cfg: Config, bd: pd.DataFrame, n_buses: int, annualise: float) -> dict:
-    """The fleet's demand, coverage, avoided charging cycles and payback over a year."""
+    """The fleet's demand, coverage, the battery's balance under the charging plan (infeasible
+    block-days, grid energy avoided at the depot and the terminals), avoided charging cycles
+    (the balance's, and the paper's formula beside it) and payback, over a year."""
     from ..models import economics
 
     pv, vehicle, window = cfg.pv_system(), cfg.vehicle_params(), cfg.economics.soc_window
-    pv_year = float(bd["pv_kwh_usable"].sum()) * annualise
+    usable_year = float(bd["pv_kwh_usable"].sum()) * annualise
+    driving_year = float(bd["pv_kwh_driving"].sum()) * annualise
     demand_year = float(bd["demand_kwh"].sum()) * annualise
+    driving_demand_year = float(bd["consumption_kwh"].sum()) * annualise
+    # grid energy over the run's months (like the pv_kwh figures); cycles and payback per year
+    avoided_depot = float((bd["grid_kwh_depot_without_pv"] - bd["grid_kwh_depot"]).sum())
+    avoided_opp = float((bd["grid_kwh_opportunity_without_pv"] - bd["grid_kwh_opportunity"]).sum())
+    plan = cfg.charging
+    # battery energy the chargers need not put in, per year: the balance's avoided cycles
+    battery_avoided = (avoided_depot * plan.depot.efficiency
+                       + avoided_opp * plan.opportunity.efficiency) * annualise
+    cycle = float(economics.cycle_energy_kwh(vehicle.battery_kwh, window))
+    bad = bd[~bd["feasible"].to_numpy(bool)]
+    named = [f"{b} on {pd.Timestamp(d):%Y-%m-%d}" + (f" at {pd.Timestamp(t).tz_convert('UTC'):%H:%M} UTC"
+                                                     if pd.notna(t) else " (depot charge short)")
+             for b, d, t in bad[["block_id", "service_date", "infeasible_at_utc"]]
+             .head(_NAMED_BLOCKS).itertuples(index=False)]
+    tariff, cost = cfg.economics.tariff_eur_per_kwh, cfg.economics.cost_eur_per_wp
     return {
-        "fleet_demand_mwh": demand_year / 1000.0,
-        "coverage": float(economics.coverage(pv_year, demand_year)),
-        "avoided_charging_cycles_fleet": float(economics.avoided_cycles(pv_year, vehicle.battery_kwh, window)),
-        "avoided_charging_cycles_per_bus": float(
-            economics.avoided_cycles(pv_year / n_buses, vehicle.battery_kwh, window)),
-        "system_cost_eur_per_bus": float(economics.system_cost_eur(pv.kwp, cfg.economics.cost_eur_per_wp)),
+        "fleet_demand_in_service_mwh": demand_year / 1000.0,
+        "fleet_demand_driving_mwh": driving_demand_year / 1000.0,
+        "coverage": float(economics.coverage(usable_year, demand_year)),
+        "coverage_driving": float(economics.coverage(driving_year, driving_demand_year)),
+        "block_days": int(len(bd)),
+        "block_days_infeasible": int(len(bad)),
+        "block_days_infeasible_without_pv": int((~bd["feasible_without_pv"].to_numpy(bool)).sum()),
+        "infeasible_block_days_first": named,
+        "soc_lowest_pv": float(bd["soc_lowest_pv"].min()) if len(bd) else None,
+        "grid_kwh_without_pv": float((bd["grid_kwh_depot_without_pv"]
+                                      + bd["grid_kwh_opportunity_without_pv"]).sum()),
+        "grid_kwh_avoided": avoided_depot + avoided_opp,
+        "grid_kwh_avoided_depot": avoided_depot,
+        "grid_kwh_avoided_opportunity": avoided_opp,
+        "avoided_charging_cycles_fleet": battery_avoided / cycle,
+        "avoided_charging_cycles_per_bus": battery_avoided / cycle / n_buses,
+        "avoided_charging_cycles_per_bus_paper": float(
+            economics.avoided_cycles(usable_year / n_buses, vehicle.battery_kwh, window)),
+        "system_cost_eur_per_bus": float(economics.system_cost_eur(pv.kwp, cost)),
         "payback_years": float(economics.simple_payback_years(
-            pv.kwp, pv_year / n_buses, cfg.economics.cost_eur_per_wp, cfg.economics.tariff_eur_per_kwh)),
+            pv.kwp, (avoided_depot + avoided_opp) * annualise / n_buses, cost, tariff)),
+        "payback_years_paper": float(economics.simple_payback_years(
+            pv.kwp, usable_year / n_buses, cost, tariff)),
     }
 
 
@@ -705,19 +943,92 @@ def _monthly(cfg: Config, trip: pd.DataFrame, bd: pd.DataFrame, idle: pd.DataFra
                     consumption_kwh=("consumption_kwh", "sum")).reset_index())
     monthly["shading_loss"] = shading_loss(monthly["pv_kwh_direct"], monthly["pv_kwh_diffuse"],
                                            monthly["pv_kwh_unshaded"])
-    split = bd.groupby("month", sort=True)[
-        ["pv_kwh_driving", "pv_kwh_layover", "pv_kwh_parked", "pv_kwh_usable", "pv_kwh_curtailed",
-         "layover_aux_kwh"]].sum()
+    bd = bd.assign(infeasible=~bd["feasible"].to_numpy(bool),
+                   grid_kwh_avoided_depot=bd["grid_kwh_depot_without_pv"] - bd["grid_kwh_depot"],
+                   grid_kwh_avoided_opportunity=(bd["grid_kwh_opportunity_without_pv"]
+                                                 - bd["grid_kwh_opportunity"]))
+    split = bd.groupby("month", sort=True).agg(
+        pv_kwh_driving=("pv_kwh_driving", "sum"), pv_kwh_layover=("pv_kwh_layover", "sum"),
+        pv_kwh_parked=("pv_kwh_parked", "sum"), pv_kwh_usable=("pv_kwh_usable", "sum"),
+        pv_kwh_curtailed=("pv_kwh_curtailed", "sum"), layover_aux_kwh=("layover_aux_kwh", "sum"),
+        demand_kwh=("demand_kwh", "sum"), grid_kwh_avoided=("grid_kwh_avoided", "sum"),
+        grid_kwh_avoided_depot=("grid_kwh_avoided_depot", "sum"),
+        grid_kwh_avoided_opportunity=("grid_kwh_avoided_opportunity", "sum"),
+        block_days=("feasible", "size"), block_days_infeasible=("infeasible", "sum"))
     idle_month = idle.groupby("month")[["pv_kwh", "pv_kwh_curtailed"]].sum()
     split["pv_kwh_parked"] += idle_month["pv_kwh"].reindex(split.index, fill_value=0.0)
     split["pv_kwh_curtailed"] += idle_month["pv_kwh_curtailed"].reindex(split.index, fill_value=0.0)
     split["pv_kwh_whole_day"] = split[["pv_kwh_driving", "pv_kwh_layover", "pv_kwh_parked"]].sum(axis=1)
     monthly = monthly.merge(split.reset_index(), on="month", how="left")
-    monthly["avoided_charging_cycles"] = economics.avoided_cycles(
-        monthly["pv_kwh_usable"].to_numpy(), vehicle.battery_kwh, cfg.economics.soc_window)
-    monthly["kwh_per_kwp_allsky"] = monthly["pv_kwh"] / (pv.kwp * n_buses)
-    monthly["kwh_per_kwp_clearsky"] = monthly["pv_kwh_clear"] / (pv.kwp * n_buses)
+    plan = cfg.charging
+    cycle = economics.cycle_energy_kwh(vehicle.battery_kwh, cfg.economics.soc_window)
+    monthly["avoided_charging_cycles"] = (monthly["grid_kwh_avoided_depot"] * plan.depot.efficiency
+                                          + monthly["grid_kwh_avoided_opportunity"]
+                                          * plan.opportunity.efficiency) / cycle
+    monthly["coverage"] = monthly["pv_kwh_usable"] / monthly["demand_kwh"]
+    monthly["kwh_per_kwp_usable"] = monthly["pv_kwh_usable"] / (pv.kwp * n_buses)
+    monthly["kwh_per_kwp_driving"] = monthly["pv_kwh"] / (pv.kwp * n_buses)
+    monthly["kwh_per_kwp_driving_clearsky"] = monthly["pv_kwh_clear"] / (pv.kwp * n_buses)
     return monthly
+
+
+def _segment_flags(segments: pd.DataFrame) -> pd.DataFrame:
+    """Per segment id: ``length_m``, ``in_city_model``, ``in_building`` and ``ground_source``
+    (segments ingested before these existed: in the model, on the road)."""
+    out = pd.DataFrame({"length_m": segments["length_m"].to_numpy(float)},
+                       index=segments["segment_id"].to_numpy())
+    for col, default in (("in_city_model", True), ("in_building", False)):
+        out[col] = segments[col].to_numpy(bool) if col in segments else default
+    out["ground_source"] = (segments["ground_source"].astype(str).to_numpy()
+                            if "ground_source" in segments else "unknown")
+    return out
+
+
+def _study_area(sm: pd.DataFrame, flags: pd.DataFrame, kwh_per_kwp_driving: float) -> dict:
+    """What of the run lies in the city model: route-km, driving time and PV inside it, the
+    driving yield of the whole lines and of the part inside (a bus driving only the
+    modelled streets: the yield scaled by the PV per second inside over the PV per second
+    of the whole), the shading loss inside, the segments inside building footprints and
+    where the segments' ground heights come from."""
+    sums = sm.groupby("segment_id")[["seconds", "pv_kwh", "h_direct", "h_diffuse",
+                                     "h_total_unshaded"]].sum()
+    f = flags.reindex(sums.index)
+    inside, street = f["in_city_model"].to_numpy(bool), ~f["in_building"].to_numpy(bool)
+    seg = flags[flags.index.isin(sums.index)]
+    km = float(seg["length_m"].sum()) / 1000.0
+    km_in = float(seg.loc[seg["in_city_model"], "length_m"].sum()) / 1000.0
+    pv, t = sums["pv_kwh"].to_numpy(), sums["seconds"].to_numpy()
+
+    def ratio(a, b):
+        return float(a / b) if b > 0 else None
+
+    rate_all = ratio(pv.sum(), t.sum())
+
+    def yield_of(sel):
+        rate = ratio(pv[sel].sum(), t[sel].sum())
+        return None if rate is None or not rate_all else kwh_per_kwp_driving * rate / rate_all
+
+    def loss(sel):
+        h = sums[sel]
+        return (float(shading_loss(h["h_direct"].sum(), h["h_diffuse"].sum(), h["h_total_unshaded"].sum()))
+                if h["h_total_unshaded"].sum() > 0 else None)
+
+    in_bld = ~street
+    return {
+        "route_km": km,
+        "route_km_in_city_model": km_in,
+        "route_km_in_city_model_share": ratio(km_in, km),
+        "driving_time_in_city_model_share": ratio(t[inside].sum(), t.sum()),
+        "pv_kwh_driving_in_city_model_share": ratio(pv[inside].sum(), pv.sum()),
+        "kwh_per_kwp_driving_in_city_model": yield_of(inside),
+        "kwh_per_kwp_driving_outside_city_model": yield_of(~inside),
+        "shading_loss_allsky_in_city_model": loss(inside & street),
+        "shading_loss_allsky_outside_city_model": loss(~inside & street),
+        "segments_in_buildings": int(seg["in_building"].sum()),
+        "route_km_in_buildings_share": ratio(float(seg.loc[seg["in_building"], "length_m"].sum()) / 1000.0, km),
+        "driving_time_in_buildings_share": ratio(t[in_bld].sum(), t.sum()),
+        "ground_sources": {k: int(v) for k, v in seg["ground_source"].value_counts().sort_index().items()},
+    }
 
 
 def _fleet_year(cfg: Config, year: int, run_dir: Path, trip, bd, idle, sm, segments,
@@ -730,7 +1041,13 @@ def _fleet_year(cfg: Config, year: int, run_dir: Path, trip, bd, idle, sm, segme
     # a run over some months states annual figures scaled by 12 / months (flagged in the summary)
     annualise = 12.0 / len(cfg.run.months)
     hours_per_bus = annual.service_hours_per_bus(float(trip["seconds"].sum()), n_buses, annualise)
-    tot = sm[[c for c in sm.columns if c.startswith("h_")]].sum()
+    h_cols = [c for c in sm.columns if c.startswith("h_")]
+    # the light on the roofs: every segment; the shading statistics: the road, without the
+    # segments inside building footprints (they take a nearby street's light: in_building)
+    flags = _segment_flags(segments)
+    street = ~sm["segment_id"].map(flags["in_building"]).fillna(False).to_numpy(bool)
+    tot_all = sm[h_cols].sum()
+    tot = sm.loc[street, h_cols].sum()
     summary = {
         "scenario": cfg.scenario, "year": year, "months": cfg.run.months, "pv_mode": cfg.pv.mode,
         "diffuse_model": cfg.irradiance.diffuse_model,
@@ -739,13 +1056,11 @@ def _fleet_year(cfg: Config, year: int, run_dir: Path, trip, bd, idle, sm, segme
         "routes": int(trip["route_id"].nunique()), "trips": int(len(trip)), "buses": n_buses,
         "segments": int(len(segments)), "passes": int(sm["n_passes"].sum()),
         "kwp_per_bus": pv.kwp,
-        "pv_kwh_allsky": float(trip["pv_kwh"].sum()),
-        "pv_kwh_clearsky": float(trip["pv_kwh_clear"].sum()),
-        "pv_kwh_allsky_unshaded": float(trip["pv_kwh_unshaded"].sum()),
+        "pv_kwh_driving_clearsky": float(trip["pv_kwh_clear"].sum()),
+        "pv_kwh_driving_unshaded": float(trip["pv_kwh_unshaded"].sum()),
         "annualised_from_months": annualise != 1.0,
-        "kwh_per_kwp_allsky": float(trip["pv_kwh"].sum() * annualise / (pv.kwp * n_buses)),
-        "kwh_per_kwp_clearsky": float(trip["pv_kwh_clear"].sum() * annualise / (pv.kwp * n_buses)),
-        "irradiation_kwh_m2": {k[2:]: float(v) / 1000.0 for k, v in tot.items()},
+        "kwh_per_kwp_driving_clearsky": float(trip["pv_kwh_clear"].sum() * annualise / (pv.kwp * n_buses)),
+        "irradiation_kwh_m2": {k[2:]: float(v) / 1000.0 for k, v in tot_all.items()},
         "shading_loss_allsky": float(shading_loss(tot["h_direct"], tot["h_diffuse"], tot["h_total_unshaded"])),
         "shading_loss_clearsky": float(shading_loss(tot["h_direct_clear"], tot["h_diffuse_clear"],
                                                     tot["h_total_clear_unshaded"])),
@@ -756,8 +1071,9 @@ def _fleet_year(cfg: Config, year: int, run_dir: Path, trip, bd, idle, sm, segme
         "reflected_share": float(tot["h_reflected"] / tot["h_total"]),
         **_harvest(cfg, bd, idle, pv.kwp * n_buses, annualise),
         **_economics(cfg, bd, n_buses, annualise),
-        **annual.per_bus_figures(tot, n_buses, annualise, hours_per_bus, data_dir, year),
+        **annual.per_bus_figures(tot_all, n_buses, annualise, hours_per_bus, data_dir, year),
     }
+    summary.update(_study_area(sm, flags, summary["kwh_per_kwp_driving"]))
     summary.update(_radiation_gaps(data_dir, year, cfg.run.months))
     _check_totals(summary, run_dir)
     return _monthly(cfg, trip, bd, idle, n_buses), summary

@@ -187,7 +187,8 @@ def _run_context(cfg: Config, year: int, run_dir: Path) -> tuple[RunContext, lis
         bvh_cache_size=cfg.dask.bvh_cache_size, ground_albedo=cfg.city.albedo.ground,
         road_albedo=cfg.city.albedo.road, roof_height_m=cfg.trajectory.roof_height_m,
         routes=tuple(routes) if routes is not None else None, shapes=shapes,
-        route_of_trip=dict(zip(trips["trip_id"], trips["route_id"].astype(str))))
+        # the progress view's kWh per route, by the routes' public names
+        route_of_trip=dict(zip(trips["trip_id"], trips["route_short_name"].astype(str))))
     return ctx, tiles
 
 
@@ -248,16 +249,65 @@ def _warm_radiation(data_dir: str, year: int, sky: bool = False) -> None:
         pass
 
 
-def _summary_line(s: dict) -> str:
-    def yield_of(key):
-        return "not computed" if s.get(key) is None else f"{s[key]:.0f} kWh/kWp"
+def _period(months: list[int]) -> str:
+    """'the year', or the run's months ('June', 'June-August', 'Jan, Mar')."""
+    import calendar
 
-    return (f"annual yield (all-sky) driving {s['kwh_per_kwp_allsky']:.0f} kWh/kWp "
-            f"({s['kwh_per_kwp_clearsky']:.0f} clear-sky), in service {yield_of('kwh_per_kwp_in_service')}, "
-            f"whole day {yield_of('kwh_per_kwp_whole_day')}; "
+    if len(months) == 12:
+        return "the year"
+    names = [calendar.month_abbr[m] for m in months]
+    if len(months) > 2 and months == list(range(months[0], months[-1] + 1)):
+        return f"{names[0]}-{names[-1]}"
+    return calendar.month_name[months[0]] if len(months) == 1 else ", ".join(names)
+
+
+def _summary_line(s: dict) -> str:
+    """The run's headline: the yield the batteries take (per year; a partial year's
+    annualised, said so) with the harvested yields beside it, then the energies of the run's
+    own months side by side (PV taken and curtailed, the demand it covers, grid energy
+    avoided), the charging plan's infeasible block-days, the part of the lines inside the
+    city model and what the shading statistics left out."""
+    def kwp(key):
+        return "n/a" if s.get(key) is None else f"{s[key]:.0f}"
+
+    months = s.get("months") or list(range(1, 13))
+    partial = len(months) < 12
+    scale = len(months) / 12.0 if partial else 1.0         # annual figures back to the months
+    period = _period(months)
+    harvested = ", ".join(f"{label} {kwp(key)}" for label, key in (
+        ("driving", "kwh_per_kwp_driving"), ("in service", "kwh_per_kwp_in_service"),
+        ("whole day", "kwh_per_kwp_whole_day")) if s.get(key) is not None)
+    line = (f"annual yield the batteries take {kwp('kwh_per_kwp_usable')} kWh/kWp "
+            f"({'annualised from ' + period + '; ' if partial else ''}harvested: {harvested} "
+            f"kWh/kWp; driving clear-sky {kwp('kwh_per_kwp_driving_clearsky')}); "
             f"shading loss {100 * s['shading_loss_allsky']:.1f} % on the road; "
-            f"the battery takes {s['pv_kwh_usable'] / 1000:.1f} MWh "
+            f"in {period} the batteries take {s['pv_kwh_usable'] / 1000:.1f} MWh "
             f"({s['pv_kwh_curtailed'] / 1000:.1f} MWh curtailed): "
-            f"PV covers {100 * s['coverage']:.2f} % of {s['fleet_demand_mwh']:.0f} MWh; "
-            f"{s['avoided_charging_cycles_per_bus']:.1f} charging cycles avoided per bus; "
-            f"payback {s['payback_years']:.1f} years")
+            f"PV covers {100 * s['coverage']:.2f} % of the {s['fleet_demand_in_service_mwh'] * scale:.1f} "
+            f"MWh the buses use in service (trips and layovers); "
+            f"grid energy avoided {s['grid_kwh_avoided'] / 1000:.1f} MWh (depot "
+            f"{s['grid_kwh_avoided_depot'] / 1000:.1f}, terminals {s['grid_kwh_avoided_opportunity'] / 1000:.1f}); "
+            f"{s['avoided_charging_cycles_per_bus']:.1f} charging cycles avoided per bus"
+            f"{' (annualised)' if partial else ''}; payback {s['payback_years']:.1f} years")
+    n_bad, n_days = s.get("block_days_infeasible", 0), s.get("block_days", 0)
+    if n_bad:
+        first = "; ".join(s.get("infeasible_block_days_first") or [])
+        line += (f". The charging plan cannot serve {n_bad} of {n_days} block-days (the battery "
+                 f"would fall below its minimum; first: {first}): see block_day.parquet")
+    elif n_days:
+        line += f". The charging plan serves all {n_days} block-days"
+    share = s.get("route_km_in_city_model_share")
+    if share is not None and share < 1.0:
+        inside = s.get("kwh_per_kwp_driving_in_city_model")
+        loss = s.get("shading_loss_allsky_in_city_model")
+        line += (f". In the city model: {100 * share:.0f} % of {s['route_km']:.1f} route-km, "
+                 f"{100 * (s.get('pv_kwh_driving_in_city_model_share') or 0):.0f} % of the driving PV; "
+                 f"driving yield there {'n/a' if inside is None else f'{inside:.0f} kWh/kWp'}, "
+                 f"shading loss there {'n/a' if loss is None else f'{100 * loss:.1f} %'}; "
+                 "outside it the roads are under open sky")
+    n_bld = s.get("segments_in_buildings") or 0
+    if n_bld:
+        line += (f". {n_bld} segments ({100 * (s.get('route_km_in_buildings_share') or 0):.1f} % of "
+                 "the route-km) lie inside building footprints: lit as the street next to them, "
+                 "left out of the shading statistics")
+    return line

@@ -134,7 +134,7 @@ def run_standing(ctx, tile: str) -> dict:
     run = RunDir(ctx.run_dir)
     points = pd.read_parquet(run.timeline_table("points"))
     points = points[points["tile"] == tile]
-    iv = pd.read_parquet(run.timeline_table("intervals"))
+    iv = harvested_intervals(run)
     iv = iv[iv["point_id"].isin(points["point_id"])].reset_index(drop=True)
     cfg = IrradianceCfg(**ctx.irradiance)
     dark = tile == "covered" or not len(iv)
@@ -180,17 +180,12 @@ def run_standing(ctx, tile: str) -> dict:
 def depot_point(cfg, data_dir) -> tuple | None:
     """The configured depot (``fleet.depot``, WGS84) as ``(x, y, z, tile)`` in the run's CRS:
     the roof height above the road nearest to it; ``None`` when no depot is configured.
-
-    Raises
-    ------
-    InputError
-        With ``depot_shading: city`` when the city model has no mesh at the depot.
-    """
+    With ``depot_shading: city`` a depot where the city model has no building within its
+    buffer stands in the open (:func:`vipvflow.models.shading.get_scene`)."""
     import json
 
     from pyproj import Transformer
 
-    from ..errors import InputError
     from ..inputs.tiles import tile_names
 
     depot = cfg.fleet.depot
@@ -202,10 +197,6 @@ def depot_point(cfg, data_dir) -> tuple | None:
     seg = pd.read_parquet(data.gtfs.segments, columns=["x", "y", "z"])
     near = int(np.argmin(np.hypot(seg["x"].to_numpy() - x, seg["y"].to_numpy() - y)))
     tile = str(tile_names([x], [y], data.tile_size_m())[0])
-    mesh = data.city.mesh(tile)
-    if cfg.fleet.depot_shading == "city" and not mesh.exists():
-        raise InputError(f"{cfg._source}: fleet.depot ({depot.lat}, {depot.lon}) lies outside the city "
-                         f"model (no mesh for tile {tile}); set fleet.depot_shading to open or covered")
     return float(x), float(y), float(seg["z"].to_numpy()[near]), tile
 
 
@@ -221,18 +212,33 @@ def write_timeline(cfg, year: int, run_dir, routes=None) -> list[tuple[str, str]
         tl = block_timeline(cfg.data_dir, year, months=cfg.run.months, routes=routes,
                             depot=depot_point(cfg, cfg.data_dir), depot_shading=cfg.fleet.depot_shading)
         iv = tl["intervals"]
-        if cfg.fleet.harvest == "in_service":
-            iv = iv[iv["kind"] == "layover"]
-        elif cfg.fleet.harvest == "driving":
-            iv = iv.iloc[:0]
+        # every interval, for the battery's balance (layover times, auxiliaries, chargers);
+        # the roof's light only of those fleet.harvest counts
+        harvest = {"whole_day": ("layover", "parked"), "in_service": ("layover",),
+                   "driving": ()}[cfg.fleet.harvest]
+        iv = iv.assign(harvested=iv["kind"].astype(str).isin(harvest))
         write_parquet(tl["block_days"].reset_index(drop=True), run.timeline_table("block_days"))
         write_parquet(iv.astype({"kind": str}).reset_index(drop=True), run.timeline_table("intervals"))
         write_parquet(tl["trip_runs"], run.timeline_table("trip_runs"))
         write_parquet(tl["points"].astype({"stop_id": str, "tile": str, "shading": str}),
                       run.timeline_table("points"))
-    iv = pd.read_parquet(run.timeline_table("intervals"), columns=["point_id"])
+    iv = harvested_intervals(run, columns=["point_id"])
     tiles = pd.read_parquet(run.timeline_table("points")).set_index("point_id")["tile"]
     return sorted(set(tiles.reindex(iv["point_id"].unique()).astype(str)))
+
+
+def harvested_intervals(run: RunDir, columns=None) -> pd.DataFrame:
+    """The timeline's intervals whose light ``fleet.harvest`` counts (a timeline written
+    before the ``harvested`` column: all of its intervals)."""
+    import pyarrow.parquet as pq
+
+    path = run.timeline_table("intervals")
+    has = "harvested" in pq.read_schema(path).names
+    cols = None if columns is None else list(columns) + (["harvested"] if has else [])
+    iv = pd.read_parquet(path, columns=cols)
+    if has:
+        iv = iv[iv.pop("harvested").to_numpy(bool)]
+    return iv
 
 
 def standing_done(run_dir, tile: str) -> bool:

@@ -44,6 +44,7 @@ from ...models.mesh import SURFACE_CODE, SURFACE_TYPES, TileMesh
 from ...progress import Progress, citygml_bytes, file_position
 from ..tiles import tile_bounds, tile_index, tile_name
 from .citygml import CityGMLReader, open_sources
+from .coverage import grown_footprints, tile_footprints, write_coverage
 from .crs import (SourceCRS, horizontal, inside, is_projected, local_utm, normalise_crs,
                   parse_srs_name, transform_xyz)
 from .geometry import Skip, classify_normal, prepare_polygon
@@ -81,6 +82,7 @@ class IngestReport:
     problems: dict = field(default_factory=dict)           # unreadable parts, per reason
     ignored_features: dict = field(default_factory=dict)   # city objects not read, per class
     tiles: int = 0
+    coverage: dict = field(default_factory=dict)           # the area the model covers (coverage.py)
     triangles: int = 0
     terrain_triangles: int = 0
     elapsed_s: float = 0.0
@@ -269,18 +271,13 @@ class _Accumulator:
             chunk.take(sidx[sel]).save(folder / f"{self.n_chunks:06d}.npz", own[sel])
 
 
-def _write_tile(name: str, spool: Path, city_dir: Path, cfg: CityCfg, crs: str) -> dict:
-    """Write one tile's GeoParquet (own surfaces) and mesh (own + buffer); return its tiles.json entry."""
+def _write_surfaces(own_part: "_Chunk", name: str, city_dir: Path, crs: str):
+    """A tile's own surfaces as ``surfaces/tile=<T>/part-0.parquet`` (GeoParquet); returns
+    its footprints grown for the coverage area (:func:`.coverage.grown_footprints`)."""
     import geopandas as gpd
     import shapely
 
-    files = sorted((spool / name).glob("*.npz"))
-    chunk, own = _Chunk.load_many(files)
-    order = np.argsort(~own, kind="stable")      # own surfaces first
-    chunk = chunk.take(order)
-    n_own = int(own.sum())
-    # -- surfaces (own) -> GeoParquet
-    own_part = chunk.take(np.arange(n_own))
+    n_own = own_part.n
     ring_of_vertex = np.repeat(np.arange(len(own_part.R)), own_part.R)
     rings = shapely.linearrings(own_part.V, indices=ring_of_vertex)
     polys = shapely.polygons(rings, indices=np.repeat(np.arange(n_own), own_part.rsz))
@@ -293,7 +290,19 @@ def _write_tile(name: str, spool: Path, city_dir: Path, cfg: CityCfg, crs: str) 
         "tile": np.full(n_own, name, dtype=object)}, geometry=polys, crs=crs)
     with atomic_path(CityDir(city_dir).surface_part(name)) as tmp:
         gdf.to_parquet(tmp, index=False)
-    del gdf, polys, rings
+    return grown_footprints(tile_footprints(gdf))
+
+
+def _write_tile(name: str, spool: Path, city_dir: Path, cfg: CityCfg, crs: str):
+    """Write one tile's GeoParquet (own surfaces) and mesh (own + buffer); return its
+    tiles.json entry and its footprints grown for the coverage area (None without)."""
+    files = sorted((spool / name).glob("*.npz"))
+    chunk, own = _Chunk.load_many(files)
+    order = np.argsort(~own, kind="stable")      # own surfaces first
+    chunk = chunk.take(order)
+    n_own = int(own.sum())
+    # -- surfaces (own) -> GeoParquet (a tile reached only by the buffer has none: no file)
+    grown = _write_surfaces(chunk.take(np.arange(n_own)), name, city_dir, crs) if n_own else None
     # -- mesh (own + buffer)
     vo = _offsets(chunk.vsz)
     tri_owner = np.repeat(np.arange(chunk.n, dtype=np.int32), chunk.tsz)
@@ -306,7 +315,7 @@ def _write_tile(name: str, spool: Path, city_dir: Path, cfg: CityCfg, crs: str) 
                     buffer_m=float(cfg.buffer_m), name=name)
     mesh.save(CityDir(city_dir).mesh(name))
     return {"bounds": bounds.tolist(), "n_surfaces": n_own,
-            "n_buffer_surfaces": int(chunk.n - n_own), "n_triangles": int(len(triangles))}
+            "n_buffer_surfaces": int(chunk.n - n_own), "n_triangles": int(len(triangles))}, grown
 
 
 def ingest_city(paths, data_dir, city_cfg: CityCfg | None = None, crs: str | None = None,
@@ -365,11 +374,16 @@ def ingest_city(paths, data_dir, city_cfg: CityCfg | None = None, crs: str | Non
         acc.flush()
         target = report.crs = read.target
         _check_not_empty(report, counts, read.ignored, final_dir)
-        tiles = {}
-        for name in sorted(acc.own_tiles):
-            tiles[name] = _write_tile(name, spool, city_dir, cfg, target)
+        tiles, grown = {}, []
+        # every tile a surface can shade has a mesh: its own surfaces' tiles and the tiles
+        # within the buffer around them (a road there is shaded by the model's buildings)
+        for name in sorted(acc.tiles_seen):
+            tiles[name], g = _write_tile(name, spool, city_dir, cfg, target)
+            if g is not None:
+                grown.append(g)
         terrain_tris = _write_terrain(city_dir, acc, target)
         shutil.rmtree(spool)
+        report.coverage = write_coverage(CityDir(city_dir), target, grown)
         write_json({
             "crs": target, "tile_size_m": cfg.tile_size_m, "buffer_m": cfg.buffer_m,
             "tiles": tiles}, CityDir(city_dir).tiles_json, sort_keys=True)

@@ -10,8 +10,11 @@
 
 :meth:`TerrainModel.elevation` interpolates linearly (barycentric) in the TIN triangle
 containing each point, found through a uniform grid index; outside the TIN it takes the
-inverse-distance mean of the nearest ground surfaces within ``max_distance_m``, and NaN
-where there is nothing.
+inverse-distance mean (modified Shepard weights, falling to 0 at the radius) of the nearest
+ground surfaces within ``max_distance_m``, and NaN where there is nothing.  :meth:`TerrainModel.ground` also says where each height comes from
+and blends a fallback height (the radiation file's altitude, or a configured one) into the
+buildings' mean with the weight of a ground point at ``max_distance_m``, so the road's
+profile stays continuous where it leaves the buildings.
 """
 from __future__ import annotations
 
@@ -20,6 +23,10 @@ import numpy as np
 
 from ...errors import InputError
 from ...store import DataDir
+
+
+#: where a ground height comes from (``segments.parquet`` ``ground_source``)
+GROUND_SOURCES = ("relief", "buildings", "radiation_header", "configured")
 
 
 class TerrainModel:
@@ -107,7 +114,7 @@ class TerrainModel:
         return z
 
     # -- fallback ---------------------------------------------------------------------
-    def _ground(self, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    def _ground(self, x: np.ndarray, y: np.ndarray, fallback_m: float | None = None) -> np.ndarray:
         z = np.full(len(x), np.nan)
         if len(self.ground_points) == 0 or len(x) == 0:
             return z
@@ -120,12 +127,57 @@ class TerrainModel:
                                 distance_upper_bound=self.max_distance_m)
         d, i = d.reshape(len(x), k), i.reshape(len(x), k)
         valid = np.isfinite(d)
-        w = np.where(valid, 1.0 / np.maximum(d, 1e-3) ** 2, 0.0)
+        # Franke and Nielson's modified Shepard weights ((R - d) / (R d))^2: a point's weight
+        # falls to 0 at the search radius R, so the mean has no step where a point leaves it
+        r = max(self.max_distance_m, 1e-3)
+        dd = np.maximum(np.where(valid, d, r), 1e-3)
+        w = np.where(valid, ((r - np.minimum(dd, r)) / (r * dd)) ** 2, 0.0)
         zi = np.where(valid, self.ground_points[np.minimum(i, len(self.ground_points) - 1), 2], 0.0)
         wsum = w.sum(axis=1)
         has = wsum > 0
-        z[has] = (w * zi).sum(axis=1)[has] / wsum[has]
+        num = (w * zi).sum(axis=1)
+        if fallback_m is not None:
+            # the fallback weighs as a ground point at the search radius would in plain
+            # inverse-distance weighting: it takes over smoothly where the buildings end
+            w0 = 1.0 / r ** 2
+            num, wsum = num + w0 * float(fallback_m), wsum + w0
+            has = has | valid.any(axis=1)
+        z[has] = num[has] / wsum[has]
         return z
+
+    def ground(self, x, y, fallback_m: float | None = None,
+               fallback_source: str = "configured") -> tuple[np.ndarray, np.ndarray]:
+        """Ground elevation (m) and its source at points (x, y) in m.
+
+        The TIN relief where it covers a point; else the inverse-distance mean of the
+        building ground surfaces within ``max_distance_m``, blended with *fallback_m*;
+        else *fallback_m*; else NaN.
+
+        Returns
+        -------
+        z : ndarray of float64, m (NaN where nothing is known and there is no fallback)
+        source : ndarray of int8, index into :data:`GROUND_SOURCES` (-1: unknown);
+            *fallback_source* (``radiation_header`` or ``configured``) names the fallback
+        """
+        x = np.asarray(x, dtype=np.float64).ravel()
+        y = np.asarray(y, dtype=np.float64).ravel()
+        z = np.full(len(x), np.nan)
+        src = np.full(len(x), -1, np.int8)
+        step = 200_000
+        for s in range(0, len(x), step):
+            xs, ys = x[s:s + step], y[s:s + step]
+            zs = self._tin(xs, ys)
+            ss = np.where(np.isfinite(zs), GROUND_SOURCES.index("relief"), -1).astype(np.int8)
+            miss = np.isnan(zs)
+            if miss.any():
+                zb = self._ground(xs[miss], ys[miss], fallback_m)
+                sb = np.where(np.isfinite(zb), GROUND_SOURCES.index("buildings"), -1)
+                if fallback_m is not None:
+                    sb = np.where(np.isfinite(zb), sb, GROUND_SOURCES.index(fallback_source))
+                    zb = np.where(np.isfinite(zb), zb, float(fallback_m))
+                zs[miss], ss[miss] = zb, sb
+            z[s:s + step], src[s:s + step] = zs, ss
+        return z, src
 
     def elevation(self, x, y) -> np.ndarray:
         """Ground elevation (m) at points (x, y) in m; NaN where the model knows nothing.

@@ -70,6 +70,20 @@ MAX_LINE_BYTES = 1 << 20
 BASIC_ROUTE_TYPES = {0: "tram", 1: "subway", 2: "rail", 3: "bus", 4: "ferry", 5: "cable tram",
                      6: "aerial lift", 7: "funicular", 11: "trolleybus", 12: "monorail"}
 
+#: the route types of buses: basic bus (3) and trolleybus (11), the extended bus services
+#: 700..716 and trolleybus 800 (the default of ``run.route_types``)
+BUS_ROUTE_TYPES = frozenset({3, 11, *range(700, 717), 800})
+
+
+def route_type_set(route_types) -> frozenset | None:
+    """The GTFS route types ``run.route_types`` stands for: ``"bus"`` (the default:
+    :data:`BUS_ROUTE_TYPES`), ``"all"`` (None: every type) or a list of types."""
+    if route_types is None or route_types == "all":
+        return None
+    if route_types == "bus":
+        return BUS_ROUTE_TYPES
+    return frozenset(int(t) for t in route_types)
+
 
 def check_tables(path: Path, max_line: int = MAX_LINE_BYTES) -> None:
     """Stream every ``.txt`` table of a GTFS zip or folder once, before pandas reads it.
@@ -127,7 +141,7 @@ def _check_timezone(name: str, where: str) -> str:
 
 
 def read_feed(feed_path, dist_units: str | None = None, timezone: str | None = None,
-              route_types=None) -> Feed:
+              route_types="bus") -> Feed:
     """Read a GTFS zip or folder with gtfs-kit and prepare it.
 
     Parameters
@@ -140,9 +154,11 @@ def read_feed(feed_path, dist_units: str | None = None, timezone: str | None = N
     timezone : str, optional
         IANA zone of the timetable when the feed has no agency.txt (or no timezone in
         it); the feed's own ``agency_timezone`` wins when present.
-    route_types : iterable of int, optional
-        GTFS ``route_type`` values to keep (basic 0..12 or extended 100..1799); all when
-        omitted. Trips of other types are dropped and counted.
+    route_types : "bus", "all" or iterable of int, optional
+        GTFS ``route_type`` values to keep (basic 0..12 or extended 100..1799; ``"bus"``:
+        :data:`BUS_ROUTE_TYPES`; ``"all"`` or None: every type). Trips of other types are
+        dropped and counted; kept trips of types that are not buses are named in a problem
+        line (a building model knows no tunnels or viaducts). Buses by default.
 
     Raises
     ------
@@ -159,11 +175,15 @@ def read_feed(feed_path, dist_units: str | None = None, timezone: str | None = N
     tz = _feed_timezone(gfeed, path, timezone, problems)
     gfeed = _select_routes(gfeed, path, route_types, problems)
     _fill_single_times(gfeed, path, problems)
-    gfeed, n_freq = _expand_frequencies(gk, gfeed, problems)
+    gfeed, n_freq = _expand_frequencies(gk, gfeed, path, problems)
+    # trips without stop times and stop times of unknown trips or stops go before any shape
+    # is built from the stops (gtfs-kit's create_shapes fails on a trip without stop times)
+    gfeed.trips, gfeed.stop_times = _drop_unmatched(gfeed.trips, gfeed.stop_times, gfeed.stops,
+                                                    path, problems)
     _drop_unusable_shapes(gfeed, problems)
-    gfeed, n_built = _build_missing_shapes(gk, gfeed, problems)
+    gfeed, n_built = _build_missing_shapes(gk, gfeed, path, problems)
     st = _stop_times_in_seconds(gfeed.stop_times, problems)
-    trips, st = _drop_unmatched(gfeed.trips, st, gfeed.stops, problems)
+    trips = gfeed.trips
     return Feed(path=path, timezone=tz, routes=gfeed.routes, trips=trips.reset_index(drop=True),
                 stops=gfeed.stops, stop_times=st, shapes=gfeed.shapes, calendar=gfeed.calendar,
                 calendar_dates=gfeed.calendar_dates, dist_units=gfeed.dist_units,
@@ -171,17 +191,30 @@ def read_feed(feed_path, dist_units: str | None = None, timezone: str | None = N
                 gk_feed=gfeed)
 
 
+def library_call(path: Path, what: str, fn, *args, **kwargs):
+    """``fn(*args, **kwargs)``, a call into gtfs-kit (or pandas) on the feed at *path*: any
+    error it raises becomes one :class:`InputError` line naming the feed, the step (*what*:
+    the table and field it works on) and the library's own message, never a traceback."""
+    try:
+        return fn(*args, **kwargs)
+    except InputError:
+        raise
+    except Exception as exc:  # noqa: BLE001 - a library's many error kinds, said in one line
+        msg = str(exc).strip().splitlines()[0][:200] if str(exc).strip() else ""
+        kind = type(exc).__name__
+        if isinstance(exc, KeyError):
+            msg = f"no entry {msg}"
+        raise InputError(f"{path}: {what} failed ({kind}: {msg})") from None
+
+
 def _read_tables(gk, path: Path, dist_units: str | None):
     """gtfs-kit's feed of *path*, with the trips, stop times, stops and a calendar it needs."""
     if not path.exists():
         raise InputError(f"{path}: GTFS feed not found")
     check_tables(path)
-    try:
-        gfeed = gk.read_feed(path, dist_units=dist_units) if dist_units else _read_infer(gk, path)
-    except InputError:
-        raise
-    except Exception as exc:  # gtfs-kit raises many kinds on a broken zip
-        raise InputError(f"{path}: not a readable GTFS feed: {exc}") from None
+    gfeed = library_call(path, "reading the feed (gtfs-kit read_feed)",
+                         (lambda: gk.read_feed(path, dist_units=dist_units)) if dist_units
+                         else (lambda: _read_infer(gk, path)))
     for name in ("trips", "stop_times", "stops"):
         if getattr(gfeed, name) is None or getattr(gfeed, name).empty:
             raise InputError(f"{path}: {name}.txt missing or empty")
@@ -213,7 +246,7 @@ def _feed_timezone(gfeed, path: Path, timezone: str | None, problems: list[str])
                      "(or inputs.gtfs_timezone), e.g. Europe/Berlin")
 
 
-def _expand_frequencies(gk, gfeed, problems: list[str]):
+def _expand_frequencies(gk, gfeed, path: Path, problems: list[str]):
     """frequencies.txt expanded into trips: (feed, number of trips added)."""
     if gfeed.frequencies is None or gfeed.frequencies.empty:
         return gfeed, 0
@@ -221,7 +254,8 @@ def _expand_frequencies(gk, gfeed, problems: list[str]):
     fr = gfeed.frequencies
     exact = (pd.to_numeric(fr["exact_times"], errors="coerce").fillna(0).astype(int)
              if "exact_times" in fr else pd.Series(0, index=fr.index))
-    gfeed = gk.expand_frequencies(gfeed)
+    gfeed = library_call(path, "frequencies.txt: expanding trip_id, start_time, end_time, "
+                         "headway_secs into trips (gtfs-kit)", gk.expand_frequencies, gfeed)
     n_freq = len(gfeed.trips) - n_before
     if (exact == 0).any():
         problems.append(f"{int((exact == 0).sum())} frequencies.txt rows are headway-based "
@@ -257,13 +291,15 @@ def _drop_unusable_shapes(gfeed, problems: list[str]) -> None:
             gfeed.trips.loc[named, "shape_id"] = pd.NA
 
 
-def _build_missing_shapes(gk, gfeed, problems: list[str]):
+def _build_missing_shapes(gk, gfeed, path: Path, problems: list[str]):
     """A shape from the stop sequence for every trip without one: (feed, shapes built)."""
     n_missing = int(gfeed.trips["shape_id"].isna().sum())
     if not n_missing:
         return gfeed, 0
     before = set() if gfeed.shapes is None else set(gfeed.shapes["shape_id"])
-    gfeed = gk.create_shapes(gfeed)
+    gfeed = library_call(path, "building shapes from stop_times.txt stop sequences and "
+                         "stops.txt stop_lat/stop_lon (gtfs-kit create_shapes)",
+                         gk.create_shapes, gfeed)
     n_built = len(set(gfeed.shapes["shape_id"]) - before)
     problems.append(f"{n_missing} trips without a shape: {n_built} shapes built from the "
                     "stop sequence (straight lines between stops)")
@@ -294,19 +330,22 @@ def _stop_times_in_seconds(stop_times: pd.DataFrame, problems: list[str]) -> pd.
     return st.sort_values(["trip_id", "stop_sequence"], kind="stable").reset_index(drop=True)
 
 
-def _drop_unmatched(trips: pd.DataFrame, st: pd.DataFrame, stops: pd.DataFrame,
+def _drop_unmatched(trips: pd.DataFrame, st: pd.DataFrame, stops: pd.DataFrame, path: Path,
                     problems: list[str]):
-    """(trips, stop times) without the trips that have no stop times and the stop times at
-    unknown stops (counted)."""
-    no_times = ~trips["trip_id"].isin(st["trip_id"])
-    if no_times.any():
-        problems.append(f"{int(no_times.sum())} trips have no stop_times; dropped")
-        trips = trips[~no_times]
+    """(trips, stop times) without the stop times at unknown stops and the trips left with
+    no stop times (each counted)."""
     missing_stop = ~st["stop_id"].isin(stops["stop_id"])
     if missing_stop.any():
         problems.append(f"{int(missing_stop.sum())} stop_times reference unknown stops; dropped")
         st = st[~missing_stop]
-    return trips, st
+    no_times = ~trips["trip_id"].isin(st["trip_id"])
+    if no_times.any():
+        problems.append(f"{int(no_times.sum())} of {len(trips)} trips have no stop_times; dropped")
+        trips = trips[~no_times]
+    if trips.empty:
+        raise InputError(f"{path}: no trip has stop_times (stop_times.txt names none of the "
+                         "trips.txt trips at known stops)")
+    return trips.reset_index(drop=True), st.reset_index(drop=True)
 
 
 def _check_dates(gfeed, path: Path) -> None:
@@ -374,25 +413,42 @@ def _select_routes(gfeed, path: Path, route_types, problems: list[str]):
     routes, trips = gfeed.routes, gfeed.trips
     if routes is None or routes.empty:
         raise InputError(f"{path}: routes.txt missing or empty")
+    orphan = ~gfeed.stop_times["trip_id"].isin(trips["trip_id"])
+    if orphan.any():
+        problems.append(f"{int(orphan.sum())} stop_times name a trip_id that trips.txt does not "
+                        "list; dropped")
     unknown = ~trips["route_id"].isin(routes["route_id"])
     if unknown.any():
         names = sorted(trips.loc[unknown, "route_id"].astype(str).unique())
         problems.append(f"{int(unknown.sum())} trips name a route_id missing from routes.txt "
                         f"({', '.join(names[:5])}{' ...' if len(names) > 5 else ''}); dropped")
         trips = trips[~unknown]
-    if route_types is not None:
-        wanted = {int(t) for t in route_types}
-        rtype = pd.to_numeric(routes["route_type"], errors="coerce")
+    wanted = route_type_set(route_types)
+    rtype = pd.to_numeric(routes["route_type"], errors="coerce")
+    if wanted is not None:
         keep_routes = set(routes.loc[rtype.isin(wanted), "route_id"])
         other = ~trips["route_id"].isin(keep_routes)
+        label = "bus" if wanted == BUS_ROUTE_TYPES else sorted(wanted)
         if other.all():
             present = sorted(int(t) for t in rtype.dropna().unique())
             raise InputError(f"{path}: no trip has a route_type in run.route_types "
-                             f"{sorted(wanted)}; the feed has {present}")
+                             f"({label}); the feed has {present}"
+                             + ("; name the types to simulate in run.route_types (a list) "
+                                "or 'all'" if wanted == BUS_ROUTE_TYPES else ""))
         if other.any():
-            problems.append(f"{int(other.sum())} trips of route types outside run.route_types "
-                            f"{sorted(wanted)}; dropped")
+            dropped = sorted(int(t) for t in rtype[routes["route_id"].isin(
+                set(trips.loc[other, "route_id"]))].dropna().unique())
+            problems.append(f"{int(other.sum())} trips of route types {dropped} outside "
+                            f"run.route_types ({label}); dropped")
             trips = trips[~other]
+    kept_types = rtype[routes["route_id"].isin(set(trips["route_id"]))].dropna().astype(int)
+    not_bus = sorted(set(kept_types) - BUS_ROUTE_TYPES)
+    if not_bus:
+        n = int(trips["route_id"].isin(set(routes.loc[rtype.isin(not_bus), "route_id"])).sum())
+        problems.append(f"{n} trips of route types {not_bus} that are not buses are simulated "
+                        "as buses on the street: a building model knows no tunnels, cuttings "
+                        "or viaducts, so where such a line runs underground or elevated its "
+                        "light is wrong")
     if trips.empty:
         raise InputError(f"{path}: no trip left: every trip names a route_id missing from "
                          "routes.txt")

@@ -26,6 +26,7 @@ from ...errors import InputError
 from ...store import TILE_SIZE_M, DataDir, GtfsDir, staging_dir, swap_dir, write_parquet, write_text
 from .feed import read_feed
 from .schedule import pattern_segment_times, project_stops_monotone
+from ..city.terrain import GROUND_SOURCES as _GROUND_SOURCES
 from .segments import build_segments, cumulative_distance, project_shapes
 
 log = logging.getLogger(__name__)
@@ -45,21 +46,111 @@ def _city_grid(data_dir: Path):
     return meta.get("crs"), meta.get("tile_size_m")
 
 
-def _terrain(data_dir: Path, problems: list[str]):
-    """The city's terrain model, or None (module not available or no terrain.npz)."""
-    if not DataDir(data_dir).city.terrain.exists():
+def _terrain(data_dir: Path):
+    """The city's terrain model (relief and building ground surfaces), or None without a
+    city model."""
+    path = DataDir(data_dir).city.terrain
+    if not path.exists():
         return None
-    try:
-        from ..city import TerrainModel
-    except ImportError:
-        problems.append("city/terrain.npz present but vipvflow.inputs.city.TerrainModel is not "
-                        "available; default elevation used")
-        return None
+    from ..city import TerrainModel
+
     try:
         return TerrainModel.load(data_dir)
-    except Exception as exc:  # a broken terrain must not stop the timetable
-        problems.append(f"city/terrain.npz could not be loaded ({exc}); default elevation used")
+    except (OSError, ValueError, KeyError) as exc:
+        raise InputError(f"{path}: unreadable ({exc}); run `vipvflow ingest city` again") from None
+
+
+def ground_fallback(data_dir: Path, traj_cfg) -> tuple[float, str] | None:
+    """The ground height (m) where the city model knows none, and its source:
+    ``trajectory.ground_elevation_m`` when set (``configured``), else the altitude declared
+    by the ingested radiation files' headers (``radiation_header``, their mean), else None."""
+    height = getattr(traj_cfg, "ground_elevation_m", None)
+    if height is not None:
+        return float(height), "configured"
+    path = DataDir(data_dir).radiation.report
+    try:
+        locations = json.loads(path.read_text()).get("locations", [])
+    except (OSError, ValueError):
         return None
+    alts = [float(loc["altitude"]) for loc in locations
+            if loc.get("altitude_declared", True) and loc.get("altitude") is not None]
+    return (float(np.mean(alts)), "radiation_header") if alts else None
+
+
+def _ground_findings(segs: pd.DataFrame, fallback, feed_path, data_dir: Path,
+                     problems: list[str]) -> dict:
+    """Segments by the source of their ground height (counted, the fallback said in a
+    problem line); segments with none are an :class:`InputError`."""
+    from ..city.terrain import GROUND_SOURCES
+
+    src = segs["ground_source"].to_numpy()
+    unknown = int((src < 0).sum())
+    if unknown:
+        city = DataDir(data_dir).city
+        where = ("no city model is ingested" if not city.terrain.exists() else
+                 "they lie outside the city model's relief and more than 100 m from its buildings")
+        raise InputError(f"{feed_path}: no ground height for {unknown} of {len(segs)} road "
+                         f"segments ({where}): ingest the CAMS radiation first (its header's "
+                         "altitude is used) or set trajectory.ground_elevation_m (m above sea level)")
+    counts = {name: int((src == i).sum()) for i, name in enumerate(GROUND_SOURCES)}
+    far = counts["radiation_header"] + counts["configured"]
+    if far and fallback is not None:
+        what = ("the radiation file's altitude" if fallback[1] == "radiation_header"
+                else "trajectory.ground_elevation_m")
+        if not DataDir(data_dir).city.terrain.exists():
+            problems.append(f"no city model: the ground of all {len(segs)} segments is {what} "
+                            f"({fallback[0]:.1f} m)")
+        else:
+            problems.append(f"{far} of {len(segs)} segments ({100 * far / len(segs):.0f} %) are "
+                            f"beyond the city model's relief and more than 100 m from its "
+                            f"buildings: their ground is {what} ({fallback[0]:.1f} m), blended into "
+                            "the buildings' ground where it meets them")
+    return counts
+
+
+def _city_fit(segs: pd.DataFrame, data_dir: Path, problems: list[str]) -> dict:
+    """``in_city_model`` (the segment's midpoint inside the model's coverage area) and
+    ``in_building`` with the offset of the point its light is taken from (the midpoint inside
+    a building footprint: a straight line between stops crossing a block), added to *segs*;
+    counts for the report."""
+    import shapely
+
+    from ..city.coverage import STREET_M, footprint_polygons, inside_footprints, read_coverage
+
+    city = DataDir(data_dir).city
+    mx = 0.5 * (segs["x"].to_numpy() + segs["x_end"].to_numpy())
+    my = 0.5 * (segs["y"].to_numpy() + segs["y_end"].to_numpy())
+    area = read_coverage(city)
+    if shapely.is_empty(area):
+        segs["in_city_model"] = np.zeros(len(segs), bool)
+    else:
+        shapely.prepare(area)
+        segs["in_city_model"] = shapely.contains_xy(area, mx, my)
+    segs["in_building"] = np.zeros(len(segs), bool)
+    segs["light_dx_m"] = np.zeros(len(segs))
+    segs["light_dy_m"] = np.zeros(len(segs))
+    length = segs["length_m"].to_numpy()
+    out = {"route_km": round(float(length.sum()) / 1000.0, 3),
+           "route_km_in_city_model": round(float(length[segs["in_city_model"].to_numpy()].sum())
+                                           / 1000.0, 3),
+           "segments_in_buildings": 0}
+    if len(segs) and city.tiles_json.exists():
+        pad = 100.0
+        prints = footprint_polygons(city, bounds=(mx.min() - pad, my.min() - pad,
+                                                  mx.max() + pad, my.max() + pad))
+        inside, dx, dy = inside_footprints(mx, my, prints)
+        segs["in_building"], segs["light_dx_m"], segs["light_dy_m"] = inside, dx, dy
+        n = int(inside.sum())
+        out["segments_in_buildings"] = n
+        if n:
+            km = float(length[inside].sum()) / 1000.0
+            problems.append(
+                f"{n} of {len(segs)} segments ({km:.2f} km, {100 * km / max(out['route_km'], 1e-9):.1f} "
+                f"% of the route-km) lie inside building footprints (straight lines between stops "
+                f"where the feed has no shapes cross blocks and halls): each takes its light "
+                f"{STREET_M:g} m outside the block, at the nearest point of its outline, and "
+                "they are left out of the shading statistics (in_building)")
+    return out
 
 
 def _choose_crs(feed, data_dir: Path, crs):
@@ -169,7 +260,7 @@ def _route_type_counts(routes: pd.DataFrame, trips: pd.DataFrame) -> dict:
 
 
 def ingest_gtfs(feed_path, data_dir, traj_cfg, crs=None, dist_units: str | None = None,
-                timezone: str | None = None, route_types=None) -> dict:
+                timezone: str | None = None, route_types="bus") -> dict:
     """Read a GTFS feed and write the trajectory stage files under ``data_dir/gtfs/``.
 
     Parameters
@@ -188,8 +279,9 @@ def ingest_gtfs(feed_path, data_dir, traj_cfg, crs=None, dist_units: str | None 
         Units of ``shape_dist_traveled`` when known (checked against the geometry anyway).
     timezone : str, optional
         IANA zone of the timetable for a feed without agency.txt (see :func:`read_feed`).
-    route_types : list of int, optional
-        GTFS route types to keep (``run.route_types``); all when omitted.
+    route_types : "bus", "all" or list of int
+        GTFS route types to keep (``run.route_types``): buses by default
+        (:data:`vipvflow.inputs.gtfs.feed.BUS_ROUTE_TYPES`).
 
     Returns
     -------
@@ -211,9 +303,14 @@ def ingest_gtfs(feed_path, data_dir, traj_cfg, crs=None, dist_units: str | None 
 
     shape_xy = _used_shapes(feed, to_xy, problems)
     shape_len = {s: float(cumulative_distance(p)[-1]) for s, p in shape_xy.items()}
-    terrain = _terrain(data_dir, problems)
+    terrain = _terrain(data_dir)
+    fallback = ground_fallback(data_dir, traj_cfg)
     segs, geom = build_segments(shape_xy, traj_cfg.segment_length_m, traj_cfg.roof_height_m,
-                                tile_size, terrain, traj_cfg.default_elevation_m)
+                                tile_size, terrain, fallback)
+    ground_sources = _ground_findings(segs, fallback, feed.path, data_dir, problems)
+    fit = _city_fit(segs, data_dir, problems)
+    segs["ground_source"] = pd.Categorical.from_codes(
+        segs["ground_source"].to_numpy(), categories=list(_GROUND_SOURCES))
     trips, st, st_xy = _stops_along_shapes(feed, shape_xy, to_xy)
     feed_d = _feed_distances(st, shape_len, feed.dist_units, problems)
     pats = _group_trips(st, st_xy, feed_d, shape_xy, shape_len)
@@ -232,6 +329,10 @@ def ingest_gtfs(feed_path, data_dir, traj_cfg, crs=None, dist_units: str | None 
         "segment_length_m": float(traj_cfg.segment_length_m),
         "timing": timing,
         "terrain": terrain is not None,
+        "ground_sources": ground_sources,
+        "ground_fallback_m": None if fallback is None else round(fallback[0], 2),
+        "ground_fallback_source": None if fallback is None else fallback[1],
+        **fit,
         "counts": {
             "routes": int(trips_out["route_id"].nunique()),
             "shapes": len(shape_xy),
@@ -454,21 +555,35 @@ def _segment_timing(pstops: pd.DataFrame, pattern_shape: list, segs: pd.DataFram
 
 
 def _trips_table(trips: pd.DataFrame, routes: pd.DataFrame, pats: _Patterns) -> pd.DataFrame:
-    """``trips.parquet``: the trips kept, with route name, pattern and start (s)."""
+    """``trips.parquet``: the trips kept, with the route's names and type, the trip's
+    headsign, pattern and start (s).  A route without a short name is named by its long
+    name, else its route_id (``route_short_name`` is what outputs, console and app show)."""
     trips = trips[trips["trip_id"].astype(str).isin(pats.trip_pattern.keys())].copy()
     trips["trip_id"] = trips["trip_id"].astype(str)
-    routes = routes[["route_id", "route_short_name"]] if "route_short_name" in \
-        routes else routes[["route_id"]].assign(route_short_name=pd.NA)
-    trips = trips.merge(routes, on="route_id", how="left")
-    for col in ("direction_id", "block_id"):
+    keep = [c for c in ("route_id", "route_short_name", "route_long_name", "route_type")
+            if c in routes]
+    trips = trips.drop(columns=[c for c in keep if c != "route_id" and c in trips])
+    trips = trips.merge(routes[keep], on="route_id", how="left")
+    for col in ("direction_id", "block_id", "trip_headsign", "route_short_name",
+                "route_long_name", "route_type"):
         if col not in trips:
             trips[col] = pd.NA
+
+    def text(col):
+        v = trips[col].astype("string").str.strip()
+        return v.mask(v == "")
+
+    short = text("route_short_name").fillna(text("route_long_name")).fillna(
+        trips["route_id"].astype("string"))
     trips["pattern_id"] = trips["trip_id"].map(pats.trip_pattern).astype(np.int64)
     trips["start_s"] = trips["trip_id"].map(pats.trip_start).astype(np.float64)
     return pd.DataFrame({
         "trip_id": trips["trip_id"].astype(str),
         "route_id": trips["route_id"].astype(str),
-        "route_short_name": trips["route_short_name"].astype("string"),
+        "route_short_name": short.astype("string"),
+        "route_long_name": text("route_long_name"),
+        "route_type": pd.to_numeric(trips["route_type"], errors="coerce").astype("Int32"),
+        "trip_headsign": text("trip_headsign"),
         "direction_id": trips["direction_id"].astype("Int32"),
         "shape_id": trips["shape_id"].astype(str),
         "service_id": trips["service_id"].astype(str),

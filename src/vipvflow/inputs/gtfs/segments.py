@@ -15,7 +15,10 @@ import numpy as np
 import pandas as pd
 import shapely
 
+from ..city.terrain import GROUND_SOURCES
 from ..tiles import tile_names
+
+_RELIEF = GROUND_SOURCES.index("relief")
 
 log = logging.getLogger(__name__)
 
@@ -73,17 +76,78 @@ def cut_shape(pts: np.ndarray, nominal_m: float):
     return np.column_stack([np.interp(s, cum, pts[:, 0]), np.interp(s, cum, pts[:, 1])]), s
 
 
-def ground_elevation(x, y, terrain, default_m: float) -> np.ndarray:
-    """Ground height at points (m); *terrain* has ``.elevation(x, y)`` or is None."""
-    x = np.asarray(x, float)
+def ground_elevation(x, y, terrain, fallback=None) -> tuple[np.ndarray, np.ndarray]:
+    """Ground height at points (m) and its source.
+
+    Parameters
+    ----------
+    x, y : array_like, m
+    terrain : :class:`vipvflow.inputs.city.TerrainModel` (or an object with
+        ``ground(x, y, fallback_m, fallback_source)``, or only ``elevation(x, y)``), or None
+    fallback : (height_m, source) or None
+        The height where the city model knows none (``radiation_header``: the radiation
+        file's altitude, ``configured``: ``trajectory.ground_elevation_m``).
+
+    Returns
+    -------
+    z : ndarray, m (NaN where unknown)
+    source : ndarray of int8, index into
+        :data:`vipvflow.inputs.city.terrain.GROUND_SOURCES` (-1 unknown)
+    """
+    from ..city.terrain import GROUND_SOURCES
+
+    x = np.asarray(x, float).ravel()
+    y = np.asarray(y, float).ravel()
+    height, source = fallback if fallback is not None else (None, "configured")
     if terrain is None:
-        return np.full(x.shape, float(default_m))
-    z = np.asarray(terrain.elevation(x, np.asarray(y, float)), dtype=float)
-    return np.where(np.isfinite(z), z, float(default_m))
+        if height is None:
+            return np.full(x.shape, np.nan), np.full(x.shape, -1, np.int8)
+        return (np.full(x.shape, float(height)),
+                np.full(x.shape, GROUND_SOURCES.index(source), np.int8))
+    if hasattr(terrain, "ground"):
+        z, src = terrain.ground(x, y, height, source)
+        return np.asarray(z, float), np.asarray(src, np.int8)
+    z = np.asarray(terrain.elevation(x, y), dtype=float)
+    src = np.where(np.isfinite(z), GROUND_SOURCES.index("relief"), -1).astype(np.int8)
+    if height is not None:
+        src = np.where(np.isfinite(z), src, GROUND_SOURCES.index(source)).astype(np.int8)
+        z = np.where(np.isfinite(z), z, float(height))
+    return z, src
+
+
+#: a road's ground profile from scattered heights (building ground surfaces, a fallback) is
+#: smoothed along the road over this length (m): a running median, then a running mean of
+#: half of it; the relief (a TIN) is followed as it is
+SMOOTH_M = 100.0
+
+
+def smooth_profile(s: np.ndarray, z: np.ndarray, keep: np.ndarray, window_m: float = SMOOTH_M) -> np.ndarray:
+    """Heights *z* at evenly spaced distances *s* (m) along a road, smoothed where not *keep*.
+
+    The building ground surfaces around a street differ by a metre or two (entrances,
+    courtyards, slopes along a block); their inverse-distance mean then makes bumps that a
+    road does not have (gradients of 20 % over 10 m).  A running median over *window_m* and a
+    running mean over half of it keep the road's trend and drop the bumps (the ends are
+    extended by their nearest value).
+
+    Returns
+    -------
+    ndarray, m
+    """
+    from scipy.ndimage import median_filter, uniform_filter1d
+
+    z = np.asarray(z, float)
+    if len(z) < 3 or keep.all():
+        return z.copy()
+    step = float(s[1] - s[0]) if len(s) > 1 else window_m
+    k = max(1, int(round(window_m / max(step, 1e-6))) | 1)
+    med = median_filter(z, size=k, mode="nearest")
+    mean = uniform_filter1d(med, size=max(1, (k // 2) | 1), mode="nearest")
+    return np.where(keep, z, mean)
 
 
 def build_segments(shape_xy: dict[str, np.ndarray], nominal_m: float, roof_height_m: float,
-                   tile_size_m: float, terrain=None, default_elevation_m: float = 300.0):
+                   tile_size_m: float, terrain=None, fallback=None):
     """Hyper-segments of every shape.
 
     Parameters
@@ -96,14 +160,17 @@ def build_segments(shape_xy: dict[str, np.ndarray], nominal_m: float, roof_heigh
         PV plane above the road (m).
     tile_size_m : float
         Tile size for the ``tile`` column (m).
-    terrain : object with ``elevation(x, y)``, optional
-        Ground model (m, NaN where unknown); None gives *default_elevation_m* everywhere.
+    terrain : TerrainModel, optional
+        Ground model (:func:`ground_elevation`).
+    fallback : (height_m, source), optional
+        Ground height where the model knows none (:func:`ground_elevation`).
 
     Returns
     -------
     segments : DataFrame
         One row per segment, columns of ``gtfs/segments.parquet`` without geometry, ordered
-        by shape then ``seg_index``; ``segment_id`` numbers them 0..N-1.
+        by shape then ``seg_index``; ``segment_id`` numbers them 0..N-1; ``ground_z`` is NaN
+        and ``ground_source`` -1 where no height is known (the caller refuses those).
     geometry : ndarray of shapely LineString Z
     """
     frames, lines = [], []
@@ -114,7 +181,9 @@ def build_segments(shape_xy: dict[str, np.ndarray], nominal_m: float, roof_heigh
             continue
         bxy, bs = cut_shape(pts, nominal_m)
         n = len(bs) - 1
-        gz = ground_elevation(bxy[:, 0], bxy[:, 1], terrain, default_elevation_m)
+        gz, gsrc = ground_elevation(bxy[:, 0], bxy[:, 1], terrain, fallback)
+        if np.isfinite(gz).all():
+            gz = smooth_profile(bs, gz, gsrc == _RELIEF)
         length = np.diff(bs)
         dx, dy = np.diff(bxy[:, 0]), np.diff(bxy[:, 1])
         heading = np.degrees(np.arctan2(dx, dy)) % 360.0
@@ -125,23 +194,24 @@ def build_segments(shape_xy: dict[str, np.ndarray], nominal_m: float, roof_heigh
             "x": bxy[:-1, 0], "y": bxy[:-1, 1], "z": gz[:-1] + roof_height_m,
             "x_end": bxy[1:, 0], "y_end": bxy[1:, 1], "z_end": gz[1:] + roof_height_m,
             "ground_z": gz[:-1],
+            "ground_source": gsrc[:-1],
             "heading_deg": heading,
             "gradient": np.diff(gz) / length,
             "length_m": length,
             "cum_dist_m": bs[:-1],
             "tile": tile_names(bxy[:-1, 0], bxy[:-1, 1], tile_size_m),
         }))
-        lines.append(_segment_lines(pts, bxy, bs, gz, roof_height_m, terrain,
-                                    default_elevation_m))
+        lines.append(_segment_lines(pts, bxy, bs, gz, roof_height_m, terrain, fallback,
+                                    relief=gsrc == _RELIEF))
         next_id += n
     if not frames:
         cols = ["segment_id", "shape_id", "seg_index", "x", "y", "z", "x_end", "y_end", "z_end",
-                "ground_z", "heading_deg", "gradient", "length_m", "cum_dist_m", "tile"]
+                "ground_z", "ground_source", "heading_deg", "gradient", "length_m", "cum_dist_m", "tile"]
         return pd.DataFrame(columns=cols), np.array([], dtype=object)
     return pd.concat(frames, ignore_index=True), np.concatenate(lines)
 
 
-def _segment_lines(pts, bxy, bs, gz, roof, terrain, default_m):
+def _segment_lines(pts, bxy, bs, gz, roof, terrain, fallback, relief=None):
     """LineString Z per piece: its two ends plus the shape vertices strictly inside it."""
     cum = cumulative_distance(pts)
     n = len(bs) - 1
@@ -152,7 +222,14 @@ def _segment_lines(pts, bxy, bs, gz, roof, terrain, default_m):
     # drop vertices that coincide with a break point
     keep = (v_s > bs[v_seg] + 1e-9) & (v_s < bs[v_seg + 1] - 1e-9)
     v_s, v_seg, v_xy = v_s[keep], v_seg[keep], v_xy[keep]
-    v_z = ground_elevation(v_xy[:, 0], v_xy[:, 1], terrain, default_m) + roof
+    # the shape's own vertices: on the relief, its height; elsewhere the smoothed profile of
+    # the break points
+    v_z = np.interp(v_s, bs, gz)
+    if relief is not None and relief.any():
+        z_rel, src = ground_elevation(v_xy[:, 0], v_xy[:, 1], terrain, fallback)
+        on = (src == _RELIEF) & np.isfinite(z_rel)
+        v_z = np.where(on, z_rel, v_z)
+    v_z = v_z + roof
     k = np.arange(n)
     seg = np.concatenate([k, v_seg, k])
     order = np.concatenate([np.full(n, -1.0), v_s, np.full(n, np.inf)])
