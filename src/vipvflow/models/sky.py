@@ -303,7 +303,10 @@ def sky_share(table_g, table_h, levels, normal) -> np.ndarray:
     nrm = np.asarray(normal, np.float32)
     tilt = (nrm[:, 0:1] * SECTOR_SIN.astype(np.float32) + nrm[:, 1:2] * SECTOR_COS.astype(np.float32))
     v = nrm[:, 2:3] * _interp(table_g, levels) + tilt * _interp(table_h, levels)
-    return v.sum(1, dtype=np.float32)
+    out = np.zeros(len(v), np.float32)
+    for k in range(v.shape[1]):          # in sector order, as the compiled kernel sums them
+        out += v[:, k]
+    return out
 
 
 def open_terms(table_h) -> np.ndarray:

@@ -296,7 +296,7 @@ class RadiationTable:
             st = Path(path).stat()
             key = json.dumps(["sky-4", st.st_size, st.st_mtime_ns, self.t0, self.n, SKY_STEP_S,
                               np.round(self.lat, 8).tolist(), np.round(self.lon, 8).tolist()])
-            file = RadiationDir(Path(path).parent).root / f"sky_{int(self.t0)}_{self.n}.npz"
+            file = RadiationDir(Path(path).parent).sky_cache(int(self.t0), self.n)
             try:
                 with np.load(file) as z:
                     if str(z["key"]) == key:
