@@ -35,7 +35,7 @@ def _ctx(mode: str) -> RunContext:
     cfg = load_config(None)
     return RunContext(data_dir="", run_dir="", year=2024, irradiance=IrradianceCfg().model_dump(),
                       pv_system=cfg.pv_system().model_dump(), pv_mode=mode,
-                      monthly_temperature_c=tuple(cfg.climate.monthly_mean_temperature_c),
+                      monthly_temperature_c=(0.0,) * 5 + (16.1,) + (0.0,) * 6,   # June: 16.1 deg C
                       wind_speed_mps=3.0, timezone="Europe/Luxembourg")
 
 

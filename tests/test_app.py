@@ -90,7 +90,7 @@ def test_trip_model_components_equal_the_runs(trip_model, small_run):
     te = pd.read_parquet(Path(small_run) / "trip_energy.parquet")
     ref = te[(te["trip_id"] == res.trip_id) & (pd.to_datetime(te["service_date"]) == date)].iloc[0]
     n = res.numbers
-    assert trip_model.cfg.irradiance.diffuse_model == "sky_view_factor"       # the default
+    assert trip_model.cfg.irradiance.diffuse_model == "perez_svf"       # the default
     assert n["pv_kwh_diffuse"] == pytest.approx(ref["pv_kwh_diffuse"], rel=1e-5)
     assert n["pv_kwh_direct"] == pytest.approx(ref["pv_kwh_direct"], rel=1e-5)
     se = n["pv_kwh_reflected_se"]

@@ -60,7 +60,8 @@ def _canyon_scene(H=16.0, W=18.0, L=400.0):
     return Scene(mesh)
 
 
-@pytest.mark.parametrize("sampling, diffuse", [("rotate", "sky_view_factor"), ("all", "isotropic")])
+@pytest.mark.parametrize("sampling, diffuse", [("rotate", "sky_view_factor"), ("all", "isotropic"),
+                                             ("rotate", "perez_svf"), ("all", "perez_svf")])
 def test_fused_equals_numpy_on_a_canyon_with_layovers(sampling, diffuse):
     """Driving passes (climbing and descending segments along the canyon) and a layover's
     minutes (a standing point, :mod:`vipvflow.simulation.standing`) over a clear June day:

@@ -216,7 +216,7 @@ def test_small_run_splits_every_block_day(small_run, small_config):
     np.testing.assert_allclose(bd["seconds_driving"].sum(), trips["seconds"].sum(), rtol=1e-7)
     # the layovers' auxiliaries: base load and HVAC at June's mean temperature, per hour stood
     v = cfg.vehicle_params()
-    aux_kw = float(v.aux_kw(cfg.climate.monthly_mean_temperature_c[5]))
+    aux_kw = float(v.aux_kw(cfg.monthly_temperature_c()[5]))
     np.testing.assert_allclose(bd["layover_aux_kwh"], aux_kw * bd["seconds_layover"] / 3600.0
                                / v.discharge_efficiency, rtol=1e-9)
     assert bd["demand_kwh"].sum() == pytest.approx(bd["consumption_kwh"].sum() + bd["layover_aux_kwh"].sum())

@@ -162,10 +162,9 @@ class EconomicsCfg(_Model):
 class ClimateCfg(_Model):
     """Ambient conditions for the vehicle's HVAC and the PV cell temperature."""
 
-    # Luxembourg-Findel monthly mean air temperature 1991-2020 normals (deg C), Jan..Dec
-    monthly_mean_temperature_c: list[float] = Field(
-        default_factory=lambda: [0.8, 1.6, 5.0, 8.9, 12.8, 16.1, 18.1, 17.6, 13.9, 9.6, 4.9, 1.7],
-        min_length=12, max_length=12)
+    # monthly mean air temperature of the city (deg C), Jan..Dec; null: the shipped
+    # climatology at the radiation file's location (vipvflow.inputs.climate)
+    monthly_mean_temperature_c: list[float] | None = Field(None, min_length=12, max_length=12)
     wind_speed_mps: float = Field(3.0, ge=0)
 
 
@@ -330,6 +329,42 @@ class Config(_Model):
         return _catalog_entry(catalog, self.vehicle.model, self.vehicle.overrides,
                               VehicleParams, CONF_DIR / "vehicles.yaml", "vehicle.model")
 
+    def monthly_temperature_c(self) -> list[float]:
+        """The run's monthly mean air temperature (deg C, Jan..Dec): the scenario's
+        ``climate.monthly_mean_temperature_c``, or the shipped climatology at the place of
+        the ingested radiation (:func:`vipvflow.inputs.climate.monthly_air_temperature`);
+        :meth:`temperature_source` says which."""
+        return list(self._temperature()[0])
+
+    def temperature_source(self) -> str:
+        """Where :meth:`monthly_temperature_c` comes from (for summary.json and the manifest)."""
+        return self._temperature()[1]
+
+    def _temperature(self) -> tuple[tuple, str]:
+        given = self.climate.monthly_mean_temperature_c
+        if given is not None:
+            return tuple(given), f"{Path(self._source).name}: climate.monthly_mean_temperature_c"
+        key = str(Path(self.data_dir).resolve())
+        hit = _TEMPERATURES.get(key)
+        if hit is None:
+            from .inputs.climate import SOURCE, monthly_air_temperature
+            from .store import DataDir
+
+            path = DataDir(self.data_dir).radiation.table
+            try:
+                import pyarrow.parquet as pq
+
+                first = pq.ParquetFile(path).read_row_group(0, columns=["lat", "lon"])
+                lat, lon = float(first["lat"][0].as_py()), float(first["lon"][0].as_py())
+            except (OSError, KeyError, IndexError) as exc:
+                raise ConfigError(f"{self._source}: climate.monthly_mean_temperature_c is not set "
+                                  f"and the city's place is unknown ({path}: {exc}); ingest the "
+                                  "radiation first or give the 12 monthly values") from None
+            hit = (tuple(monthly_air_temperature(lat, lon)),
+                   f"{SOURCE} ({lat:.3f} N, {lon:.3f} E)")
+            _TEMPERATURES[key] = hit
+        return hit
+
     def digest(self) -> str:
         """A stable hash of what decides a run's results (for run manifests and resuming):
         the validated configuration without where it runs (``dask``), where it writes
@@ -337,6 +372,9 @@ class Config(_Model):
         text = json.dumps(self.model_dump(mode="json", exclude={"dask", "db", "out_dir"}), sort_keys=True)
         return hashlib.sha256(text.encode()).hexdigest()[:16]
 
+
+#: the climatology's monthly temperatures per data dir (the radiation's place)
+_TEMPERATURES: dict[str, tuple[tuple, str]] = {}
 
 #: PyYAML's safe loader, libyaml's when PyYAML has it (the same documents, ~10x faster: the
 #: catalogs are read each time a run asks for its vehicle or PV system)

@@ -122,6 +122,11 @@ class RadiationDir(_Ingested):
         workers of a run (:func:`vipvflow.models.sun_sky._cached_sun`)."""
         return self.root / f"sun_{first_s}_{n}.npz"
 
+    def sky_cache(self, first_s: int, n: int) -> Path:
+        """The Perez sky's visible-share tables of the table's grid from *first_s* (Unix s),
+        *n* steps (:meth:`vipvflow.models.sun_sky.RadiationTable.sky`)."""
+        return self.root / f"sky_{first_s}_{n}.npz"
+
 
 @dataclass(frozen=True)
 class DataDir:

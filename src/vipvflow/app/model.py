@@ -397,7 +397,8 @@ class TripModel:
         estimate of the reflected beam for that pass), ``sun_visible`` (bool),
         ``elevation, azimuth`` (deg), ``ghi, dni, dhi`` (W/m2).
         """
-        from ..models.irradiance import ROULETTE_WEIGHT, roof_components
+        from ..models.irradiance import ROULETTE_WEIGHT, roof_components, sky_terms
+        from ..models.sky import COS_85
         from ..models.view_factors import isotropic_sky_view
 
         f32 = np.float32
@@ -415,7 +416,7 @@ class TripModel:
         cos_aoi = np.where(up, np.maximum(np.einsum("ij,ij->i", nrm, sun), 0), 0).astype(f32)
         visible = self.sun_visible(rows, sun, elev, np.nan_to_num(rad["azimuth"]), up & (cos_aoi > 0))
         iso = isotropic_sky_view(nrm[:, 2])
-        sky = geo["svf"][rows] if self.cfg.irradiance.diffuse_model == "sky_view_factor" else iso
+        sky = geo["svf"][rows] if self.cfg.irradiance.diffuse_model != "isotropic" else iso
         cfg = self.cfg.irradiance
         J = geo["wn"].shape[1] if (cfg.reflection and cfg.max_reflector_groups) else 0
         beam = np.zeros((len(rows), J), f32)
@@ -426,13 +427,24 @@ class TripModel:
         else:
             r_sky = r_ghi = np.zeros(len(rows), f32)
         lit = self.reflector_lit(rows, sun, beam > 0)
+        terms = None
+        if cfg.diffuse_model == "perez_svf":
+            terms = {**sky_terms(geo, rows, sun[:, 2], bool(J)),
+                     "f1": np.nan_to_num(np.asarray(rad["f1"], f32)),
+                     "f2": np.nan_to_num(np.asarray(rad["f2"], f32))}
+            if geo["sky_x"].shape[1]:            # the sky the roof point sees, as the run
+                terms["share"], terms["share_open"] = self.radiation.sky_share(
+                    np.asarray(t_utc, np.float64), geo["sky_x"][rows], nrm, loc)
         direct, diffuse, reflected, unshaded = roof_components(
-            dni, dhi, ghi, cos_aoi, visible, sky, beam, lit, r_sky, r_ghi, iso)
+            dni, dhi, ghi, cos_aoi, visible, sky, beam, lit, r_sky, r_ghi, iso, terms)
         # the run's estimate of a reflector's beam, per pass: one sample point (0 or 1),
         # faint reflectors traced only now and then at a larger weight (irradiance._roulette):
         # variance b max(b, ROULETTE_WEIGHT) L - b^2 L^2 each
         var = beam * np.maximum(beam, ROULETTE_WEIGHT) * lit - (beam * lit) ** 2
-        sd = dni * np.sqrt(np.maximum(var, 0).sum(1)) if J else np.zeros(len(rows), f32)
+        beam_in = dni                    # the reflectors' beam: the sun's, and the circumsolar sky's
+        if terms is not None:
+            beam_in = dni + dhi * terms["f1"] / np.maximum(terms["cos_zenith"], f32(COS_85))
+        sd = beam_in * np.sqrt(np.maximum(var, 0).sum(1)) if J else np.zeros(len(rows), f32)
         return {"direct": direct, "diffuse": diffuse, "reflected": reflected,
                 "total": direct + diffuse + reflected, "unshaded": unshaded, "reflected_sd": sd,
                 "sun_visible": visible, "elevation": elev, "azimuth": rad["azimuth"],
@@ -444,7 +456,7 @@ class TripModel:
         from ..models import pv as pvmod
 
         return pvmod.energy(poa, dt_s, pv.system(), pv.mode,
-                            temp_air_c=self.cfg.climate.monthly_mean_temperature_c[month - 1],
+                            temp_air_c=self.cfg.monthly_temperature_c()[month - 1],
                             vehicle_speed_mps=speed_mps, wind_mps=self.cfg.climate.wind_speed_mps)
 
     def _vehicle_run(self, pid: int, month: int, origin: float, off, dt, energy, aux_kw, soc_start,
@@ -467,7 +479,7 @@ class TripModel:
             params = params.model_copy(update=upd)
         soc0 = params.soc_max if soc_start is None else float(soc_start)
         cycle = self._cycle(pid)
-        cons = simulate_cycle(cycle, params, self.cfg.climate.monthly_mean_temperature_c[month - 1],
+        cons = simulate_cycle(cycle, params, self.cfg.monthly_temperature_c()[month - 1],
                               detail=True)
         iv = cons["intervals"]
         t_s = cycle["t_s"].to_numpy(np.float64)

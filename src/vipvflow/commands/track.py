@@ -41,7 +41,8 @@ def run(args):
     city_crs = json.loads(tiles_json.read_text())["crs"]
     track = read_track(args.track, city_crs, args.crs)
     table = RadiationTable.from_cams(args.cams)
-    out = model_track(track, args.city, table, cfg.irradiance, cfg.trajectory.roof_height_m)
+    out = model_track(track, args.city, table, cfg.irradiance, cfg.trajectory.roof_height_m,
+                      ground_albedo=cfg.city.albedo.ground, road_albedo=cfg.city.albedo.road)
     args.out.parent.mkdir(parents=True, exist_ok=True)
     out.to_csv(args.out, index=False)
     print(f"{len(out)} points -> {args.out}")

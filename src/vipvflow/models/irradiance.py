@@ -4,8 +4,10 @@ The paper's model (sections 3.2.1 to 3.2.3), extended for streets:
 
 * (1) direct    ``E_b = DNI x max(cos AOI, 0) x V_sun`` with ``V_sun`` = 1 when the ray
   from the roof point to the sun is not blocked (Embree occlusion query);
-* (2) diffuse   ``E_d = DHI x SVF`` with the cosine-weighted sky view factor of the roof
-  point (``diffuse_model: sky_view_factor``, the default), or the paper's isotropic sky
+* (2) diffuse   the Perez (1993) sky's light over the sky the roof point sees
+  (``diffuse_model: perez_svf``, the default; :mod:`vipvflow.models.sky`), or
+  ``E_d = DHI x SVF`` with the cosine-weighted sky view factor of the roof point
+  (``sky_view_factor``, a uniform sky), or the paper's isotropic sky
   ``E_d = DHI x (1 + cos beta) / 2`` (Liu & Jordan; pvlib ``irradiance.isotropic``;
   ``diffuse_model: isotropic``), which counts the sky the buildings hide as open: an upper
   bound in streets;
@@ -50,6 +52,7 @@ import numpy as np
 import pandas as pd
 
 from .params import IrradianceCfg
+from .sky import COS_85
 from .view_factors import _CHUNK, COMPONENTS, isotropic_sky_view, pack_geometry
 
 
@@ -68,7 +71,7 @@ def _local_frame(geo: dict, scene) -> bool:
 
 def roof_components(dni_wm2, dhi_wm2, ghi_wm2, cos_aoi, sun_visible, sky_view,
                     reflector_beam, reflector_lit, reflector_sky, reflector_ghi,
-                    isotropic_view):
+                    isotropic_view, sky=None):
     """Direct, diffuse and reflected irradiance on the roof from what the roof point sees
     (eqs. 1-3): the one place the components are summed, for the simulation (visibility
     from ray casting) and the web app (visibility from stored horizon profiles).
@@ -81,7 +84,7 @@ def roof_components(dni_wm2, dhi_wm2, ghi_wm2, cos_aoi, sun_visible, sky_view,
     sun_visible : (n,) 1 (or True) when the ray from the roof point to the sun is free, else 0
     sky_view : (n,) sky view factor of the roof for the diffuse sky: ``(1 + cos tilt) / 2``
         (isotropic, the paper) or the cosine-weighted sky view factor of the roof point
-        (Oke's canyon SVF; ``diffuse_model: sky_view_factor``)
+        (Oke's canyon SVF; ``diffuse_model: sky_view_factor`` and ``perez_svf``)
     reflector_beam : (n, J) per reflector ``j``: its weight at the roof (albedo x view factor,
         inter-reflections folded in, see :func:`pack_geometry`) x the cosine of the sun on it,
         clipped at 0; dimensionless
@@ -92,12 +95,36 @@ def roof_components(dni_wm2, dhi_wm2, ghi_wm2, cos_aoi, sun_visible, sky_view,
         and of GHI (open ground beyond the city model, lit as an open field); dimensionless
     isotropic_view : (n,) ``(1 + cos tilt) / 2`` (:func:`isotropic_sky_view`), for the
         unshaded reference
+    sky : dict, optional
+        The Perez sky (``diffuse_model: perez_svf``; none: a uniform sky), (n,) arrays:
+        ``f1, f2`` the circumsolar and horizon coefficients (:mod:`vipvflow.models.sky`),
+        ``cos_zenith`` of the sun, ``horizon_view`` the roof point's view of the horizon
+        band, ``reflector_horizon`` the reflectors' so weighted (:func:`pack_geometry`),
+        ``sin_tilt`` of the roof (the open field's horizon view, for the unshaded reference)
+        and, optionally, ``share``: the share of DHI the roof point receives from the Perez
+        (1993) sky luminance over the sky it sees (:meth:`RadiationTable.sky_share`), which
+        then is its diffuse light instead of the three parts below, and ``share_open`` the
+        same in the open (the unshaded reference's).
 
     Returns
     -------
     direct_wm2, diffuse_wm2, reflected_wm2, unshaded_wm2 : (n,) arrays, W/m2; unshaded is
-    the open-field plane-of-array irradiance ``DNI cos AOI + DHI (1 + cos tilt) / 2`` (no
-    buildings, no ground reflection), the reference of :func:`shading_loss`.
+    the open-field plane-of-array irradiance ``DNI cos AOI + E_sky`` (no buildings, no
+    ground reflection; ``E_sky = DHI (1 + cos tilt) / 2``, or pvlib's Perez sky diffuse under
+    the Perez sky), the reference of :func:`shading_loss`.
+
+    Notes
+    -----
+    With ``share`` (the run's ``perez_svf``) the roof's diffuse light is ``DHI x share``:
+    the sky's luminance (Perez, Seals, Michalsky 1993, as Radiance's ``gendaylit``)
+    integrated over the sky above the roof point's horizon; without it, the three-part form
+    of the Perez (1990) model.  Under the Perez sky (Perez et al. 1990, pvlib
+    ``irradiance.perez``) the three-part diffuse light is ``DHI [(1 - F1) SVF + F2 H] + C cos AOI V_sun`` with ``C = DHI F1 / max(cos Z, cos 85
+    deg)`` the circumsolar irradiance at normal incidence: the circumsolar part is seen
+    when, and only when, the sun is (it travels the sun ray), the isotropic part by the sky
+    view factor and the horizon part by the horizon-band view ``H``.  The reflectors are lit
+    the same way: their beam is ``DNI + C`` on their sunlit part, their sky ``DHI [(1 - F1)
+    F_s + F2 H_j]``.  The diffuse part is clipped at 0 as pvlib clips the sky diffuse.
 
     References
     ----------
@@ -105,15 +132,39 @@ def roof_components(dni_wm2, dhi_wm2, ghi_wm2, cos_aoi, sun_visible, sky_view,
     solar energy collectors, Solar Energy 7(2), 53-74.
     T. R. Oke (1988), Street design and urban canopy layer climate, Energy and Buildings 11,
     103-113 (sky view factor of a street canyon).
-    pvlib: ``irradiance.get_total_irradiance(model='isotropic')``, ``irradiance.aoi``.
+    R. Perez, P. Ineichen, R. Seals, J. Michalsky, R. Stewart (1990), Modeling daylight
+    availability and irradiance components from direct and global irradiance, Solar Energy
+    44(5), 271-289.
+    pvlib: ``irradiance.get_total_irradiance(model='isotropic')``, ``irradiance.perez``,
+    ``irradiance.aoi``.
     """
+    f32 = np.float32
     beam_on_roof = dni_wm2 * cos_aoi
     direct = beam_on_roof * sun_visible
-    diffuse = dhi_wm2 * sky_view
     beam_factor = np.einsum("ij,ij->i", reflector_beam, reflector_lit) if np.shape(reflector_beam)[-1] \
         else np.zeros_like(direct)
-    reflected = dni_wm2 * beam_factor + dhi_wm2 * reflector_sky + ghi_wm2 * reflector_ghi
-    return direct, diffuse, reflected, beam_on_roof + dhi_wm2 * isotropic_view
+    if sky is None:
+        diffuse = dhi_wm2 * sky_view
+        reflected = dni_wm2 * beam_factor + dhi_wm2 * reflector_sky + ghi_wm2 * reflector_ghi
+        return direct, diffuse, reflected, beam_on_roof + dhi_wm2 * isotropic_view
+    f1, f2 = sky["f1"], sky["f2"]
+    circumsolar = dhi_wm2 * f1 / np.maximum(sky["cos_zenith"], f32(COS_85))
+    circ_on_roof = circumsolar * cos_aoi
+    iso = f32(1) - f1
+    if "share" in sky:
+        diffuse = np.maximum(dhi_wm2 * sky["share"], f32(0))
+    else:
+        diffuse = np.maximum(dhi_wm2 * (iso * sky_view + f2 * sky["horizon_view"])
+                             + circ_on_roof * sun_visible, f32(0))
+    reflected = ((dni_wm2 + circumsolar) * beam_factor
+                 + dhi_wm2 * (iso * reflector_sky + f2 * sky["reflector_horizon"])
+                 + ghi_wm2 * reflector_ghi)
+    if "share" in sky:
+        unshaded = beam_on_roof + np.maximum(dhi_wm2 * sky["share_open"], f32(0))
+    else:
+        unshaded = beam_on_roof + np.maximum(dhi_wm2 * (iso * isotropic_view + f2 * sky["sin_tilt"])
+                                             + circ_on_roof, f32(0))
+    return direct, diffuse, reflected, unshaded
 
 
 def shading_loss(direct, diffuse, unshaded):
@@ -210,7 +261,20 @@ def roof_irradiance(geometry, rows, sun: np.ndarray, rad: dict, scene, cfg: Irra
     nrm = geo["n"][rows]
     dni, dhi, ghi = _finite(rad["dni"]), _finite(rad["dhi"]), _finite(rad["ghi"])
     dnic, dhic, ghic = _finite(rad["dni_clear"]), _finite(rad["dhi_clear"]), _finite(rad["ghi_clear"])
-    lit = np.flatnonzero((sun[:, 2] > 0) & ((dni > 0) | (dnic > 0)))
+    perez = cfg.diffuse_model == "perez_svf"
+    if perez:
+        need = ("f1", "f2", "f1_clear", "f2_clear") + (
+            ("sky_share", "sky_share_clear", "sky_open", "sky_open_clear")
+            if geo["sky_x"].shape[1] else ())
+        missing = [c for c in need if c not in rad]
+        if missing:
+            raise KeyError(f"the Perez sky needs {', '.join(missing)} in the radiation "
+                           "(models.sky.perez_coefficients)")
+        f1, f2, f1c, f2c = (_finite(rad[c]) for c in ("f1", "f2", "f1_clear", "f2_clear"))
+        beam_any = (dni > 0) | (dnic > 0) | (f1 > 0) | (f1c > 0)     # circumsolar is beam-like
+    else:
+        beam_any = (dni > 0) | (dnic > 0)
+    lit = np.flatnonzero((sun[:, 2] > 0) & beam_any)
     sl = sun[lit]
     rows_lit = rows[lit]
     cos_aoi = np.zeros(n, f32)
@@ -265,19 +329,48 @@ def roof_irradiance(geometry, rows, sun: np.ndarray, rad: dict, scene, cfg: Irra
                 share = (P - occ[nd:].reshape(-1, P).sum(1, dtype=np.int32)) * f32(1.0 / P)
             beam_sum[lit] = np.bincount(pi, beam_w * share, len(lit))
     iso = isotropic_sky_view(nrm[:, 2])
-    sky = geo["svf"][rows] if cfg.diffuse_model == "sky_view_factor" else iso
+    sky = geo["svf"][rows] if cfg.diffuse_model != "isotropic" else iso
     zero, one = np.zeros(n, f32), np.ones(n, f32)
     r_sky, r_ghi = (geo["refl_sky"][rows], geo["refl_ghi"][rows]) if G else (zero, zero)
+    if perez:
+        perez_sky = sky_terms(geo, rows, sun[:, 2], G)
     out = {}
     for sfx, (b, dh, gh) in (("", (dni, dhi, ghi)), ("_clear", (dnic, dhic, ghic))):
+        terms = None
+        if perez:
+            terms = {**perez_sky, "f1": f1 if not sfx else f1c, "f2": f2 if not sfx else f2c}
+            if geo["sky_x"].shape[1]:
+                terms["share"] = _finite(rad["sky_share" + sfx])
+                terms["share_open"] = _finite(rad["sky_open" + sfx])
         (out["direct" + sfx], out["diffuse" + sfx], out["reflected" + sfx],
          unshaded) = roof_components(b, dh, gh, cos_aoi, visible, sky, beam_sum[:, None],
-                                     one[:, None], r_sky, r_ghi, iso)
+                                     one[:, None], r_sky, r_ghi, iso, terms)
         out["total" + sfx] = out["direct" + sfx] + out["diffuse" + sfx] + out["reflected" + sfx]
         out[f"total{sfx}_unshaded"] = unshaded
     out["sun_visible"] = visible
     _add_seconds(timings, components_s=time.perf_counter() - t_start)
     return out
+
+
+def sky_terms(geo: dict, rows, cos_zenith, with_reflectors: bool = True) -> dict:
+    """The per-pass geometry of the Perez sky for :func:`roof_components` (its *sky*
+    without ``f1, f2``): the sun's ``cos_zenith``, the roof's ``horizon_view`` and
+    ``sin_tilt``, the reflectors' ``reflector_horizon`` (float32, dimensionless).
+
+    Parameters
+    ----------
+    geo : dict from :func:`pack_geometry`
+    rows : (n,) int, rows of *geo*
+    cos_zenith : (n,) float, up component of the unit vector towards the sun
+    with_reflectors : bool, whether the reflectors count (else their horizon weight is 0)
+    """
+    f32 = np.float32
+    nrm = geo["n"][rows]
+    sin_tilt = np.sqrt(nrm[:, 0] * nrm[:, 0] + nrm[:, 1] * nrm[:, 1]).astype(f32)
+    return {"cos_zenith": np.asarray(cos_zenith, f32), "horizon_view": geo["hbv"][rows],
+            "reflector_horizon": (geo["refl_hor"][rows] if with_reflectors
+                                  else np.zeros(len(rows), f32)),
+            "sin_tilt": sin_tilt}
 
 
 def _add_seconds(timings: dict | None, **seconds: float) -> None:
@@ -413,6 +506,10 @@ def evaluate_passes(passes: pd.DataFrame, segments: pd.DataFrame, geometry: pd.D
         r = row[idx]
         loc = None if loc_col is None else loc_col[r]
         rad = radiation_table.lookup(t[idx], location=loc, angles=False)
+        if cfg.diffuse_model == "perez_svf" and geo["sky_x"].shape[1]:
+            for sfx in ("", "_clear"):
+                rad["sky_share" + sfx], rad["sky_open" + sfx] = radiation_table.sky_share(
+                    t[idx], geo["sky_x"][r], geo["n"][r], loc, clear=bool(sfx))
         sun = np.stack([rad["sun_x"], rad["sun_y"], rad["sun_z"]], 1)
         key = pass_sample_key(seg[idx], t_start[idx])
         clock["lookup_s"] += time.perf_counter() - t_look

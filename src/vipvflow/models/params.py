@@ -23,9 +23,11 @@ class CycleCfg(_Params):
 
 
 class IrradianceCfg(_Params):
-    # sky_view_factor: DHI x the roof point's cosine-weighted sky view (the default);
+    # perez_svf (default): the Perez (1993) sky's light over the sky the roof point sees
+    # (its horizon per 10 deg sector), the reflectors lit by the three-part Perez (1990) sky;
+    # sky_view_factor: DHI x the roof point's cosine-weighted sky view (a uniform sky);
     # isotropic: the paper's DHI (1 + cos tilt) / 2, an upper bound in streets
-    diffuse_model: Literal["isotropic", "sky_view_factor"] = "sky_view_factor"
+    diffuse_model: Literal["perez_svf", "isotropic", "sky_view_factor"] = "perez_svf"
     reflection: bool = True
     reflection_rays: int = Field(256, ge=0, le=65_536)
     svf_rays: int = Field(512, gt=0, le=65_536)
@@ -35,6 +37,11 @@ class IrradianceCfg(_Params):
     reflector_points: int = Field(64, ge=1)
     reflector_sampling: Literal["rotate", "all"] = "rotate"
     reflector_sky_rays: int = Field(4, ge=1)
+    horizon_band_rays: int = Field(64, ge=1, le=65_536)
+    # where the city model has no ground (no terrain, no road surfaces) the street under the
+    # bus is the level ground at the road's height, lit and shaded as it is, with the road's
+    # albedo; false: rays that leave the model downwards see an open field lit by GHI
+    virtual_street: bool = True
     seed: int = 7
 
 

@@ -40,6 +40,7 @@ import numpy as np
 from numba import njit
 
 from .irradiance import ROULETTE_WEIGHT
+from .sky import COS_85, SECTOR_COS, SECTOR_SIN, SKY_AZIMUTH_BINS, SKY_LEVELS
 
 #: components of a pass in the order of the kernel's output block (W/m2)
 BLOCK_COLUMNS = ("direct", "diffuse", "reflected", "total", "direct_clear", "diffuse_clear",
@@ -47,8 +48,15 @@ BLOCK_COLUMNS = ("direct", "diffuse", "reflected", "total", "direct_clear", "dif
                  "ghi", "ghi_clear")
 #: rays in one batch (bounds the batch's memory: 24 bytes a ray)
 RAY_BUDGET = 1 << 21
-#: radiation columns the kernel reads, in this order
-_RAD = ("dni", "dhi", "ghi", "dni_clear", "dhi_clear", "ghi_clear", "sun_x", "sun_y", "sun_z")
+#: radiation columns the kernel reads, in this order (then the Perez sky's coefficients)
+_RAD = ("dni", "dhi", "ghi", "dni_clear", "dhi_clear", "ghi_clear", "sun_x", "sun_y", "sun_z",
+        "f1", "f2", "f1_clear", "f2_clear")
+_N_RAD = len(_RAD)
+#: per pass after the radiation: the Perez sky tables' row nearest in time
+_N_ROW = _N_RAD + 1
+_COS_85 = np.float32(COS_85)
+_SEC_SIN = SECTOR_SIN.astype(np.float32)
+_SEC_COS = SECTOR_COS.astype(np.float32)
 
 _M30, _M27, _M31 = np.uint64(30), np.uint64(27), np.uint64(31)
 _C1, _C2, _C3 = np.uint64(0x9E3779B97F4A7C15), np.uint64(0xBF58476D1CE4E5B9), np.uint64(0x94D049BB133111EB)
@@ -66,12 +74,13 @@ def _sample_key(segment_id, t_utc):
 
 @njit(cache=True, nogil=True)
 def _setup(lo, hi, seg, t_start, dt, mid, row, loc_of_row, packed, cols, t0, step,
-           nrm, wn, p_local, gp_local, rotate, roulette_w,
+           nrm, wn, p_local, gp_local, rotate, roulette_w, perez, sky_rows, sky_t0, sky_step,
            rad, cos_aoi, pass_ray, pair_w, pair_pass, o, d, done):
     """Radiation lookup and ray batch of passes ``lo..hi`` (see the module docstring).
 
-    Fills, per pass ``i`` (chunk index ``i - lo``): ``rad`` (9 values, NaN as 0, sun
-    components as looked up), ``cos_aoi``, ``pass_ray`` (the pass's first ray in the batch;
+    Fills, per pass ``i`` (chunk index ``i - lo``): ``rad`` (:data:`_RAD`, NaN as 0, sun
+    components as looked up; the Perez coefficients 0 unless *perez*), ``cos_aoi``,
+    ``pass_ray`` (the pass's first ray in the batch;
     ``pass_ray[i + 1] - pass_ray[i]`` rays: its direct ray first when the sun is in front of
     the roof, then per reflector pair one ray, or P with ``rotate`` False), ``done[i]``
     False for a dark pass (every component 0).  ``pair_w`` / ``pair_pass``: per pair its
@@ -96,21 +105,30 @@ def _setup(lo, hi, seg, t_start, dt, mid, row, loc_of_row, packed, cols, t0, ste
         r = row[i]
         li = loc_of_row[r]
         dark = True
-        for q in range(9):
+        for q in range(_N_RAD):
+            if q >= 9 and not perez:
+                rad[c, q] = np.float32(0.0)
+                continue
             a = packed[li, ii, cols[q]]
             b = packed[li, ii + 1, cols[q]] if n_t > 1 else a
             v = a + w * (b - a)
-            if q < 6:
+            if q < 6 or q >= 9:
                 if np.isnan(v):
                     v = np.float32(0.0)
-                if v != 0:
+                if q < 6 and v != 0:
                     dark = False
             rad[c, q] = v
         if dark:
             continue
         done[c] = True
+        if sky_rows.shape[1]:
+            # the Perez sky tables' row nearest the pass (RadiationTable.sky_steps)
+            js = np.int64(min(max(np.floor((t - sky_t0) / sky_step + 0.5), 0.0),
+                              sky_rows.shape[1] - 1))
+            rad[c, _N_RAD] = np.float32(sky_rows[li, js])
         sx, sy, sz = rad[c, 6], rad[c, 7], rad[c, 8]
-        if not (sz > 0 and (rad[c, 0] > 0 or rad[c, 3] > 0)):
+        # the circumsolar part of the Perez sky travels the sun ray, like the beam
+        if not (sz > 0 and (rad[c, 0] > 0 or rad[c, 3] > 0 or rad[c, 9] > 0 or rad[c, 11] > 0)):
             continue
         ca = nrm[r, 0] * sx + nrm[r, 1] * sy + nrm[r, 2] * sz
         ca = max(ca, np.float32(0.0))
@@ -154,22 +172,74 @@ def _setup(lo, hi, seg, t_start, dt, mid, row, loc_of_row, packed, cols, t0, ste
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _components(c, r, rad, cos_aoi, visible, beam_sum, sky, iso, refl_sky, refl_ghi, out):
+def _share(tg, th, r, cell, f, t, tilted, nz):
+    """The Perez (1993) sky's share of DHI on a roof from table row *r*: per sector its
+    cell, interpolation weight and tilt weight (:func:`vipvflow.models.sky.sky_share`; the
+    tables flat, (rows, 36 x 10))."""
+    s = np.float32(0.0)
+    if tilted:
+        for k in range(cell.shape[0]):
+            j = cell[k]
+            g0, h0 = tg[r, j], th[r, j]
+            s += nz * (g0 + f[k] * (tg[r, j + 1] - g0)) + t[k] * (h0 + f[k] * (th[r, j + 1] - h0))
+    else:
+        for k in range(cell.shape[0]):
+            j = cell[k]
+            g0 = tg[r, j]
+            s += nz * (g0 + f[k] * (tg[r, j + 1] - g0))
+    return s
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _components(c, r, rad, cos_aoi, visible, beam_sum, sky, iso, refl_sky, refl_ghi,
+                perez, hbv, refl_hor, sin_tilt, sky_cell, sky_f, sky_t, sky_tilted, tg_all, th_all,
+                to_all, tg_clear, th_clear, to_clear, nrm, out):
     """The 12 :data:`BLOCK_COLUMNS` of one pass into *out* (float32, as
-    :func:`vipvflow.models.irradiance.roof_components` sums them)."""
+    :func:`vipvflow.models.irradiance.roof_components` sums them, the Perez sky with
+    *perez*)."""
     ca = cos_aoi[c]
     vis = np.float32(1.0) if visible else np.float32(0.0)
     for s in range(2):
         b, dh, gh = rad[c, 3 * s], rad[c, 3 * s + 1], rad[c, 3 * s + 2]
         beam = b * ca
         direct = beam * vis
-        diffuse = dh * sky[r]
-        reflected = b * beam_sum + dh * refl_sky[r] + gh * refl_ghi[r]
+        if perez:
+            f1, f2 = rad[c, 9 + 2 * s], rad[c, 10 + 2 * s]
+            cs = dh * f1 / max(rad[c, 8], _COS_85)
+            circ = cs * ca
+            iso_w = np.float32(1.0) - f1
+            if sky_cell.shape[1]:
+                rs = np.int64(rad[c, _N_RAD])
+                share = np.float32(0.0)
+                share_open = np.float32(0.0)
+                if rs >= 0:
+                    nx, ny, nz = nrm[r, 0], nrm[r, 1], nrm[r, 2]
+                    if s == 0:
+                        share = _share(tg_all, th_all, rs, sky_cell[r], sky_f[r], sky_t[r],
+                                       sky_tilted[r], nz)
+                        share_open = nz + (nx * to_all[rs, 0] + ny * to_all[rs, 1])
+                    else:
+                        share = _share(tg_clear, th_clear, rs, sky_cell[r], sky_f[r], sky_t[r],
+                                       sky_tilted[r], nz)
+                        share_open = nz + (nx * to_clear[rs, 0] + ny * to_clear[rs, 1])
+                diffuse = max(dh * share, np.float32(0.0))
+            else:
+                diffuse = max(dh * (iso_w * sky[r] + f2 * hbv[r]) + circ * vis, np.float32(0.0))
+            reflected = ((b + cs) * beam_sum + dh * (iso_w * refl_sky[r] + f2 * refl_hor[r])
+                         + gh * refl_ghi[r])
+            if sky_cell.shape[1]:
+                unshaded = beam + max(dh * share_open, np.float32(0.0))
+            else:
+                unshaded = beam + max(dh * (iso_w * iso[r] + f2 * sin_tilt[r]) + circ, np.float32(0.0))
+        else:
+            diffuse = dh * sky[r]
+            reflected = b * beam_sum + dh * refl_sky[r] + gh * refl_ghi[r]
+            unshaded = beam + dh * iso[r]
         out[4 * s] = direct
         out[4 * s + 1] = diffuse
         out[4 * s + 2] = reflected
         out[4 * s + 3] = direct + diffuse + reflected
-        out[8 + s] = beam + dh * iso[r]
+        out[8 + s] = unshaded
     out[10] = rad[c, 2]
     out[11] = rad[c, 5]
 
@@ -201,8 +271,9 @@ def _visibility(c, pass_ray, pair_w, pair_pass, q, occ, cos_aoi, rotate, P):
 
 @njit(cache=True, nogil=True)
 def _finish(lo, hi, row, rad, cos_aoi, pass_ray, pair_w, pair_pass, occ, done,
-            sky, iso, refl_sky, refl_ghi, rotate, P, to_bins, block, visible_out,
-            dt, seg_hour, run, seg_bins, run_bins):
+            sky, iso, refl_sky, refl_ghi, perez, hbv, refl_hor, sin_tilt, sky_cell, sky_f, sky_t,
+            sky_tilted, tg_all, th_all, to_all, tg_clear, th_clear, to_clear, nrm, rotate, P,
+            to_bins, block, visible_out, dt, seg_hour, run, seg_bins, run_bins):
     """Components of passes ``lo..hi``: into columns of *block* (12, n) and *visible_out*,
     or, with *to_bins*, as irradiation (Wh/m2) added into ``seg_bins[seg_hour[i]]`` and
     ``run_bins[run[i]]`` ((bins, 12) float64, :data:`BLOCK_COLUMNS`); the other side's
@@ -215,7 +286,9 @@ def _finish(lo, hi, row, rad, cos_aoi, pass_ray, pair_w, pair_pass, occ, done,
             continue
         visible, beam_sum, q = _visibility(c, pass_ray, pair_w, pair_pass, q, occ, cos_aoi,
                                            rotate, P)
-        _components(c, row[i], rad, cos_aoi, visible, beam_sum, sky, iso, refl_sky, refl_ghi, out)
+        _components(c, row[i], rad, cos_aoi, visible, beam_sum, sky, iso, refl_sky, refl_ghi,
+                    perez, hbv, refl_hor, sin_tilt, sky_cell, sky_f, sky_t, sky_tilted, tg_all,
+                    th_all, to_all, tg_clear, th_clear, to_clear, nrm, out)
         if to_bins:
             w = dt[i] / 3600.0
             b, k = seg_hour[i], run[i]
@@ -353,7 +426,7 @@ class _Batch:
 
     def __init__(self, chunk: int, rays_per_pass: int, pairs_per_pass: int):
         f32 = np.float32
-        self.rad = np.empty((chunk, 9), f32)
+        self.rad = np.empty((chunk, _N_ROW), f32)
         self.cos_aoi = np.empty(chunk, f32)
         self.pass_ray = np.empty(chunk + 1, np.int64)
         self.done = np.empty(chunk, np.bool_)
@@ -394,19 +467,41 @@ def _inputs(geo: dict, cfg, radiation_table, rows_of_segment_loc):
     n_seg = len(geo["n"])
     nrm = geo["n"]
     iso = ((f32(1) + nrm[:, 2]) * f32(0.5)).astype(f32)
-    sky = geo["svf"] if cfg.diffuse_model == "sky_view_factor" else iso
+    sky = geo["svf"] if cfg.diffuse_model != "isotropic" else iso
     J = geo["wn"].shape[1] if (cfg.reflection and cfg.max_reflector_groups) else 0
     zero = np.zeros(n_seg, f32)
     r_sky, r_ghi = (geo["refl_sky"], geo["refl_ghi"]) if J else (zero, zero)
+    sin_tilt = np.sqrt(nrm[:, 0] * nrm[:, 0] + nrm[:, 1] * nrm[:, 1]).astype(f32)
+    hbv = geo["hbv"] if "hbv" in geo else zero
+    r_hor = geo["refl_hor"] if (J and "refl_hor" in geo) else zero
     wn = geo["wn"] if J else np.zeros((n_seg, 0, 3), f32)
     loc = (np.zeros(n_seg, np.int64) if rows_of_segment_loc is None
            else np.asarray(rows_of_segment_loc, np.int64))
     x = dict(packed=packed, cols=cols, nrm=nrm, wn=wn.astype(f32, copy=False), p_local=geo["p_local"],
              gp_local=geo["group_p_local"].astype(f32, copy=False), sky=sky.astype(f32, copy=False),
              iso=iso, refl_sky=r_sky.astype(f32, copy=False), refl_ghi=r_ghi.astype(f32, copy=False),
-             loc=loc)
+             hbv=hbv.astype(f32, copy=False), refl_hor=r_hor.astype(f32, copy=False),
+             sin_tilt=sin_tilt, loc=loc)
     x = {k: _writable(v) for k, v in x.items()}
-    x.update(t0=float(radiation_table.t0), step=float(radiation_table.step_s))
+    perez = cfg.diffuse_model == "perez_svf"
+    x.update(t0=float(radiation_table.t0), step=float(radiation_table.step_s), perez=perez)
+    sky_x = geo.get("sky_x")
+    if perez and sky_x is not None and sky_x.shape[1]:
+        tables = radiation_table.sky()
+        flat = lambda a: _writable(a.reshape(len(a), -1))          # noqa: E731
+        x.update(sky_cell=_writable(geo["sky_cell"]), sky_f=_writable(geo["sky_f"]),
+                 sky_t=_writable(geo["sky_t"]), sky_tilted=_writable(geo["sky_tilted"]),
+                 sky_rows=_writable(tables["rows"]),
+                 sky_tables=(flat(tables["all"]), flat(tables["all_h"]), _writable(tables["all_open"]),
+                             flat(tables["clear"]), flat(tables["clear_h"]), _writable(tables["clear_open"])),
+                 sky_t0=tables["t0"], sky_step=tables["step"])
+    else:
+        e2 = np.zeros((0, 2), f32)
+        e = np.zeros((0, SKY_AZIMUTH_BINS * (SKY_LEVELS + 1)), f32)
+        x.update(sky_cell=np.zeros((n_seg, 0), np.int64), sky_f=np.zeros((n_seg, 0), f32),
+                 sky_t=np.zeros((n_seg, 0), f32), sky_tilted=np.zeros(n_seg, np.bool_),
+                 sky_rows=np.zeros((1, 0), np.int32),
+                 sky_tables=(e, e, e2, e, e, e2), sky_t0=0.0, sky_step=1.0)
     return x
 
 
@@ -424,7 +519,7 @@ def _run(seg, t_start, dt, mid, row, geo, cfg, radiation_table, scene, loc_of_ro
         t_a = time.perf_counter()
         nr, _ = _setup(lo, hi, seg, t_start, dt, mid, row, x["loc"], x["packed"], x["cols"],
                        x["t0"], x["step"], x["nrm"], x["wn"], x["p_local"], x["gp_local"],
-                       rotate, rw, bt.rad, bt.cos_aoi, bt.pass_ray, bt.pair_w, bt.pair_pass,
+                       rotate, rw, x["perez"], x["sky_rows"], x["sky_t0"], x["sky_step"], bt.rad, bt.cos_aoi, bt.pass_ray, bt.pair_w, bt.pair_pass,
                        bt.o, bt.d, bt.done)
         t_b = time.perf_counter()
         occ = (scene.occluded_local(bt.o[:nr], bt.d[:nr], cfg.ray_length_m) if nr
@@ -503,8 +598,9 @@ def _finisher(row, dt, to_bins, block, visible, seg_hour, run, seg_bins, run_bin
     *visible*, or (*to_bins*) into *seg_bins* and *run_bins*."""
     def finish(lo, hi, x, bt, occ, P, rotate):
         _finish(lo, hi, row, bt.rad, bt.cos_aoi, bt.pass_ray, bt.pair_w, bt.pair_pass,
-                occ, bt.done, x["sky"], x["iso"], x["refl_sky"], x["refl_ghi"],
-                rotate, P, to_bins, block, visible, dt, seg_hour, run, seg_bins, run_bins)
+                occ, bt.done, x["sky"], x["iso"], x["refl_sky"], x["refl_ghi"], x["perez"],
+                x["hbv"], x["refl_hor"], x["sin_tilt"], x["sky_cell"], x["sky_f"], x["sky_t"],
+                x["sky_tilted"], *x["sky_tables"], x["nrm"], rotate, P, to_bins, block, visible, dt, seg_hour, run, seg_bins, run_bins)
     return finish
 
 
@@ -514,18 +610,27 @@ def warm() -> float:
     t = time.perf_counter()
     f32, i64 = np.float32, np.int64
     one_i, one_f, one_t = np.zeros(1, i64), np.zeros(1, f32), np.zeros(1)
-    rad, pr = np.zeros((1, 9), f32), np.zeros(2, i64)
+    rad, pr = np.zeros((1, _N_ROW), f32), np.zeros(2, i64)
     o3 = np.zeros((1, 3), f32)
-    packed = np.zeros((1, 2, 9), f32)
+    packed = np.zeros((1, 2, _N_RAD), f32)
+    tables = np.zeros((1, SKY_AZIMUTH_BINS * (SKY_LEVELS + 1)), f32)
     for rotate in (True, False):
-        _setup(0, 1, one_i, one_t, one_t, True, one_i, one_i, packed, np.arange(9, dtype=i64),
-               0.0, 60.0, o3, np.zeros((1, 1, 3), f32), o3, np.zeros((1, 1, 3), f32), rotate,
-               f32(0.02), rad, one_f, pr, one_f, one_i, o3, o3, np.zeros(1, np.bool_))
-        for to_bins in (False, True):
-            _finish(0, 1, one_i, rad, one_f, pr, one_f, one_i, np.zeros(1, bool),
-                    np.zeros(1, np.bool_), one_f, one_f, one_f, one_f, rotate, 1, to_bins,
-                    np.zeros((12, 1), f32), np.zeros(1, bool), one_t, one_i, one_i,
-                    np.zeros((1, 12)), np.zeros((1, 12)))
+        for perez in (True, False):
+            for n_sky in (0, SKY_AZIMUTH_BINS):
+                rows = np.zeros((1, 2 if n_sky else 0), np.int32)
+                _setup(0, 1, one_i, one_t, one_t, True, one_i, one_i, packed,
+                       np.arange(_N_RAD, dtype=i64), 0.0, 60.0, o3, np.zeros((1, 1, 3), f32), o3,
+                       np.zeros((1, 1, 3), f32), rotate, f32(0.02), perez, rows, 0.0, 900.0,
+                       rad, one_f, pr, one_f, one_i, o3, o3, np.zeros(1, np.bool_))
+                for to_bins in (False, True):
+                    _finish(0, 1, one_i, rad, one_f, pr, one_f, one_i, np.zeros(1, bool),
+                            np.zeros(1, np.bool_), one_f, one_f, one_f, one_f, perez, one_f, one_f,
+                            one_f, np.zeros((1, n_sky), np.int64), np.zeros((1, n_sky), f32),
+                            np.zeros((1, n_sky), f32), np.zeros(1, np.bool_), tables, tables,
+                            np.zeros((1, 2), f32), tables, tables, np.zeros((1, 2), f32), o3,
+                            rotate, 1, to_bins,
+                            np.zeros((12, 1), f32), np.zeros(1, bool), one_t, one_i, one_i,
+                            np.zeros((1, 12)), np.zeros((1, 12)))
     _groups(one_i, one_i, one_i, one_t, one_t, 0, one_i, 0, one_t, one_i, one_i, one_i, one_i)
     _seconds(one_i, one_i, one_i, one_t, one_t, one_t, one_t, one_i, one_i)
     return time.perf_counter() - t

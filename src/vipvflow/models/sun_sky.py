@@ -17,6 +17,7 @@ import pandas as pd
 from ..errors import InputError
 from ..inputs.cams import _GRID_S, COLUMNS, ingest_cams
 from ..store import DataDir, RadiationDir, write_npz
+from .sky import SKY_STEP_S, open_terms, perez_table, sky_table
 
 log = logging.getLogger(__name__)
 
@@ -76,6 +77,30 @@ def _cached_sun(path: Path, grid, lat, lon, alt) -> np.ndarray:
     return sun
 
 
+def _sky_tables(grid_t0: float, n_steps: int, table: "RadiationTable", k: int) -> dict:
+    """The Perez (1993) visible-sky tables of location *k* every :data:`SKY_STEP_S` from
+    *grid_t0*: ``rows`` (n_steps,) int32 (-1 where the sun is more than 3 deg below the
+    horizon), ``all`` and ``clear`` (rows, 36, 9) float32 (:func:`vipvflow.models.sky.sky_table`)."""
+    import pvlib
+
+    t = grid_t0 + SKY_STEP_S * np.arange(n_steps)
+    v = table.lookup(t, location=k, angles=False)
+    sun = np.stack([v["sun_x"], v["sun_y"], v["sun_z"]], 1).astype(np.float64)
+    day = np.nan_to_num(v["sun_z"], nan=-1.0) > -0.05
+    rows = np.full(n_steps, -1, np.int32)
+    rows[day] = np.arange(int(day.sum()), dtype=np.int32)
+    times = pd.DatetimeIndex(pd.to_datetime(np.round(t[day] * 1e3).astype(np.int64), unit="ms", utc=True))
+    e0 = np.asarray(pvlib.irradiance.get_extra_radiation(times.day_of_year.to_numpy()), np.float64)
+    out = {"rows": rows}
+    for sfx, name in (("", "all"), ("_clear", "clear")):
+        out[name], out[name + "_h"] = sky_table(v["dhi" + sfx][day], v["dni" + sfx][day], e0, sun[day])
+        out[name + "_open"] = open_terms(out[name + "_h"])
+    return out
+
+
+_SKY_KEYS = ("rows", "all", "all_h", "all_open", "clear", "clear_h", "clear_open")
+
+
 # --------------------------------------------------------------------------- lookup
 @dataclass
 class RadiationTable:
@@ -85,8 +110,9 @@ class RadiationTable:
     ----------
     t0 : float, Unix s of grid point 0
     step_s : float, grid step (s)
-    data : dict name -> (K, N) float32; ``ghi ... dhi_clear`` (W/m2) and the sun unit vector
-        ``sun_x, sun_y, sun_z`` (east, north, up; from pvlib apparent zenith and azimuth)
+    data : dict name -> (K, N) float32; ``ghi ... dhi_clear`` (W/m2), the sun unit vector
+        ``sun_x, sun_y, sun_z`` (east, north, up; from pvlib apparent zenith and azimuth) and
+        the Perez coefficients ``f1, f2, f1_clear, f2_clear`` (dimensionless)
     lat, lon : (K,) float64, degrees
 
     References
@@ -187,6 +213,11 @@ class RadiationTable:
             sun = sun_vectors(t, lat, lon, alt, sun_step_s)
         for j, name in enumerate(("sun_x", "sun_y", "sun_z")):
             data[name] = sun[j]
+        # the Perez sky's circumsolar and horizon coefficients of every time step, all-sky
+        # and clear-sky (models.sky): looked up per pass like the radiation
+        for sfx in ("", "_clear"):
+            data["f1" + sfx], data["f2" + sfx] = perez_table(
+                t, data["dhi" + sfx], data["dni" + sfx], data["sun_z"])
         return cls(t0=float(t[0]), step_s=step, data=data, lat=lat, lon=lon)
 
     @classmethod
@@ -224,7 +255,9 @@ class RadiationTable:
                         100 * (1 - covered), year)
         alts = np.array(alts)
         sun = _cached_sun(path, grid, locs[:, 0], locs[:, 1], alts)
-        return cls.from_grid(grid, values, locs[:, 0], locs[:, 1], alts, sun=sun)
+        out = cls.from_grid(grid, values, locs[:, 0], locs[:, 1], alts, sun=sun)
+        out.__dict__["_source"] = str(path)            # where the sky tables are cached
+        return out
 
     @classmethod
     def from_cams(cls, paths) -> "RadiationTable":
@@ -243,6 +276,75 @@ class RadiationTable:
             for c in COLUMNS:
                 values[c][i, idx] = part[c].to_numpy(np.float32)
         return cls.from_grid(grid, values, locs[:, 0], locs[:, 1], locs[:, 2])
+
+    def sky(self) -> dict:
+        """The Perez (1993) sky's visible-share tables of every location, every
+        :data:`vipvflow.models.sky.SKY_STEP_S` from the grid's start (``diffuse_model:
+        perez_svf``): ``t0``, ``step``, ``rows`` (K, n_steps) int32 (-1 at night) into
+        ``all``, ``all_h``, ``clear`` and ``clear_h`` (rows, 36, 10) float32 (the ``_h``
+        tables the tilt term, :func:`vipvflow.models.sky.sky_table`) and ``all_open``,
+        ``clear_open`` (rows, 2) (:func:`vipvflow.models.sky.open_terms`).  Computed once per
+        table (a few seconds for a year) and kept beside the radiation file where it came
+        from one (:meth:`load`)."""
+        cache = self.__dict__.get("_sky")
+        if cache is not None:
+            return cache
+        n_steps = int(np.floor((self.t_end - self.t0) / SKY_STEP_S)) + 2
+        path = self.__dict__.get("_source")
+        key = None
+        if path is not None:
+            st = Path(path).stat()
+            key = json.dumps(["sky-4", st.st_size, st.st_mtime_ns, self.t0, self.n, SKY_STEP_S,
+                              np.round(self.lat, 8).tolist(), np.round(self.lon, 8).tolist()])
+            file = RadiationDir(Path(path).parent).sky_cache(int(self.t0), self.n)
+            try:
+                with np.load(file) as z:
+                    if str(z["key"]) == key:
+                        cache = {k: z[k] for k in _SKY_KEYS}
+            except (OSError, KeyError, ValueError):
+                pass
+        if cache is None:
+            parts = [_sky_tables(self.t0, n_steps, self, k) for k in range(len(self.lat))]
+            offset = np.cumsum([0] + [len(p["all"]) for p in parts])
+            cache = {"rows": np.stack([np.where(p["rows"] >= 0, p["rows"] + offset[i], -1)
+                                       for i, p in enumerate(parts)]).astype(np.int32),
+                     **{k: np.concatenate([p[k] for p in parts]) for k in _SKY_KEYS[1:]}}
+            if key is not None:
+                try:
+                    write_npz(file, key=np.array(key), **cache)
+                except OSError:
+                    pass
+        cache = {**cache, "t0": float(self.t0), "step": float(SKY_STEP_S)}
+        self.__dict__["_sky"] = cache
+        return cache
+
+    def sky_share(self, t_utc, levels, normal, location=None, clear: bool = False):
+        """The share of DHI a roof point receives from the Perez (1993) sky it sees, and
+        the same in the open: two float32 (n,) arrays, at times *t_utc* (Unix s), for
+        horizons *levels* (n, 36) (:func:`vipvflow.models.sky.sky_levels`) and roof unit
+        *normal* (n, 3), from the table row of :meth:`sky` nearest in time (the sun moves
+        at most 1.9 deg from it); all-sky or *clear*-sky.  At night both are 0."""
+        sky = self.sky()
+        rows = sky["rows"]
+        j = self.sky_steps(t_utc)
+        loc = np.zeros(len(j), np.int64) if location is None else np.broadcast_to(np.asarray(location, np.int64), j.shape)
+        r = rows[loc, j]
+        name = "clear" if clear else "all"
+        from .sky import open_share, sky_share as share
+
+        out, open_ = np.zeros(len(j), np.float32), np.zeros(len(j), np.float32)
+        ok = r >= 0
+        if ok.any():
+            nrm = np.asarray(normal, np.float32)[ok]
+            out[ok] = share(sky[name][r[ok]], sky[name + "_h"][r[ok]], np.asarray(levels, np.float32)[ok], nrm)
+            open_[ok] = open_share(sky[name + "_open"][r[ok]], nrm)
+        return out, open_
+
+    def sky_steps(self, t_utc) -> np.ndarray:
+        """The sky tables' step nearest each time (int64, within the tables)."""
+        sky = self.sky()
+        f = (np.asarray(t_utc, np.float64) - sky["t0"]) / sky["step"]
+        return np.clip(np.floor(f + 0.5), 0, sky["rows"].shape[1] - 1).astype(np.int64)
 
     def nearest_location(self, lat, lon) -> np.ndarray:
         """Index of the nearest table location for each point (degrees; great-circle)."""
@@ -267,7 +369,8 @@ class RadiationTable:
         -------
         dict of float32 arrays
             ``ghi, dni, dhi, ghi_clear, dni_clear, dhi_clear`` (W/m2), ``sun_x, sun_y, sun_z``
-            (unit vector east/north/up), ``zenith`` (apparent, deg), ``azimuth`` (deg from
+            (unit vector east/north/up), ``f1, f2, f1_clear, f2_clear`` (the Perez sky's
+            circumsolar and horizon coefficients, :mod:`vipvflow.models.sky`), ``zenith`` (apparent, deg), ``azimuth`` (deg from
             north, clockwise).  NaN outside the grid.
         """
         t = np.asarray(t_utc, dtype=np.float64)

@@ -14,6 +14,7 @@ import pandas as pd
 
 from .params import IrradianceCfg
 from .mesh import SURFACE_CODE
+from .sky import SKY_AZIMUTH_BINS as _SKY_SECTORS
 
 _GOLDEN = (np.sqrt(5.0) - 1.0) / 2.0
 
@@ -206,11 +207,11 @@ def _group_points(o, hs, gkey, w, hp, hn, w_g, n_g, P: int, lift: float):
     key1 = np.where(v, hp[:, 2], np.hypot(rel[:, 0], rel[:, 1]))
     key2 = np.where(v, along, np.arctan2(rel[:, 0], rel[:, 1]))
     wflat = w_g.reshape(-1)
-    before = np.cumsum(wflat) - wflat                           # weight of earlier groups
     # band of each hit: the weight quantile of its mid-weight along key1 within its group
+    # (sums within each group only, so a group's points do not depend on the others')
     srt = np.lexsort((key1, gkey))
     mid = np.empty(len(w))
-    mid[srt] = np.cumsum(w[srt]) - 0.5 * w[srt] - before[gkey[srt]]
+    mid[srt] = _group_cumsum(w[srt], gkey[srt]) - 0.5 * w[srt]
     B = math.isqrt(P)
     B = B if B * B == P else P           # P not a square: P bands along key1, as in 1D
     band = np.minimum((B * mid / np.maximum(wflat[gkey], 1e-300)).astype(np.int64), B - 1)
@@ -218,7 +219,7 @@ def _group_points(o, hs, gkey, w, hp, hn, w_g, n_g, P: int, lift: float):
     bkey = gkey * B + band
     w_band = np.bincount(bkey, w, m * G * B)
     srt = np.lexsort((key2, bkey))
-    mid[srt] = np.cumsum(w[srt]) - 0.5 * w[srt] - (np.cumsum(w_band) - w_band)[bkey[srt]]
+    mid[srt] = _group_cumsum(w[srt], bkey[srt]) - 0.5 * w[srt]
     per = P // B                                                # cells per band
     cell = np.minimum((per * mid / np.maximum(w_band[bkey], 1e-300)).astype(np.int64), per - 1)
     ckey = bkey * per + cell
@@ -227,22 +228,32 @@ def _group_points(o, hs, gkey, w, hp, hn, w_g, n_g, P: int, lift: float):
     # (a Latin square of bands and cells) and B x per strata of key2 within the bands
     srt = np.lexsort((key1, ckey))
     cs = ckey[srt]
-    cw = np.cumsum(w[srt])
+    gs = gkey[srt]
+    cw = _group_cumsum(w[srt], gs)                              # within each group
     n_cell = m * G * B * per
-    w_cell = np.bincount(ckey, w, n_cell).reshape(m * G, B, per)
-    start = (np.cumsum(w_cell) - w_cell.reshape(-1)).reshape(m * G, B, per)
+    w_cell = np.bincount(ckey, w, n_cell).reshape(m * G, B * per)
+    start = np.cumsum(w_cell, axis=1) - w_cell                  # within each group
     bb, cc = np.divmod(np.arange(B * per), per)
     sub = ((cc + bb) % per + 0.5) / per
-    target = (start + sub.reshape(B, per) * w_cell).reshape(m * G, P)
+    target = start + sub[None, :] * w_cell
     cells = np.arange(n_cell).reshape(m * G, P)
     lo = np.searchsorted(cs, cells, side="left")
     hi = np.searchsorted(cs, cells, side="right") - 1
     # an empty cell (a group of few hits) takes the hit at its target in the group's order
-    glo = np.searchsorted(gkey[srt], np.arange(m * G), side="left")[:, None]
-    ghi = np.searchsorted(gkey[srt], np.arange(m * G), side="right")[:, None] - 1
+    glo = np.searchsorted(gs, np.arange(m * G), side="left")[:, None]
+    ghi = np.searchsorted(gs, np.arange(m * G), side="right")[:, None] - 1
     empty = hi < lo
     lo, hi = np.where(empty, glo, lo), np.where(empty, np.maximum(ghi, glo), hi)
-    idx = np.clip(np.searchsorted(cw, target, side="left"), lo, hi)
+    # the first hit of the group whose cumulative weight reaches the target: merge the
+    # targets into the hits' (group, cumulative weight) order, a target before equal hits
+    q_group = np.repeat(np.arange(m * G), P)
+    order = np.lexsort((np.r_[np.zeros(len(q_group), np.int8), np.ones(len(gs), np.int8)],
+                        np.r_[target.reshape(-1), cw], np.r_[q_group, gs]))
+    is_hit = order >= len(q_group)
+    hits_before = np.cumsum(is_hit) - is_hit
+    first = np.empty(len(q_group), np.int64)
+    first[order[~is_hit]] = hits_before[~is_hit]
+    idx = np.clip(first.reshape(m * G, P), lo, hi)
     idx = srt[np.minimum(idx, len(srt) - 1)]
     used = (wflat > 0)[:, None]
     pts = np.where(used[..., None], hp[idx] + lift * hn[idx],
@@ -251,25 +262,85 @@ def _group_points(o, hs, gkey, w, hp, hn, w_g, n_g, P: int, lift: float):
     return pts.reshape(m, G, P, 3), nrm.reshape(m, G, P, 3)
 
 
-def _reflector_surroundings(scene, keys, pts, nrm, used, cfg: IrradianceCfg, stream: int = 2):
+#: the surface index of the street where the city model has none (the virtual ground)
+VIRTUAL_GROUND = -2
+
+
+def _hits(scene, o, d, ray_length_m: float, ground_z, road_albedo: float) -> dict:
+    """What rays from *o* (n, 3) along *d* (n, 3) hit first: a triangle of the mesh, else the
+    street where the city model has none.
+
+    A city model without terrain or road surfaces (most LoD2 building files) leaves the
+    street out, and a ray that leaves a facade downwards would escape, counted as open
+    ground lit like a field.  Here a ray that hits nothing and points down meets the
+    level ground at *ground_z* (the road under the roof point, m) within the ray length:
+    the street, with the road's albedo, lit and shaded as the buildings shade it (its
+    sample points cast their own sun rays).  A mesh hit always wins (terrain, roads).
+
+    Returns
+    -------
+    dict of (n,) arrays: ``tri`` (mesh triangle, :data:`VIRTUAL_GROUND` for the virtual
+    street, -1 for nothing), ``dist`` (m, inf for nothing), ``albedo``, ``ground`` (bool:
+    ground, terrain, road or the virtual street), ``normal`` (n, 3) the surface's normal as
+    stored (up for the virtual street)
+    """
+    tri, dist = scene.first_hit(o, d, ray_length_m)
+    tri = tri.astype(np.int64)
+    dist = dist.astype(np.float64)
+    mesh = scene.mesh
+    n = len(tri)
+    hit = tri >= 0
+    t = np.where(hit, tri, 0)
+    albedo = np.zeros(n)
+    ground = np.zeros(n, bool)
+    normal = np.zeros((n, 3))
+    normal[:, 2] = 1.0
+    if len(mesh.albedo):
+        albedo[hit] = np.asarray(mesh.albedo, np.float64)[t[hit]]
+        ground[hit] = np.isin(np.asarray(mesh.surface_type)[t[hit]], _GROUND_CODES)
+        normal[hit] = np.asarray(mesh.normals, np.float64)[t[hit]]
+    if ground_z is not None:
+        gz = np.broadcast_to(np.asarray(ground_z, np.float64), (n,))
+        down = ~hit & (d[:, 2] < 0)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            t_g = (o[:, 2] - gz) / -d[:, 2]
+        virtual = down & (t_g > 0) & (t_g <= ray_length_m)
+        tri[virtual], dist[virtual] = VIRTUAL_GROUND, t_g[virtual]
+        albedo[virtual], ground[virtual] = road_albedo, True
+    return {"tri": tri, "dist": dist, "albedo": albedo, "ground": ground, "normal": normal}
+
+
+def _group_cumsum(values: np.ndarray, groups: np.ndarray) -> np.ndarray:
+    """Cumulative sums of *values* restarting at each run of equal *groups* (sorted): each
+    group's sums are its own, whatever comes before it (float64)."""
+    if not len(values):
+        return np.zeros(0)
+    return pd.Series(np.asarray(values, np.float64)).groupby(np.asarray(groups), sort=False).cumsum().to_numpy()
+
+
+def _reflector_surroundings(scene, keys, pts, nrm, used, cfg: IrradianceCfg, stream: int = 2,
+                            ground_z=None, road_albedo: float = 0.10):
     """What the sample points of each reflector group see over their own hemisphere (m, G).
 
     ``cfg.reflector_sky_rays`` cosine-weighted rays from every sample point: a ray that
-    escapes upwards sees sky, one that escapes downwards sees open ground outside the mesh
-    (lit as an open field, albedo applied per run), one that hits a ground or terrain
-    triangle sees the street (weighted by that triangle's albedo), one that hits any other
-    surface (a facade, a roof) sees light that surface reflects (weighted by its albedo).
+    escapes upwards sees sky, one that hits a ground, terrain or road triangle, or the level
+    street under the segment where the model has no surface (*ground_z*, m, per segment;
+    :func:`_hits`), sees the street (weighted by its albedo; *road_albedo* for the virtual
+    street), one that escapes downwards beyond the ray length sees open ground (lit as an
+    open field, albedo applied per run), one that hits any other surface (a facade, a roof)
+    sees light that surface reflects (weighted by its albedo).
 
     Returns
     -------
     dict of (m, G) arrays ``sky``, ``gnd`` (albedo-weighted street), ``open``, ``wall``
-    (albedo-weighted facades and roofs), and the street hits ``hits``: ``pair`` (segment x
+    (albedo-weighted facades and roofs), ``hor`` (view of the band of sky near the horizon,
+    :func:`horizon_band_view`, mean over the points), and the street hits ``hits``: ``pair`` (segment x
     G + group), ``p`` (hit points, m), ``n`` (upward normals), ``w`` (albedo / rays, the
     hit's share of the group's ``gnd``).
     """
     m, G, P, _ = pts.shape
     R = cfg.reflector_sky_rays
-    out = {k: np.zeros((m, G)) for k in ("sky", "gnd", "open", "wall")}
+    out = {k: np.zeros((m, G)) for k in ("sky", "gnd", "open", "wall", "hor")}
     sel = np.flatnonzero(used.reshape(-1))                     # active (segment, group)
     out["hits"] = {"pair": np.zeros(0, np.int64), "p": np.zeros((0, 3)), "n": np.zeros((0, 3)),
                    "w": np.zeros(0)}
@@ -279,30 +350,34 @@ def _reflector_surroundings(scene, keys, pts, nrm, used, cfg: IrradianceCfg, str
     d = cosine_directions(nrm.reshape(m * G, P, 3)[sel].reshape(-1, 3), R,
                           uni[sel].reshape(-1, R + 1)).reshape(-1, 3)
     oo = np.repeat(pts.reshape(m * G, P, 3)[sel].reshape(-1, 3), R, axis=0)
-    tri, dist = scene.first_hit(oo, d, cfg.ray_length_m)
-    mesh = scene.mesh
-    ground_tri = np.isin(np.asarray(mesh.surface_type), _GROUND_CODES)
-    albedo = np.asarray(mesh.albedo, np.float64)
-    hit = tri >= 0
-    t = np.where(hit, tri, 0)
-    on_ground = hit & ground_tri[t] if len(ground_tri) else np.zeros(len(tri), bool)
-    a = albedo[t] if len(albedo) else np.zeros(len(tri))
     n = P * R
+    gz = None if ground_z is None else np.repeat(np.repeat(np.asarray(ground_z, np.float64), G)[sel], n)
+    h = _hits(scene, oo, d, cfg.ray_length_m, gz, road_albedo)
+    tri, dist, a = h["tri"], h["dist"], h["albedo"]
+    hit = tri != -1
+    on_ground = h["ground"]
     rays = {"sky": ~hit & (d[:, 2] > 0), "open": ~hit & (d[:, 2] <= 0)}
     for k, v in rays.items():
         out[k].reshape(-1)[sel] = v.astype(np.float64).reshape(-1, n).mean(1)
     out["gnd"].reshape(-1)[sel] = np.where(on_ground, a, 0.0).reshape(-1, n).mean(1)
     out["wall"].reshape(-1)[sel] = np.where(hit & ~on_ground, a, 0.0).reshape(-1, n).mean(1)
+    # the view of the band of sky near the horizon (the Perez horizon term), R rays a point
+    pn = nrm.reshape(m * G, P, 3)[sel].reshape(-1, 3)
+    band_uni = segment_uniforms(cfg.seed, stream + 3, keys, G * P * 2 * R).reshape(m * G, P, 2 * R)
+    band = horizon_band_view(scene, pts.reshape(m * G, P, 3)[sel].reshape(-1, 3), pn,
+                             band_uni[sel].reshape(-1, 2 * R), R, cfg.ray_length_m)
+    out["hor"].reshape(-1)[sel] = band.reshape(-1, P).mean(1)
     g = np.flatnonzero(on_ground & (a > 0))
     if len(g):
-        tn = np.asarray(mesh.normals, np.float64)[tri[g]]
+        tn = h["normal"][g]
         tn = np.where((tn[:, 2:3] < 0), -tn, tn)
         out["hits"] = {"pair": sel[g // n], "p": oo[g] + dist[g, None].astype(np.float64) * d[g],
                        "n": tn, "w": a[g] / n}
     return out
 
 
-def _street(o, gw, surround, keys, cfg: IrradianceCfg, scene, lift: float):
+def _street(o, gw, surround, keys, cfg: IrradianceCfg, scene, lift: float, ground_z=None,
+            road_albedo: float = 0.10):
     """The street the reflector groups see, as one more reflector of each segment.
 
     Its P sample points are taken from the street hits of the groups' own rays, each hit
@@ -329,13 +404,15 @@ def _street(o, gw, surround, keys, cfg: IrradianceCfg, scene, lift: float):
         z = np.zeros(m)
         return {"n": n_s[:, 0], "pts": pts, "used": used, "sky": z, "wall": z.copy()}
     pts, pn = _group_points(o, seg, seg, w, h["p"], h["n"], w_s, n_s, P, lift)
-    own = _reflector_surroundings(scene, keys, pts, pn, used[:, None], cfg, stream=3)
+    own = _reflector_surroundings(scene, keys, pts, pn, used[:, None], cfg, stream=3,
+                                  ground_z=ground_z, road_albedo=road_albedo)
     return {"n": n_s[:, 0], "pts": pts[:, 0], "used": used, "sky": own["sky"][:, 0],
             "wall": own["wall"][:, 0]}
 
 
 def segment_geometry(scene, segments: pd.DataFrame, cfg: IrradianceCfg | None = None,
-                     chunk: int = 4096) -> pd.DataFrame:
+                     chunk: int = 4096, road_albedo: float = 0.10,
+                     roof_height_m: float | None = 3.2) -> pd.DataFrame:
     """Time-independent geometry of every segment: roof plane, sky view factor, reflectors.
 
     Parameters
@@ -344,14 +421,22 @@ def segment_geometry(scene, segments: pd.DataFrame, cfg: IrradianceCfg | None = 
     segments : DataFrame with ``segment_id, x, y, z, heading_deg, gradient`` (optional
         ``x_end, y_end, z_end``: the roof point is then the segment's midpoint), metres
     cfg : IrradianceCfg (``svf_rays``, ``reflection_rays``, ``max_reflector_groups``,
-        ``reflector_points``, ``reflector_sky_rays``, ``ray_length_m``, ``ray_offset_m``,
-        ``seed``)
+        ``reflector_points``, ``reflector_sky_rays``, ``horizon_band_rays``,
+        ``ray_length_m``, ``ray_offset_m``, ``seed``)
+    road_albedo : float, albedo of the street where the city model has no surface
+        (``city.albedo.road``)
+    roof_height_m : float or None, height of the roof point above the street, m: the level
+        of the street under it where the model has no ground (:func:`_hits`; a
+        ``ground_z`` column of *segments*, m, gives it instead); None: no such street, a ray
+        that leaves the mesh downwards sees open ground
 
     Returns
     -------
     DataFrame, one row per segment (plain numeric columns):
         ``segment_id``; ``px, py, pz`` ray origin (roof point lifted by ``ray_offset_m``
         along the normal, m); ``tilt_deg, azimuth_deg``; ``nx, ny, nz`` roof normal;
+        ``hbv`` the roof's view of the band of sky near the horizon (``sin tilt`` in the
+        open, :func:`horizon_band_view`);
         ``svf`` cosine-weighted sky view factor (sky above the horizon and not blocked;
         (1 + cos tilt)/2 with no buildings); ``refl_vf`` albedo-weighted view factor of
         all surfaces seen, ``refl_vf_se`` its Monte Carlo standard error; for each group
@@ -399,13 +484,27 @@ def segment_geometry(scene, segments: pd.DataFrame, cfg: IrradianceCfg | None = 
     tilt, azim = roof_plane(segments["heading_deg"].to_numpy(float),
                             segments["gradient"].to_numpy(float))
     normal = plane_normal(tilt, azim)
-    origin = _roof_points(segments) + cfg.ray_offset_m * normal
+    roof = _roof_points(segments)
+    origin = roof + cfg.ray_offset_m * normal
+    if "ground_z" in segments:
+        ground_z = segments["ground_z"].to_numpy(np.float64)
+    elif roof_height_m is not None:
+        ground_z = roof[:, 2] - float(roof_height_m)
+    else:
+        ground_z = None
     G, P = cfg.max_reflector_groups, cfg.reflector_points
     svf = np.ones(n_seg, np.float64)
+    hbv = np.zeros(n_seg, np.float64)
     acc = _no_reflectors(origin, G, P)
+    H = cfg.horizon_band_rays
     for a in range(0, n_seg, chunk):
         sl = slice(a, min(n_seg, a + chunk))
         svf[sl] = _sky_view_factor(scene, origin[sl], normal[sl], seg_ids[sl], cfg)
+        tilted = np.flatnonzero(np.hypot(normal[sl, 0], normal[sl, 1]) > 1e-6)
+        if len(tilted):
+            uni = segment_uniforms(cfg.seed, 4, seg_ids[sl][tilted], 2 * H)
+            hbv[a + tilted] = horizon_band_view(scene, origin[sl][tilted], normal[sl][tilted],
+                                                uni, H, cfg.ray_length_m)
         if not (cfg.reflection and cfg.reflection_rays > 0 and G > 0):
             continue
         # more rays where the sky view is small: reflections matter most there
@@ -413,8 +512,24 @@ def segment_geometry(scene, segments: pd.DataFrame, cfg: IrradianceCfg | None = 
         for part, N in ((~dense, cfg.reflection_rays), (dense, _DENSE_RAYS * cfg.reflection_rays)):
             idx = np.arange(sl.start, sl.stop)[part]
             if len(idx):
-                _reflectors(scene, origin[idx], normal[idx], seg_ids[idx], N, cfg, acc, idx)
-    return _geometry_frame(seg_ids, origin, tilt, azim, normal, svf, acc, G, P)
+                _reflectors(scene, origin[idx], normal[idx], seg_ids[idx], N, cfg, acc, idx,
+                            None if ground_z is None else ground_z[idx], road_albedo)
+    frame = _geometry_frame(seg_ids, origin, tilt, azim, normal, svf, acc, G, P, hbv)
+    if cfg.diffuse_model == "perez_svf":
+        # the Perez sky's luminance is integrated over the sky the roof point sees: its
+        # horizon per 10 deg sector as a level index (models.sky.sky_levels)
+        from .horizon import horizon_profile
+        from .sky import sky_levels
+
+        profile = np.concatenate([horizon_profile(scene, origin[a:a + chunk], max_distance_m=cfg.ray_length_m)
+                                  for a in range(0, n_seg, chunk)]) if n_seg else np.zeros((0, 72), np.float32)
+        frame = pd.concat([frame, pd.DataFrame(sky_levels(profile), columns=SKY_COLUMNS)], axis=1)
+        frame.attrs["horizon_profile"] = profile        # the run stores it for the app, once
+    return frame
+
+
+#: the geometry table's columns of the roof point's horizon per sky sector (perez_svf)
+SKY_COLUMNS = [f"sky_x{k:02d}" for k in range(_SKY_SECTORS)]
 
 
 def _no_reflectors(origin, G: int, P: int) -> dict:
@@ -424,7 +539,7 @@ def _no_reflectors(origin, G: int, P: int) -> dict:
             "n": np.tile(np.array([0.0, 0.0, 1.0]), (n, G, 1)) if G else np.zeros((n, 0, 3)),
             "rep": np.repeat(origin[:, None], G, axis=1),
             "pts": np.repeat(np.repeat(origin[:, None, None], G, axis=1), P, axis=2),
-            **{k: np.zeros((n, G)) for k in ("sky", "gnd", "open", "wall")},
+            **{k: np.zeros((n, G)) for k in ("sky", "gnd", "open", "wall", "hor")},
             "nlen": np.ones((n, G)), "surface": np.full((n, G), -1, np.int64),
             "street": {"n": np.tile([0.0, 0.0, 1.0], (n, 1)),
                        "pts": np.repeat(origin[:, None], P, axis=1),
@@ -448,6 +563,76 @@ def _sky_view_factor(scene, o, nrm, keys, cfg: IrradianceCfg) -> np.ndarray:
     return np.minimum(free, isotropic_sky_view(np.asarray(nrm, np.float64)[:, 2]))
 
 
+def horizon_band_directions(normals: np.ndarray, n_rays: int, uni: np.ndarray) -> np.ndarray:
+    """Directions into the band of sky near the horizon in front of each plane, drawn in
+    proportion to the light the band gives the plane.
+
+    The Perez model's horizon band lies at the horizon, so it lights a plane of tilt
+    ``beta`` in proportion to ``sin beta cos phi`` (``phi`` the azimuth from the plane's
+    own); ray ``k`` takes its azimuth from the ``k``-th of *n_rays* equal shares of that
+    weight (``phi = asin(2 u - 1)``, stratified and jittered) and its elevation uniform in
+    the band's 6.5 deg, so the share of rays that escape is the weighted view of the band.
+
+    Parameters
+    ----------
+    normals : (m, 3) float, unit normals (east, north, up)
+    n_rays : int, rays per normal
+    uni : (m, 2 n_rays) float, uniforms in [0, 1): the azimuth jitter, then the elevation
+
+    Returns
+    -------
+    (m, n_rays, 3) float64 unit vectors
+
+    References
+    ----------
+    R. Perez, R. Seals, P. Ineichen, R. Stewart, D. Menicucci (1987), Solar Energy 39(3),
+    221-231 (the horizon band); M. Pharr, W. Jakob, G. Humphreys, Physically Based Rendering,
+    3rd ed., section 13.3 (inversion method, stratified sampling).
+    """
+    from .sky import HORIZON_BAND_DEG
+
+    n = np.asarray(normals, np.float64)
+    m = len(n)
+    uni = np.asarray(uni, np.float64).reshape(m, 2, n_rays)
+    az0 = np.arctan2(n[:, 0], n[:, 1])[:, None]
+    u = (np.arange(n_rays)[None, :] + uni[:, 0]) / n_rays
+    az = az0 + np.arcsin(np.clip(2.0 * u - 1.0, -1.0, 1.0))
+    el = np.radians(HORIZON_BAND_DEG) * uni[:, 1]
+    ce = np.cos(el)
+    return np.stack([ce * np.sin(az), ce * np.cos(az), np.sin(el)], -1)
+
+
+def horizon_band_view(scene, o, nrm, uni, n_rays: int, ray_length_m: float) -> np.ndarray:
+    """Each plane's view of the band of sky near the horizon, weighted as the Perez horizon
+    term lights it: ``sin beta`` x the weighted share of the band in front of it that no
+    surface hides (``sin beta`` for an open plane, 0 for a horizontal one); (m,) float64.
+
+    Parameters
+    ----------
+    scene : vipvflow.models.shading.Scene
+    o : (m, 3) ray origins (m), nrm : (m, 3) unit normals
+    uni : (m, 2 n_rays) uniforms in [0, 1) (:func:`segment_uniforms`)
+    n_rays : int, rays per plane (:func:`horizon_band_directions`)
+    ray_length_m : float, m
+
+    References
+    ----------
+    R. Perez et al. (1990), Solar Energy 44(5), 271-289 (the horizon term ``F2 sin beta``);
+    pvlib ``irradiance.perez``.
+    """
+    nrm = np.asarray(nrm, np.float64)
+    s = np.hypot(nrm[:, 0], nrm[:, 1])
+    out = np.zeros(len(nrm))
+    tilted = np.flatnonzero(s > 1e-6)
+    if not len(tilted):
+        return out
+    d = horizon_band_directions(nrm[tilted], n_rays, np.asarray(uni)[tilted]).reshape(-1, 3)
+    blocked = scene.occluded(np.repeat(np.asarray(o, np.float64)[tilted], n_rays, axis=0), d,
+                             ray_length_m)
+    out[tilted] = s[tilted] * (~blocked).reshape(-1, n_rays).mean(1)
+    return out
+
+
 def _merge_groups(hs, hn, w, m: int, G: int) -> np.ndarray:
     """Reflector group (0..G-1) of each hit: the hits' orientation classes by weight, the G
     heaviest kept, every other class merged into the kept one nearest in orientation."""
@@ -469,19 +654,22 @@ def _merge_groups(hs, hn, w, m: int, G: int) -> np.ndarray:
     return target[hs, cls]
 
 
-def _reflectors(scene, o, nrm, keys, N: int, cfg: IrradianceCfg, acc: dict, idx) -> None:
+def _reflectors(scene, o, nrm, keys, N: int, cfg: IrradianceCfg, acc: dict, idx,
+                ground_z=None, road_albedo: float = 0.10) -> None:
     """Reflector groups of the roof points *o* (m, 3) with normals *nrm*, from *N*
     cosine-weighted rays each; written into the rows *idx* of *acc* (see
-    :func:`segment_geometry` for what each array holds)."""
+    :func:`segment_geometry` for what each array holds).  *ground_z* (m,): the level of the
+    street under each roof point where the model has none (:func:`_hits`)."""
     mesh = scene.mesh
     G, P = cfg.max_reflector_groups, cfg.reflector_points
     m = len(o)
     d = cosine_directions(nrm, N, segment_uniforms(cfg.seed, 1, keys, N + 1)).reshape(-1, 3)
     oo = np.repeat(o, N, axis=0)
-    tri, dist = scene.first_hit(oo, d, cfg.ray_length_m)
-    hit = tri >= 0
-    x = np.zeros(len(tri))
-    x[hit] = np.asarray(mesh.albedo, np.float64)[tri[hit]]
+    h = _hits(scene, oo, d, cfg.ray_length_m,
+              None if ground_z is None else np.repeat(np.asarray(ground_z, np.float64), N), road_albedo)
+    tri, dist = h["tri"], h["dist"]
+    hit = tri != -1
+    x = h["albedo"]
     xs = x.reshape(m, N)
     acc["refl_vf"][idx] = xs.mean(axis=1)
     acc["refl_se"][idx] = xs.std(axis=1, ddof=1) / np.sqrt(N) if N > 1 else 0.0
@@ -489,7 +677,7 @@ def _reflectors(scene, o, nrm, keys, N: int, cfg: IrradianceCfg, acc: dict, idx)
     if not hit.any():
         return
     hs, hd = np.repeat(np.arange(m), N)[hit], d[hit]
-    hn = np.asarray(mesh.normals, np.float64)[tri[hit]]
+    hn = h["normal"][hit]
     hn = np.where(((hn * hd).sum(1) > 0)[:, None], -hn, hn)     # the face the roof sees
     hp = oo[hit] + dist[hit, None].astype(np.float64) * hd
     w = x[hit] / N
@@ -509,28 +697,32 @@ def _reflectors(scene, o, nrm, keys, N: int, cfg: IrradianceCfg, acc: dict, idx)
     rep = np.repeat(o[:, None], G, axis=1).reshape(-1, 3)
     rep[gkey[first]] = hp[first]
     # the surface holding most of each group's weight (for the export)
-    acc["surface"][idx] = _dominant_surface(gkey, np.asarray(mesh.surface_index, np.int64)[tri[hit]],
-                                            w, m * G).reshape(m, G)
+    surf = np.full(int(hit.sum()), -1, np.int64)
+    on_mesh = tri[hit] >= 0
+    surf[on_mesh] = np.asarray(mesh.surface_index, np.int64)[tri[hit][on_mesh]]
+    acc["surface"][idx] = _dominant_surface(gkey, surf, w, m * G).reshape(m, G)
     # sample points (lit fraction) and the groups' own surroundings (sky, street, facades)
     lift = max(cfg.ray_offset_m, _MIN_REFLECTOR_LIFT)
     pts, pn = _group_points(o, hs, gkey, w, hp, hn, w_g, n_g, P, lift)
-    around = _reflector_surroundings(scene, keys, pts, pn, nz, cfg)
-    for k in ("sky", "gnd", "open", "wall"):
+    around = _reflector_surroundings(scene, keys, pts, pn, nz, cfg, ground_z=ground_z,
+                                     road_albedo=road_albedo)
+    for k in ("sky", "gnd", "open", "wall", "hor"):
         acc[k][idx] = around[k]
     acc["w"][idx], acc["n"][idx], acc["rep"][idx], acc["pts"][idx] = w_g, n_g, rep.reshape(m, G, 3), pts
-    st = _street(o, w_g, around, keys, cfg, scene, lift)
+    st = _street(o, w_g, around, keys, cfg, scene, lift, ground_z, road_albedo)
     for k in acc["street"]:
         acc["street"][k][idx] = st[k]
 
 
-def _geometry_frame(seg_ids, origin, tilt, azim, normal, svf, acc: dict, G: int, P: int) -> pd.DataFrame:
+def _geometry_frame(seg_ids, origin, tilt, azim, normal, svf, acc: dict, G: int, P: int,
+                    hbv) -> pd.DataFrame:
     """The stored geometry table (plain numeric columns, see :func:`segment_geometry`)."""
     f32 = np.float32
     out = {"segment_id": seg_ids,
            "px": origin[:, 0], "py": origin[:, 1], "pz": origin[:, 2],
            "tilt_deg": tilt.astype(f32), "azimuth_deg": azim.astype(f32),
            "nx": normal[:, 0].astype(f32), "ny": normal[:, 1].astype(f32),
-           "nz": normal[:, 2].astype(f32), "svf": svf.astype(f32),
+           "nz": normal[:, 2].astype(f32), "svf": svf.astype(f32), "hbv": hbv.astype(f32),
            "refl_vf": acc["refl_vf"].astype(f32), "refl_vf_se": acc["refl_se"].astype(f32)}
     for g in range(G):
         out[f"r{g}_w"] = acc["w"][:, g].astype(f32)
@@ -541,7 +733,7 @@ def _geometry_frame(seg_ids, origin, tilt, azim, normal, svf, acc: dict, G: int,
         for k in range(P):
             for j, c in enumerate("xyz"):
                 out[f"r{g}_p{k}_{c}"] = acc["pts"][:, g, k, j]
-        for k in ("sky", "gnd", "open", "wall", "nlen"):
+        for k in ("sky", "gnd", "open", "wall", "hor", "nlen"):
             out[f"r{g}_{k}"] = acc[k][:, g].astype(f32)
         out[f"r{g}_surface"] = acc["surface"][:, g].astype(np.int32)
     if G:
@@ -714,8 +906,12 @@ def pack_geometry(geometry: pd.DataFrame, cfg: IrradianceCfg, ground_albedo: flo
     Returns
     -------
     dict of arrays per segment ``s`` and reflector ``J`` (groups, then the street): ``p``
-    (s, 3) ray origins (m), ``n`` (s, 3) roof normals, ``svf`` (s,), ``refl_sky`` and
-    ``refl_ghi`` (s,) the weights of DHI and GHI in the reflected part (dimensionless),
+    (s, 3) ray origins (m), ``n`` (s, 3) roof normals, ``svf`` (s,), ``hbv`` (s,) the roof's
+    view of the horizon band, ``refl_sky`` and ``refl_ghi`` (s,) the weights of DHI and GHI
+    in the reflected part, ``refl_hor`` (s,) the reflectors' horizon-band views so weighted
+    (x DHI F2 under the Perez sky; all dimensionless), ``sky_x`` (s, 36) the roof point's
+    horizon per sky sector as a level index (:func:`vipvflow.models.sky.sky_levels`; (s, 0)
+    without the ``sky_x..`` columns),
     ``wn`` (s, J, 3) weight x normal of each reflector (its beam weight is ``wn . sun``),
     ``group_p`` (s J, P, 3) sample points (m); with *scene* also ``scene_origin``,
     ``p_local`` and ``group_p_local`` (float32, the scene's frame).
@@ -740,7 +936,7 @@ def pack_geometry(geometry: pd.DataFrame, cfg: IrradianceCfg, ground_albedo: flo
     w = np.stack([col(f"r{g}_w") for g in range(G)], 1) if G else np.zeros((s, 0))
     nrm = np.zeros((s, J, 3))
     pts = np.zeros((s, J, max(P, 1), 3), np.float64)
-    f_s, f_g, f_o, f_w = (np.zeros((s, G)) for _ in range(4))
+    f_s, f_g, f_o, f_w, f_h = (np.zeros((s, G)) for _ in range(5))
     beam_len = np.ones((s, J))
     # the sample points: one (s, P x 3) block per reflector (a thousand columns read one
     # by one cost more than the rest of the packing)
@@ -759,6 +955,8 @@ def pack_geometry(geometry: pd.DataFrame, cfg: IrradianceCfg, ground_albedo: flo
             f_s[:, g], f_o[:, g] = (1 + nrm[:, g, 2]) / 2, (1 - nrm[:, g, 2]) / 2
         if f"r{g}_wall" in cols:
             f_w[:, g] = col(f"r{g}_wall")
+        if f"r{g}_hor" in cols:
+            f_h[:, g] = col(f"r{g}_hor")
         if f"r{g}_nlen" in cols:
             beam_len[:, g] = col(f"r{g}_nlen")
     src_sky, src_ghi = f_s, ground_albedo * f_o
@@ -770,19 +968,45 @@ def pack_geometry(geometry: pd.DataFrame, cfg: IrradianceCfg, ground_albedo: flo
         m = _exchange_weights(w, f_g, f_w, col("st_wall"), has)
         src_sky = np.concatenate([f_s, col("st_sky")[:, None]], 1)
         src_ghi = np.concatenate([src_ghi, np.zeros((s, 1))], 1)
+        f_h = np.concatenate([f_h, np.zeros((s, 1))], 1)     # a level street: no horizon term
     else:                     # the street lit as an open field, by GHI
         m = w
         src_ghi = src_ghi + f_g
     geo = {"p": np.ascontiguousarray(geometry[["px", "py", "pz"]].to_numpy(np.float64)),
            "n": np.ascontiguousarray(geometry[["nx", "ny", "nz"]].to_numpy(f32)),
            "svf": geometry["svf"].to_numpy(f32),
+           "hbv": (geometry["hbv"].to_numpy(f32) if "hbv" in cols else np.zeros(s, f32)),
+           **_sky_terms(geometry, cols),
            "refl_sky": (m * src_sky).sum(1).astype(f32), "refl_ghi": (m * src_ghi).sum(1).astype(f32),
+           "refl_hor": (m * f_h).sum(1).astype(f32),
            "wn": ((m * beam_len)[..., None] * nrm).astype(f32), "group_p": pts.reshape(s * J, -1, 3)}
     if scene is not None:
         geo["scene_origin"] = np.asarray(scene.origin, np.float64).copy()
         geo["p_local"] = scene.to_local(geo["p"])
         geo["group_p_local"] = scene.to_local(geo["group_p"])
     return geo
+
+
+def _sky_terms(geometry: pd.DataFrame, cols: set) -> dict:
+    """The roof points' horizon levels per sky sector (``sky_x``, (s, 36) float32, (s, 0)
+    without them) and, for the compiled kernel, each sector's cell in a table row
+    (``sky_cell``: ``10 k + level``, int64), its interpolation weight (``sky_f``) and the
+    roof's tilt weight ``n_x sin a_k + n_y cos a_k`` (``sky_t``; ``sky_tilted`` where any)."""
+    from .sky import SECTOR_COS, SECTOR_SIN, SKY_LEVELS
+
+    f32 = np.float32
+    s = len(geometry)
+    if not set(SKY_COLUMNS) <= cols:
+        z = np.zeros((s, 0), f32)
+        return {"sky_x": z, "sky_cell": np.zeros((s, 0), np.int64), "sky_f": z, "sky_t": z,
+                "sky_tilted": np.zeros(s, bool)}
+    x = np.ascontiguousarray(geometry[SKY_COLUMNS].to_numpy(f32))
+    i = x.astype(np.int64)
+    n = geometry[["nx", "ny"]].to_numpy(f32)
+    t = (n[:, 0:1] * SECTOR_SIN.astype(f32) + n[:, 1:2] * SECTOR_COS.astype(f32)).astype(f32)
+    return {"sky_x": x, "sky_cell": np.arange(len(SKY_COLUMNS))[None, :] * (SKY_LEVELS + 1) + i,
+            "sky_f": (x - i.astype(f32)).astype(f32), "sky_t": t,
+            "sky_tilted": np.abs(n).max(1) > 0}
 
 
 def isotropic_sky_view(normal_z):

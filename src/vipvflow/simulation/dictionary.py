@@ -319,6 +319,8 @@ SUMMARY: dict[str, Column] = {
     "months": Column("", "simulated months (1-12)"),
     "pv_mode": Column("", "PV model: 'paper' (kWp x POA x PR) or 'pvlib' (PVWatts with cell temperature)"),
     "diffuse_model": Column("", "sky diffuse model on the tilted, obstructed roof"),
+    "air_temperature_c": Column("degC", "monthly mean air temperature, January to December (HVAC, PV cell)"),
+    "air_temperature_source": Column("", "where the air temperature comes from: the scenario's table, or the climatology at the city's place"),
     "routes": Column("count", "routes simulated"),
     "trips": Column("count", "trips simulated (trip x service date)"),
     "buses": Column("count", "fleet size: most vehicle blocks on one service date"),

@@ -46,6 +46,8 @@ class RunContext:
     timezone: str
     bvh_cache_size: int = 8
     ground_albedo: float = 0.2
+    road_albedo: float = 0.10
+    roof_height_m: float = 3.2
     routes: tuple | None = None
     ray_threads: int | None = None
     shapes: tuple | None = None
@@ -147,15 +149,26 @@ def tile_geometry(ctx: RunContext, tile: str) -> pd.DataFrame:
         seg = seg[seg["tile"] == tile]
         if ctx.shapes is not None:
             seg = seg[seg["shape_id"].isin(ctx.shapes)]
-        geom = segment_geometry(_scene(ctx, tile), seg, IrradianceCfg(**ctx.irradiance))
+        geom = segment_geometry(_scene(ctx, tile), seg, IrradianceCfg(**ctx.irradiance),
+                                **street_options(ctx))
         write_parquet(geometry_table(geom), path)
     hpath = RunDir(ctx.run_dir).tile_part("horizon", tile)
     if not hpath.exists():
-        origins = geom[["px", "py", "pz"]].to_numpy(np.float64)
-        profile = horizon_profile(_scene(ctx, tile), origins,
-                                  max_distance_m=IrradianceCfg(**ctx.irradiance).ray_length_m)
+        profile = geom.attrs.get("horizon_profile")         # computed with the geometry (perez_svf)
+        if profile is None or len(profile) != len(geom):
+            origins = geom[["px", "py", "pz"]].to_numpy(np.float64)
+            profile = horizon_profile(_scene(ctx, tile), origins,
+                                      max_distance_m=IrradianceCfg(**ctx.irradiance).ray_length_m)
         write_parquet(horizon_frame(geom["segment_id"].to_numpy(), profile), hpath)
     return geom
+
+
+def street_options(ctx: RunContext) -> dict:
+    """How :func:`vipvflow.models.view_factors.segment_geometry` places the street where the
+    city model has none: the road's albedo and the roof's height above it (None:
+    ``irradiance.virtual_street`` off)."""
+    on = IrradianceCfg(**ctx.irradiance).virtual_street
+    return {"road_albedo": ctx.road_albedo, "roof_height_m": ctx.roof_height_m if on else None}
 
 
 class TileGeometry:

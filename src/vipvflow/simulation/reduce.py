@@ -301,7 +301,7 @@ def pattern_consumption(cfg: Config, data_dir: Path, year: int, pattern_ids, vec
     from ..outputs import vecto
 
     params = cfg.vehicle_params()
-    temps = cfg.climate.monthly_mean_temperature_c
+    temps = cfg.monthly_temperature_c()
     out = {}
     for pattern_id in sorted(set(pattern_ids)):
         cycle = pattern_cycle(data_dir, pattern_id, cfg.trajectory.cycle)
@@ -466,7 +466,7 @@ def block_day_table(cfg: Config, run_dir: Path, trip: pd.DataFrame, vehicle, pla
     iv["seconds"] = (iv["t1_utc"] - iv["t0_utc"]).to_numpy(float)
 
     # the layovers' auxiliaries (kWh from the battery) at the month's temperature
-    temps = np.asarray(cfg.climate.monthly_mean_temperature_c, float)
+    temps = np.asarray(cfg.monthly_temperature_c(), float)
 
     def aux_kwh(service_date, seconds):
         month_no = pd.to_datetime(service_date).dt.month.to_numpy()
@@ -1072,6 +1072,8 @@ def _fleet_year(cfg: Config, year: int, run_dir: Path, trip, bd, idle, sm, segme
     summary = {
         "scenario": cfg.scenario, "year": year, "months": cfg.run.months, "pv_mode": cfg.pv.mode,
         "diffuse_model": cfg.irradiance.diffuse_model,
+        "air_temperature_c": cfg.monthly_temperature_c(),
+        "air_temperature_source": cfg.temperature_source(),
         "routes": int(trip["route_id"].nunique()), "trips": int(len(trip)), "buses": n_buses,
         "segments": int(len(segments)), "passes": int(sm["n_passes"].sum()),
         "kwp_per_bus": pv.kwp,

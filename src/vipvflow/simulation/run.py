@@ -90,8 +90,8 @@ def run_simulation(cfg: Config, year: int, scheduler: str | None = None,
         timeline = _Background(write_timeline, cfg, year, run_dir, routes=routes, name="timeline")
         # the radiation table's sun positions are computed (and cached beside the radiation
         # file, where every worker loads them) while the cluster starts
-        warm = threading.Thread(target=_warm_radiation, args=(ctx.data_dir, year), daemon=True,
-                                name="sun-positions")
+        warm = threading.Thread(target=_warm_radiation, daemon=True, name="sun-positions",
+                                args=(ctx.data_dir, year, cfg.irradiance.diffuse_model == "perez_svf"))
         warm.start()
         t_wait = time.perf_counter()
         client, cluster = starting.result()
@@ -194,9 +194,10 @@ def _run_context(cfg: Config, year: int, run_dir: Path) -> tuple[RunContext, lis
     ctx = RunContext(
         data_dir=str(data_dir.resolve()), run_dir=str(run_dir.resolve()), year=year,
         irradiance=cfg.irradiance.model_dump(), pv_system=cfg.pv_system().model_dump(),
-        pv_mode=cfg.pv.mode, monthly_temperature_c=tuple(cfg.climate.monthly_mean_temperature_c),
+        pv_mode=cfg.pv.mode, monthly_temperature_c=tuple(cfg.monthly_temperature_c()),
         wind_speed_mps=cfg.climate.wind_speed_mps, timezone=feed["timezone"],
         bvh_cache_size=cfg.dask.bvh_cache_size, ground_albedo=cfg.city.albedo.ground,
+        road_albedo=cfg.city.albedo.road, roof_height_m=cfg.trajectory.roof_height_m,
         routes=tuple(routes) if routes is not None else None, shapes=shapes,
         # the progress view's kWh per route, by the routes' public names
         route_of_trip=dict(zip(trips["trip_id"], trips["route_short_name"].astype(str))))
@@ -246,13 +247,16 @@ class _Starting(_Background):
             close_client(*self._out["value"])
 
 
-def _warm_radiation(data_dir: str, year: int) -> None:
-    """Load the radiation table once in this process (writes its sun-position cache); a
-    failure is left for the workers to report with the file named."""
+def _warm_radiation(data_dir: str, year: int, sky: bool = False) -> None:
+    """Load the radiation table once in this process (writes its sun-position cache, and
+    with *sky* the Perez sky's tables); a failure is left for the workers to report with
+    the file named."""
     from ..models.sun_sky import RadiationTable
 
     try:
-        RadiationTable.load(data_dir, year)
+        table = RadiationTable.load(data_dir, year)
+        if sky:
+            table.sky()
     except Exception:  # noqa: BLE001 - the same load fails again in the tasks, with its message
         pass
 

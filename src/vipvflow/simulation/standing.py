@@ -46,14 +46,15 @@ def open_scene():
     return Scene(box_mesh([]))
 
 
-def point_geometry(scene, points: pd.DataFrame, cfg: IrradianceCfg) -> pd.DataFrame:
-    """Geometry factors of standing roof points (``point_id, x, y, z``, m): a flat roof."""
+def point_geometry(scene, points: pd.DataFrame, cfg: IrradianceCfg, **street) -> pd.DataFrame:
+    """Geometry factors of standing roof points (``point_id, x, y, z``, m): a flat roof;
+    *street*: :func:`vipvflow.simulation.partition.street_options`."""
     from ..models.view_factors import segment_geometry
 
     seg = pd.DataFrame({"segment_id": points["point_id"].to_numpy(np.int64),
                         "x": points["x"].to_numpy(float), "y": points["y"].to_numpy(float),
                         "z": points["z"].to_numpy(float), "heading_deg": 0.0, "gradient": 0.0})
-    return segment_geometry(scene, seg, cfg)
+    return segment_geometry(scene, seg, cfg, **street)
 
 
 def interval_integrals(intervals: pd.DataFrame, geometry: pd.DataFrame, radiation, scene,
@@ -126,7 +127,7 @@ def run_standing(ctx, tile: str) -> dict:
     ``covered``: the depot outside the city model) of the run's block-days; writes
     ``parts/standing/tile=T/month=all.parquet``, one row per interval (``seconds`` and the
     sums are per bus times ``buses``: more than 1 only for the idle buses of a day)."""
-    from .partition import _radiation, _scene, pv_energy_kwh, tune_malloc
+    from .partition import _radiation, _scene, pv_energy_kwh, street_options, tune_malloc
 
     tune_malloc()
     t_start = time.perf_counter()
@@ -144,7 +145,7 @@ def run_standing(ctx, tile: str) -> dict:
         _radiation(ctx.data_dir, ctx.year)
         timings["standing_scene_s"] = time.perf_counter() - t
         t = time.perf_counter()
-        geom = point_geometry(scene, points, cfg)
+        geom = point_geometry(scene, points, cfg, **street_options(ctx))
         timings["standing_geometry_s"] = time.perf_counter() - t
     t_eval = time.perf_counter()
     parts = []

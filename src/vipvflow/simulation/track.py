@@ -97,9 +97,24 @@ def fit_stats(measured, modelled) -> dict:
 
 
 def model_track(track: pd.DataFrame, data_dir, radiation_table, cfg: IrradianceCfg | None = None,
-                roof_height_m: float = 3.2) -> pd.DataFrame:
-    """Irradiance components (W/m2) at every point of a track read by :func:`read_track`."""
-    cfg = cfg or IrradianceCfg()
+                roof_height_m: float = 3.2, ground_albedo: float = 0.20,
+                road_albedo: float = 0.10) -> pd.DataFrame:
+    """Irradiance components (W/m2) at every point of a track read by :func:`read_track`.
+
+    Parameters
+    ----------
+    track : DataFrame from :func:`read_track`
+    data_dir : the scenario's data dir (tiles, meshes, terrain)
+    radiation_table : vipvflow.models.sun_sky.RadiationTable
+    cfg : IrradianceCfg, the run's physics (diffuse model, rays); its reflector sampling
+        is replaced by ``all``: each point is one instant, and every sample point of its
+        reflectors is traced (the lit fraction of that instant), not one in turn (right only
+        on average over many passes)
+    roof_height_m : float, m, the roof above the street where the track gives no ``z``
+    ground_albedo, road_albedo : float, the open ground's and the street's albedo
+        (``city.albedo.ground``, ``city.albedo.road``)
+    """
+    cfg = (cfg or IrradianceCfg()).model_copy(update={"reflector_sampling": "all"})
     data_dir = Path(data_dir)
     tiles_json = DataDir(data_dir).city.tiles_json
     meta = json.loads(tiles_json.read_text())
@@ -137,10 +152,12 @@ def model_track(track: pd.DataFrame, data_dir, radiation_table, cfg: IrradianceC
             zz = np.where(np.isnan(zz), scene.mesh.vertices[:, 2].min() + roof_height_m, zz)
         segs = pd.DataFrame({"segment_id": np.arange(len(sel)), "x": x[sel], "y": y[sel], "z": zz,
                              "heading_deg": heading[sel], "gradient": grad[sel]})
-        geom = segment_geometry(scene, segs, cfg)
+        geom = segment_geometry(scene, segs, cfg, road_albedo=road_albedo,
+                                roof_height_m=roof_height_m if cfg.virtual_street else None)
         geom["rad_location"] = loc[sel]
         passes = pd.DataFrame({"segment_id": np.arange(len(sel)), "t_utc": tr["t_utc"].to_numpy()[sel]})
-        res = evaluate_passes(passes, segs, geom, radiation_table, scene, cfg, time_at="start")
+        res = evaluate_passes(passes, segs, geom, radiation_table, scene, cfg,
+                              ground_albedo=ground_albedo, time_at="start")
         res.index = sel
         res["z"], res["tilt_deg"], res["svf"] = zz, geom["tilt_deg"].to_numpy(), geom["svf"].to_numpy()
         parts.append(res)
