@@ -50,8 +50,8 @@ def _buildings(data_dir: Path, tiles: list[str]) -> tuple[np.ndarray, np.ndarray
     codes = np.array([SURFACE_CODE[t] for t in BUILDING_TYPES])
     corners, owners = [], []
     for tile in tiles:
-        if tile not in entries:           # a segment's tile without city surfaces
-            continue
+        if tile not in entries or not entries[tile]["n_surfaces"]:
+            continue                      # a segment's tile without buildings of its own
         mesh = TileMesh.load(city.mesh(tile))
         n_own = int(entries[tile]["n_surfaces"])
         bid = pq.read_table(city.surface_part(tile), columns=["building_id"]).column(0).to_numpy(
