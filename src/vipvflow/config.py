@@ -233,6 +233,31 @@ class DbCfg(_Model):
     dsn: str | None = None
 
 
+#: how far (km) a radiation location may lie from the city model (without one: from the
+#: routes) before a run is refused (``radiation_far``): CAMS series are point values of a
+#: 3-5 km satellite pixel; 50 km keeps a city's own weather, not another region's
+RADIATION_MAX_KM = 50.0
+
+#: the plausibility findings a run or an ingest refuses, each in one line naming it, unless
+#: it is listed in ``checks.accept`` (or given with ``--accept``): docs/checks.md
+PLAUSIBILITY_FINDINGS = {
+    "radiation_far": f"a radiation location more than {RADIATION_MAX_KM:g} km from the city "
+                     "model (without one: from the routes)",
+    "radiation_components": "GHI below DHI, or above the clear-sky GHI by more than the margin, "
+                            "for more than a few minutes (columns swapped or in other units)",
+    "crs_area": "the city model or the feed's stops outside the area of use of the CRS they "
+                "are put in",
+}
+
+
+class ChecksCfg(_Model):
+    """Plausibility checks of the inputs before a run (docs/checks.md)."""
+
+    # findings accepted for the rare real case: each refusal names its finding
+    accept: list[Literal["radiation_far", "radiation_components", "crs_area"]] = Field(
+        default_factory=list)
+
+
 class Config(_Model):
     scenario: str = "default"
     data_dir: Path = Path("data/default")
@@ -249,6 +274,7 @@ class Config(_Model):
     run: RunCfg = Field(default_factory=RunCfg)
     radiation: RadiationCfg = Field(default_factory=RadiationCfg)
     fleet: FleetCfg = Field(default_factory=FleetCfg)
+    checks: ChecksCfg = Field(default_factory=ChecksCfg)
     dask: DaskCfg = Field(default_factory=DaskCfg)
     db: DbCfg = Field(default_factory=DbCfg)
 
@@ -272,8 +298,10 @@ class Config(_Model):
     def digest(self) -> str:
         """A stable hash of what decides a run's results (for run manifests and resuming):
         the validated configuration without where it runs (``dask``), where it writes
-        (``out_dir``) and where it mirrors (``db``)."""
-        text = json.dumps(self.model_dump(mode="json", exclude={"dask", "db", "out_dir"}), sort_keys=True)
+        (``out_dir``), where it mirrors (``db``) and which plausibility findings it accepts
+        (``checks``: they change no number)."""
+        text = json.dumps(self.model_dump(mode="json", exclude={"dask", "db", "out_dir", "checks"}),
+                          sort_keys=True)
         return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 

@@ -28,3 +28,21 @@ def add_config(parser, default: str | None = None) -> None:
     parser.add_argument("--config", "-c", default=default, metavar="SCENARIO",
                         help=CONFIG_HELP.format(names=", ".join(shipped_scenarios()),
                                                 default=default or "the shipped defaults alone"))
+
+
+def add_accept(parser) -> None:
+    """Add ``--accept FINDING`` (repeatable) to *parser*: a plausibility finding to accept for
+    the rare real case, added to ``checks.accept`` of the scenario (docs/checks.md)."""
+    from ..config import PLAUSIBILITY_FINDINGS
+
+    parser.add_argument("--accept", action="append", default=[], metavar="FINDING",
+                        choices=sorted(PLAUSIBILITY_FINDINGS),
+                        help="accept a plausibility finding the inputs are refused for, when it is "
+                        "right after all (also checks.accept): " + "; ".join(
+                            f"{k}: {v}" for k, v in PLAUSIBILITY_FINDINGS.items()))
+
+
+def accepted(cfg, args) -> tuple[str, ...]:
+    """The plausibility findings accepted: ``checks.accept`` of *cfg* and ``--accept``."""
+    return tuple(sorted({*cfg.checks.accept, *(getattr(args, "accept", None) or [])}))
+
