@@ -13,6 +13,7 @@ import copy
 import hashlib
 import json
 import os
+import re
 from importlib import resources
 from pathlib import Path
 from typing import Any, Literal
@@ -280,6 +281,15 @@ class Config(_Model):
 
     # where the values came from, for error messages and the run manifest
     _source: str = "<defaults>"
+
+    @field_validator("scenario")
+    @classmethod
+    def _scenario_name(cls, v: str) -> str:
+        # the run folder is <out_dir>/<scenario>/<year>: a name, never a path out of out_dir
+        if not re.fullmatch(r"[A-Za-z0-9][A-Za-z0-9._-]*", v or "") or v in (".", ".."):
+            raise ValueError(f"{v!r} is not a scenario name (letters, digits, '.', '_', '-'; no "
+                             "'/' or '..'): it names the run folder <out_dir>/<scenario>/<year>")
+        return v
 
     def pv_system(self) -> PVSystem:
         """The PV system chosen by ``pv.system``, with ``pv.overrides`` applied."""

@@ -46,3 +46,10 @@ def accepted(cfg, args) -> tuple[str, ...]:
     """The plausibility findings accepted: ``checks.accept`` of *cfg* and ``--accept``."""
     return tuple(sorted({*cfg.checks.accept, *(getattr(args, "accept", None) or [])}))
 
+
+def ingest_lock(data_dir):
+    """The data dir's lock taken for an ingest (exclusively), as a context manager; a data
+    dir that is a file, or that another vipvflow process uses, is refused in one line."""
+    from ..store import data_dir_lock, folder_path, lock_for_writing
+
+    return lock_for_writing(data_dir_lock(folder_path(data_dir, "--data-dir")), "ingest")

@@ -5,7 +5,7 @@ from pathlib import Path
 
 from ..config import load_config
 from ..errors import InputError
-from . import accepted, add_accept, add_config
+from . import accepted, add_accept, add_config, ingest_lock
 
 
 def register(sub):
@@ -30,7 +30,8 @@ def run(args):
     files = list(args.files) or list(cfg.inputs.cams)
     if not files:
         raise InputError("no CAMS file given (pass FILE... or set inputs.cams in --config)")
-    report = ingest_cams(files, args.data_dir or cfg.data_dir, accept=accepted(cfg, args))
+    with ingest_lock(args.data_dir or cfg.data_dir):
+        report = ingest_cams(files, args.data_dir or cfg.data_dir, accept=accepted(cfg, args))
     for f in report["files"]:
         print(f"{f['file']}: {f['rows']} rows, step {f['time_step']}, {f['time_reference']}; "
               f"gaps {f['gaps']}, negative {f['negative']}, GHI>1.1 TOA {f['ghi_above_toa']}, "

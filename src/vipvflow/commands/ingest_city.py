@@ -6,7 +6,7 @@ from pathlib import Path
 from ..config import load_config
 from ..errors import InputError
 from ..progress import set_quiet
-from . import accepted, add_accept, add_config
+from . import accepted, add_accept, add_config, ingest_lock
 
 
 def register(sub):
@@ -44,8 +44,9 @@ def run(args):
         raise InputError("no CityGML file given (pass FILE... or set inputs.citygml in --config)")
     data_dir = args.data_dir or cfg.data_dir
     crs = args.crs or cfg.inputs.citygml_crs
-    report = ingest_city(files, data_dir, cfg.city, crs=crs, axis_order=args.axis_order,
-                         accept=accepted(cfg, args))
+    with ingest_lock(data_dir):
+        report = ingest_city(files, data_dir, cfg.city, crs=crs, axis_order=args.axis_order,
+                             accept=accepted(cfg, args))
     print(report.summary())
     print(f"report: {report.report_path}")
     return 0

@@ -5,7 +5,8 @@ from pathlib import Path
 
 from ..config import load_config
 from ..progress import set_quiet
-from . import add_config
+from ..store import folder_path
+from . import accepted, add_accept, add_config
 
 
 def register(sub):
@@ -25,8 +26,10 @@ def register(sub):
     p.add_argument("--quiet", "-q", action="store_true",
                    help="no progress bars or progress lines")
     p.add_argument("--force", action="store_true",
-                   help="replace a run of another configuration in the run directory (refused "
-                   "without: the two configuration digests are named)")
+                   help="replace a run of another configuration or of other input files in the "
+                   "run directory (refused without: the two digests are named); only a folder "
+                   "holding nothing but a run's files is replaced")
+    add_accept(p)
     p.set_defaults(func=run)
 
 
@@ -37,7 +40,9 @@ def run(args):
     overrides = {"db": {"dsn": args.db}} if args.db else {}
     cfg = load_config(args.config, overrides=overrides)
     if args.out is not None:
+        folder_path(args.out, "--out")
         cfg = load_config(args.config, overrides={**overrides, **under(cfg, args.out)})
+    cfg.checks.accept = list(accepted(cfg, args))
     run_dir = run_simulation(cfg, args.year, scheduler=args.scheduler, n_workers=args.workers,
                              force=args.force)
     if cfg.db.dsn and (run_dir / "summary.json").exists():

@@ -1,4 +1,5 @@
-"""Inputs of a run: generate the demo when asked, ingest each input once (cached by fingerprint)."""
+"""Inputs of a run: generate the demo when asked, ingest each input once (cached by the
+content digests of its files and the settings), check them before a cluster starts."""
 from __future__ import annotations
 
 import json
@@ -10,11 +11,6 @@ from ..errors import InputError
 from ..store import DataDir, GtfsDir, sha256, write_text
 
 log = logging.getLogger(__name__)
-
-
-def _fingerprint(paths: list[Path], extra: dict) -> dict:
-    return {"files": [{"path": str(p), "size": p.stat().st_size, "mtime_ns": p.stat().st_mtime_ns}
-                      for p in paths], "config": extra}
 
 
 def _cached(stamp: Path, fp: dict) -> bool:
@@ -73,14 +69,11 @@ def ensure_demo(cfg: Config, year: int, say=print) -> None:
     _stamp(marker, want)
 
 
-def ensure_ingested(cfg: Config, say=print) -> dict:
-    """Ingest city, GTFS and CAMS inputs into ``cfg.data_dir`` unless already done for the same
-    files and settings. Returns the inputs' checksums for the run manifest."""
-    from ..inputs.cams import ingest_cams
-    from ..inputs.city import ingest_city
-    from ..inputs.gtfs import ingest_gtfs
+def input_digests(cfg: Config) -> "InputDigests":
+    """The content digests (SHA-256) of the scenario's input files, which must exist; the
+    timetable and the radiation are required."""
+    from .manifest import InputDigests
 
-    data_dir = Path(cfg.data_dir)
     city_files = [Path(p) for p in cfg.inputs.citygml]
     cams_files = [Path(p) for p in cfg.inputs.cams]
     gtfs = Path(cfg.inputs.gtfs) if cfg.inputs.gtfs else None
@@ -90,41 +83,87 @@ def ensure_ingested(cfg: Config, say=print) -> dict:
                          + " (see data_manifest.yaml and `make data`)")
     if gtfs is None or not cams_files:
         raise InputError(f"{cfg._source}: inputs.gtfs and inputs.cams are required")
+    not_files = [str(p) for p in [*city_files, *cams_files] if not p.is_file()]
+    if not_files:
+        raise InputError(f"{cfg._source}: inputs name folders, not files: {', '.join(not_files)}")
+    return InputDigests({"inputs.citygml": {str(p): sha256(p) for p in city_files},
+                         "inputs.gtfs": {str(gtfs): sha256(gtfs)},
+                         "inputs.cams": {str(p): sha256(p) for p in cams_files}})
 
-    # the ingests' format versions: a data dir ingested before (city: no meshes for the
-    # tiles within the buffer, no coverage area, no check of the CRS's area; GTFS: no ground
-    # sources, no duplicate rows or service-day checks) is ingested again
-    city_fp = _fingerprint(city_files, {"city": cfg.city.model_dump(mode="json"),
-                                        "crs": cfg.inputs.citygml_crs, "format": 3})
+
+#: the ingests' format versions: a data dir ingested before (city: no meshes for the tiles
+#: within the buffer, no coverage area, no check of --crs's area; GTFS: no ground sources, no
+#: duplicate rows or service-day checks; radiation: no gaps listed, no check of GHI against
+#: DHI and the clear sky) is ingested again
+_FORMATS = {"city": 3, "radiation": 4, "gtfs": 3}
+
+
+def _fingerprints(cfg: Config, inputs) -> dict:
+    """What each ingested folder of the data dir must have been made from: the contents
+    (SHA-256) of its input files and the settings that shape it."""
+    def shas(role):
+        return sorted(inputs.files[role].values())
+
+    city = {"files": shas("inputs.citygml"), "config": {
+        "city": cfg.city.model_dump(mode="json"), "crs": cfg.inputs.citygml_crs,
+        "format": _FORMATS["city"]}}
+    radiation = {"files": shas("inputs.cams"), "config": {"checks": _FORMATS["radiation"]}}
+    gtfs = {"files": shas("inputs.gtfs"), "config": {
+        "trajectory": cfg.trajectory.model_dump(mode="json"), "city": city,
+        "radiation": radiation, "timezone": cfg.inputs.gtfs_timezone,
+        "route_types": cfg.run.route_types, "format": _FORMATS["gtfs"]}}
+    return {"city": city, "radiation": radiation, "gtfs": gtfs}
+
+
+def ingest_needed(cfg: Config, inputs) -> list[str]:
+    """The folders of the data dir (``city``, ``radiation``, ``gtfs``) that
+    :func:`ensure_ingested` would ingest again for these inputs and settings."""
+    data = DataDir(cfg.data_dir)
+    fps = _fingerprints(cfg, inputs)
+    return [name for name in ("city", "radiation", "gtfs")
+            if (name != "city" or cfg.inputs.citygml)
+            and not _cached(getattr(data, name).stamp, fps[name])]
+
+
+def ensure_ingested(cfg: Config, say=print, inputs=None):
+    """Ingest city, GTFS and CAMS inputs into ``cfg.data_dir`` unless already done from the
+    same file contents and settings (each folder's ``.inputs.json`` records the SHA-256 of
+    its files). Returns the inputs' :class:`~vipvflow.simulation.manifest.InputDigests`
+    (computed when *inputs* is not given)."""
+    from ..inputs.cams import ingest_cams
+    from ..inputs.city import ingest_city
+    from ..inputs.gtfs import ingest_gtfs
+
+    if inputs is None:
+        inputs = input_digests(cfg)
+    data_dir = Path(cfg.data_dir)
+    city_files = [Path(p) for p in cfg.inputs.citygml]
+    cams_files = [Path(p) for p in cfg.inputs.cams]
+    gtfs = Path(cfg.inputs.gtfs)
+    fps = _fingerprints(cfg, inputs)
     data = DataDir(data_dir)
     stamp = data.city.stamp
-    if city_files and not _cached(stamp, city_fp):
+    if city_files and not _cached(stamp, fps["city"]):
         say(f"ingesting {len(city_files)} CityGML file(s)")
         report = ingest_city(city_files, data_dir, cfg.city, crs=cfg.inputs.citygml_crs,
                              accept=cfg.checks.accept)
         say("  " + report.summary())
-        _stamp(stamp, city_fp)
+        _stamp(stamp, fps["city"])
     # the radiation before the timetable: its header's altitude is the ground where the
     # city model has none
-    # the checks' version: data ingested before gaps were listed, or before GHI was checked
-    # against DHI and the clear sky, is read again
-    cams_fp = _fingerprint(cams_files, {"checks": 4})
     stamp = data.radiation.stamp
-    if not _cached(stamp, cams_fp):
+    if not _cached(stamp, fps["radiation"]):
         say(f"ingesting {len(cams_files)} CAMS file(s)")
         from ..commands.ingest_cams import findings
 
         report = ingest_cams(cams_files, data_dir, accept=cfg.checks.accept)
         for line in findings(report):
             say("  " + line)
-        _stamp(stamp, cams_fp)
+        _stamp(stamp, fps["radiation"])
     else:
         _earlier(data.radiation.report, "gaps", say)
-    gtfs_fp = _fingerprint([gtfs], {"trajectory": cfg.trajectory.model_dump(mode="json"), "city": city_fp,
-                                    "radiation": cams_fp, "timezone": cfg.inputs.gtfs_timezone,
-                                    "route_types": cfg.run.route_types, "format": 3})
     stamp = data.gtfs.stamp
-    if not _cached(stamp, gtfs_fp):
+    if not _cached(stamp, fps["gtfs"]):
         from ..commands.ingest_gtfs import findings, summary_lines
 
         say(f"ingesting GTFS feed {gtfs}")
@@ -135,10 +174,10 @@ def ensure_ingested(cfg: Config, say=print) -> dict:
             say("  " + line)
         for line in findings(report):
             say("  " + line)
-        _stamp(stamp, gtfs_fp)
+        _stamp(stamp, fps["gtfs"])
     else:
         _earlier(data.gtfs.feed_json, "problems", say)
-    return {str(p): sha256(p) for p in [*city_files, gtfs, *cams_files]}
+    return inputs
 
 
 def _earlier(report_path: Path, what: str, say) -> None:

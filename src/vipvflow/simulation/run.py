@@ -1,6 +1,7 @@
 """Run a scenario-year on a Dask cluster: prepare, map over partitions, reduce, write."""
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import gc
 import importlib
@@ -15,8 +16,9 @@ from pathlib import Path
 import pandas as pd
 
 from ..config import Config
+from ..errors import InputError
 from ..progress import FolderProgress
-from ..store import DataDir
+from ..store import DataDir, FolderLock, data_dir_lock, folder_path, lock_for_writing, run_dir_lock
 from .cluster import close_client, local_cluster_size, make_client
 from .manifest import claim_run_dir, write_manifest
 from .network import selected_network
@@ -62,22 +64,45 @@ def run_simulation(cfg: Config, year: int, scheduler: str | None = None,
     naming both digests), or with *force* replaced as a whole (see :func:`claim_run_dir`).
     *max_partitions* stops after that many new partitions (for tests of resuming).
     """
-    from .prepare import check_year, ensure_demo, ensure_ingested, preflight
+    from .prepare import check_year
+
+    check_year(year)
+    if n_workers is not None and n_workers < 1:
+        raise InputError(f"--workers {n_workers}: a LocalCluster needs at least one worker")
+    folder_path(cfg.out_dir, "out_dir")
+    folder_path(cfg.data_dir, "data_dir")
+    with contextlib.ExitStack() as held:        # the locks of the run folder and the data dir
+        return _run(cfg, year, scheduler, n_workers, say, max_partitions, force, held)
+
+
+def _run(cfg: Config, year: int, scheduler, n_workers, say, max_partitions, force,
+         held: contextlib.ExitStack) -> Path:
+    """:func:`run_simulation` holding its locks in *held*."""
+    from .manifest import check_run_dir
+    from .prepare import ensure_demo, ensure_ingested, input_digests, preflight
     from .reduce import reduce_run
 
     t_start = time.perf_counter()
     timings: dict[str, float] = {}
-    check_year(year)
+    run_dir = run_dir_of(cfg, year)
     # the cluster starts (worker processes, their imports) while the inputs are checked
     # and the timeline is written; closed again if those stop the run
     starting = _Starting(cfg, scheduler, n_workers)
     timeline = None
     try:
         ensure_demo(cfg, year, say=say)
-        checksums = ensure_ingested(cfg, say=say)
+        inputs = input_digests(cfg)
+        # a folder of another run (configuration or input files) is refused before the data
+        # dir is ingested again for this one
+        check_run_dir(run_dir, cfg.digest(), inputs, force)
+        data_lock = held.enter_context(_lock_data_dir(cfg, inputs))
+        inputs = ensure_ingested(cfg, say=say, inputs=inputs)
         preflight(cfg, year, say=say)
-        run_dir = run_dir_of(cfg, year)
-        claim_run_dir(run_dir, cfg.digest(), force=force, say=say)
+        data_lock.take(shared=True)             # other runs may read the data dir with this one
+        # one run at a time in a run folder: a second one (another configuration with
+        # --force, say) is refused before it writes there
+        held.enter_context(lock_for_writing(run_dir_lock(run_dir), "run the command"))
+        claim_run_dir(run_dir, cfg.digest(), force=force, say=say, inputs=inputs)
         timings["prepare_s"] = time.perf_counter() - t_start
         ctx, tiles = _run_context(cfg, year, run_dir)
         routes = cfg.run.routes
@@ -167,7 +192,7 @@ def run_simulation(cfg: Config, year: int, scheduler: str | None = None,
         if froze:
             gc.unfreeze()
     timings["total_s"] = time.perf_counter() - t_start
-    write_manifest(cfg, year, run_dir, checksums, timings, results, builds)
+    write_manifest(cfg, year, run_dir, inputs, timings, results, builds)
     say(_summary_line(summary))
     say(f"outputs in {run_dir}")
     return run_dir
@@ -189,6 +214,29 @@ def _run_context(cfg: Config, year: int, run_dir: Path) -> tuple[RunContext, lis
         # the progress view's kWh per route, by the routes' public names
         route_of_trip=dict(zip(trips["trip_id"], trips["route_short_name"].astype(str))))
     return ctx, tiles
+
+
+def _lock_data_dir(cfg: Config, inputs) -> FolderLock:
+    """The data dir's lock, taken exclusively (this run may ingest into it), or shared when
+    another run reads it and these inputs need no ingest; else :class:`InputError` in one
+    line naming the folder and the process holding it."""
+    from .prepare import ingest_needed
+
+    lock = data_dir_lock(folder_path(cfg.data_dir, "data_dir"))
+    if lock.take():
+        return lock
+    if not lock.take(shared=True):
+        lock.release()
+        raise InputError(f"{cfg.data_dir}: another vipvflow process{lock.holder()} is ingesting "
+                         "into this data dir; wait for it to finish, then run the command again")
+    needed = ingest_needed(cfg, inputs)
+    if needed:
+        lock.release()
+        raise InputError(f"{cfg.data_dir}: another vipvflow run{lock.holder()} is reading this data "
+                         f"dir, and this scenario's inputs would replace its "
+                         f"{', '.join(n + '/' for n in needed)}: "
+                         "wait for that run to finish, or give this scenario a data_dir of its own")
+    return lock
 
 
 class _Background:
