@@ -168,6 +168,9 @@ class DaskCfg(_Model):
     worker_profile: bool = False
     # the LocalCluster's dashboard: this port when free, else (or null) any free one
     dashboard_port: int | None = Field(8787, ge=0, le=65535)
+    # the address the LocalCluster's scheduler, workers and dashboard listen on: this
+    # machine only by default; 0.0.0.0 (every interface) to reach them from elsewhere
+    host: str = "127.0.0.1"
 
 
 class RunCfg(_Model):

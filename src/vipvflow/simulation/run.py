@@ -19,7 +19,8 @@ from ..config import Config
 from ..errors import InputError
 from ..progress import FolderProgress
 from ..store import DataDir, FolderLock, data_dir_lock, folder_path, lock_for_writing, run_dir_lock
-from .cluster import close_client, local_cluster_size, make_client
+from .cluster import (bound_dashboard, check_scheduler, close_client, local_cluster_size,
+                      make_client)
 from .manifest import claim_run_dir, write_manifest
 from .network import selected_network
 from .partition import RunContext, partition_done, worker_bvh_builds
@@ -69,6 +70,8 @@ def run_simulation(cfg: Config, year: int, scheduler: str | None = None,
     check_year(year)
     if n_workers is not None and n_workers < 1:
         raise InputError(f"--workers {n_workers}: a LocalCluster needs at least one worker")
+    if scheduler or cfg.dask.scheduler:
+        check_scheduler(scheduler or cfg.dask.scheduler)
     folder_path(cfg.out_dir, "out_dir")
     folder_path(cfg.data_dir, "data_dir")
     with contextlib.ExitStack() as held:        # the locks of the run folder and the data dir
@@ -130,11 +133,13 @@ def _run(cfg: Config, year: int, scheduler, n_workers, say, max_partitions, forc
     froze = False
     try:
         n_workers_now = len(client.scheduler_info()["workers"])
+        if not n_workers_now:
+            n_workers_now = _wait_for_workers(client, scheduler or cfg.dask.scheduler)
         # a LocalCluster's workers share the machine's cores for ray casting
         ray_threads = cfg.dask.ray_threads or (
             max(1, (os.cpu_count() or 1) // max(1, n_workers_now)) if cluster is not None else 1)
         ctx = dataclasses.replace(ctx, ray_threads=ray_threads)
-        say(f"dask dashboard: {client.dashboard_link}" if importlib.util.find_spec("bokeh")
+        say(f"dask dashboard: {bound_dashboard(client, cluster)}" if importlib.util.find_spec("bokeh")
             else "dask dashboard: off (it needs bokeh: pip install 'vipvflow[app]')")
         warm.join()
         # what this process holds by now (the libraries, the inputs' tables) outlives the
@@ -214,6 +219,21 @@ def _run_context(cfg: Config, year: int, run_dir: Path) -> tuple[RunContext, lis
         # the progress view's kWh per route, by the routes' public names
         route_of_trip=dict(zip(trips["trip_id"], trips["route_short_name"].astype(str))))
     return ctx, tiles
+
+
+#: how long a run waits for the first worker of a scheduler that has none (s)
+WORKER_WAIT_S = 60.0
+
+
+def _wait_for_workers(client, address) -> int:
+    """The workers of a scheduler that had none, once one joined; :class:`InputError` when
+    none joins within :data:`WORKER_WAIT_S` (the run would wait for ever)."""
+    try:
+        client.wait_for_workers(1, timeout=WORKER_WAIT_S)
+    except (TimeoutError, OSError):
+        raise InputError(f"--scheduler {address}: the scheduler has no workers (none joined "
+                         f"within {WORKER_WAIT_S:g} s): start some (dask worker {address})") from None
+    return len(client.scheduler_info()["workers"])
 
 
 def _lock_data_dir(cfg: Config, inputs) -> FolderLock:
