@@ -50,7 +50,8 @@ def scenario_path(name: str | Path) -> Path:
 
 
 class _Model(BaseModel):
-    model_config = ConfigDict(extra="forbid", validate_assignment=True)
+    # no inf or nan: "kwp: .inf" passed validation and failed only after the map
+    model_config = ConfigDict(extra="forbid", validate_assignment=True, allow_inf_nan=False)
 
 
 class DemoSpec(_Model):
@@ -298,7 +299,7 @@ class Config(_Model):
         """The PV system chosen by ``pv.system``, with ``pv.overrides`` applied."""
         catalog = _read_yaml(CONF_DIR / "pv_systems.yaml")
         return _catalog_entry(catalog, self.pv.system, self.pv.overrides, PVSystem,
-                              CONF_DIR / "pv_systems.yaml", "pv.system")
+                              CONF_DIR / "pv_systems.yaml", "pv", self._source)
 
     def vehicle_params(self):
         """The vehicle chosen by ``vehicle.model`` (a :class:`vipvflow.models.vehicle.VehicleParams`)."""
@@ -306,7 +307,7 @@ class Config(_Model):
 
         catalog = _read_yaml(CONF_DIR / "vehicles.yaml")
         return _catalog_entry(catalog, self.vehicle.model, self.vehicle.overrides,
-                              VehicleParams, CONF_DIR / "vehicles.yaml", "vehicle.model")
+                              VehicleParams, CONF_DIR / "vehicles.yaml", "vehicle", self._source)
 
     def digest(self) -> str:
         """A stable hash of what decides a run's results (for run manifests and resuming):
@@ -377,16 +378,30 @@ def _format_errors(exc: ValidationError, files: list[tuple[Path, dict]], prefix:
     return "; ".join(lines)             # one line, however many keys are wrong
 
 
-def _catalog_entry(catalog: dict, name: str, overrides: dict, model, path: Path, key: str):
+def _catalog_entry(catalog: dict, name: str, overrides: dict, model, path: Path, section: str,
+                   source: str):
+    """Catalog entry *name* of *path* with *overrides* (``<section>.overrides`` of the
+    scenario file *source*) applied, validated; an error names the scenario file and its
+    key (``pv.overrides.kwp``) when the value came from there, else the catalog's."""
+    choice = "model" if section == "vehicle" else "system"
     if name not in catalog:
         known = ", ".join(sorted(catalog)) or "none"
-        raise ConfigError(f"{path}: {key} '{name}' is not in the catalog (known: {known})")
+        raise ConfigError(f"{source}: key '{section}.{choice}': '{name}' is not in the catalog "
+                          f"{path} (known: {known})")
     data = _merge(catalog[name], overrides or {})
     data.setdefault("name", name)
     try:
         return model.model_validate(data)
     except ValidationError as exc:
-        raise ConfigError(_format_errors(exc, [(path, catalog[name])], prefix=f"{name}.")) from None
+        files = [(path, catalog[name]), (Path(source), overrides or {})]
+        lines = []
+        for err in exc.errors():
+            loc = tuple(err["loc"])
+            mine = _has_path(overrides or {}, loc)
+            key = f"{section}.overrides." if mine else f"{name}."
+            msg = "unknown key" if err["type"] == "extra_forbidden" else err["msg"]
+            lines.append(f"{files[1][0] if mine else path}: key '{key}{'.'.join(map(str, loc))}': {msg}")
+        raise ConfigError("; ".join(lines)) from None
 
 
 def load_config(path: str | Path | None = None, overrides: dict | None = None) -> Config:
