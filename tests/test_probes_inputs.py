@@ -9,7 +9,6 @@ place than the city model's CRS, a radiation file located elsewhere (2), GHI and
 """
 from __future__ import annotations
 
-import json
 import zipfile
 from pathlib import Path
 
@@ -18,7 +17,8 @@ import pytest
 import yaml
 
 from gtfs_probe_feeds import vbb_like_tables, write_feed
-from test_feed_probes import CAMS_1MIN, GROUND_M, one_line_error, repaired, vipvflow
+from test_feed_probes import (CAMS_1MIN, GROUND_M, ingested, one_line_error,  # noqa: F401
+                              repaired, vipvflow, _variant)
 
 pytestmark = pytest.mark.filterwarnings("ignore::pandas.errors.PerformanceWarning")
 
@@ -110,16 +110,16 @@ def test_timetable_shifted_by_two_days_is_refused(tmp_path):
     assert not (tmp_path / "data" / "gtfs" / "feed.json").exists()
 
 
-def test_huge_stop_time_never_reaches_the_preflight(ingested_small, tmp_path):
+def test_huge_stop_time_never_reaches_the_preflight(ingested, tmp_path):
     """The small demo's feed with one stop time at 999999999:00:00, through the run's own
     ingest and preflight (where the old code asked numpy for 89 GiB): the trip is dropped."""
     from vipvflow.config import load_config
     from vipvflow.simulation.prepare import ensure_ingested, preflight
 
-    feed = _demo_feed_with(ingested_small, tmp_path, "stop_times.txt",
+    feed = _demo_feed_with(ingested, tmp_path, "stop_times.txt",
                            lambda text: text.replace("05:01:00,05:01:20", "999999999:00:00,"
                                                      "999999999:00:00", 1))
-    cfg = load_config(_scenario(ingested_small, tmp_path, gtfs=feed))
+    cfg = load_config(_variant(ingested, tmp_path, inputs={"gtfs": str(feed)}))
     said = []
     ensure_ingested(cfg, say=said.append)
     assert any("1 of 292 trips have stop times beyond a service day" in s for s in said), said
@@ -302,38 +302,6 @@ def test_ghi_and_dhi_swapped_are_refused(demo_small, tmp_path):
 
 
 # ------------------------------------------------------------------------------ runs
-@pytest.fixture(scope="module")
-def ingested_small(tmp_path_factory, demo_small):
-    """The small demo (2024) ingested into a data dir of its own; a June scenario without
-    demo generation (variants copy the data dir: only a changed input is ingested again)."""
-    from conftest import write_small_config
-    from vipvflow.config import load_config
-    from vipvflow.simulation.prepare import ensure_ingested
-
-    root = tmp_path_factory.mktemp("probes37")
-    path = write_small_config(root, demo_small, months=(6,), name="probe")
-    conf = yaml.safe_load(path.read_text())
-    conf["demo"]["enabled"] = False
-    path.write_text(yaml.safe_dump(conf))
-    ensure_ingested(load_config(path), say=lambda *a: None)
-    return root, conf
-
-
-def _scenario(ingested, tmp_path: Path, **inputs) -> Path:
-    import shutil
-
-    root, conf = ingested
-    conf = json.loads(json.dumps(conf))
-    if not (tmp_path / "data").exists():
-        shutil.copytree(root / "data", tmp_path / "data")
-    conf["data_dir"], conf["out_dir"] = str(tmp_path / "data"), str(tmp_path / "out")
-    for key, value in inputs.items():
-        conf["inputs"][key] = [str(value)] if key in ("cams", "citygml") else str(value)
-    path = tmp_path / "scenario.yaml"
-    path.write_text(yaml.safe_dump(conf))
-    return path
-
-
 def _demo_feed_with(ingested, tmp_path: Path, member: str, fn) -> Path:
     """The small demo's GTFS zip with *member* rewritten by *fn*."""
     _, conf = ingested
@@ -359,7 +327,7 @@ def _relocated_cams(ingested, dest: Path, lat: float, lon: float) -> Path:
     return dest
 
 
-def test_radiation_of_another_place_stops_before_the_cluster(ingested_small, tmp_path):
+def test_radiation_of_another_place_stops_before_the_cluster(ingested, tmp_path):
     """Issue item 2: a CAMS header located in Sydney for the Luxembourg-like city (116
     instead of 314 kWh/kWp before): one line naming the file, its location and the
     distance, before any cluster; accepted with --accept radiation_far (the preflight then
@@ -367,8 +335,8 @@ def test_radiation_of_another_place_stops_before_the_cluster(ingested_small, tmp
     from vipvflow.config import load_config
     from vipvflow.simulation.prepare import ensure_ingested, preflight
 
-    cams = _relocated_cams(ingested_small, tmp_path / "cams_sydney.csv", -33.8688, 151.2093)
-    path = _scenario(ingested_small, tmp_path, cams=cams)
+    cams = _relocated_cams(ingested, tmp_path / "cams_sydney.csv", -33.8688, 151.2093)
+    path = _variant(ingested, tmp_path, cams=cams)
     res = vipvflow("simulate", "--config", path, "--year", "2024", "--quiet")
     err = one_line_error(res, str(cams), "the radiation's location -33.8688, 151.2093 lies",
                          "km from the city model (49.", "more than 50 km", "--accept radiation_far")
@@ -379,8 +347,9 @@ def test_radiation_of_another_place_stops_before_the_cluster(ingested_small, tmp
     ensure_ingested(cfg, say=lambda *a: None)
     assert preflight(cfg, 2024, say=lambda *a: None)["service_days"] == 30
     # a location 20 km away passes
-    near = _relocated_cams(ingested_small, tmp_path / "cams_near.csv", 49.61 + 0.18, 6.13)
-    cfg = load_config(_scenario(ingested_small, tmp_path, cams=near))
+    near = _relocated_cams(ingested, tmp_path / "cams_near.csv", 49.61 + 0.18, 6.13)
+    (tmp_path / "near").mkdir()
+    cfg = load_config(_variant(ingested, tmp_path / "near", cams=near))
     ensure_ingested(cfg, say=lambda *a: None)
     preflight(cfg, 2024, say=lambda *a: None)
 
