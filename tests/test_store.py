@@ -26,7 +26,7 @@ def _named_by_store(data_dir, run_dir) -> set:
     tiles |= set(pd.read_parquet(data.gtfs.segments, columns=["tile"])["tile"].astype(str))
     city, gtfs, rad = data.city, data.gtfs, data.radiation
     names = {city.tiles_json, city.report, city.stamp, city.terrain, city.coverage,
-             gtfs.feed_json, gtfs.stamp, rad.table, rad.report, rad.stamp, data.lock,
+             gtfs.feed_json, gtfs.stamp, rad.table, rad.report, rad.stamp,
              run.manifest, run.config_stamp, run.inputs_stamp, run.report,
              run.output("summary.json")}
     names |= {city.mesh(t) for t in tiles} | {city.surface_part(t) for t in tiles}

@@ -134,7 +134,6 @@ class DataDir:
     city = _Entry("city", kind=CityDir)
     gtfs = _Entry("gtfs", kind=GtfsDir)
     radiation = _Entry("radiation", kind=RadiationDir)
-    lock = _Entry(".lock", "The lock file of the data dir (:func:`data_dir_lock`).")
 
     def tile_size_m(self) -> float:
         """The tile edge (m) of this data dir's grid: ``tile_size_m`` of ``gtfs/feed.json``
@@ -601,9 +600,15 @@ def run_dir_lock(run_dir: str | Path) -> FolderLock:
 
 
 def data_dir_lock(data_dir: str | Path) -> FolderLock:
-    """The lock of a data dir: ``.lock`` in it; ingests hold it exclusively, runs shared
-    while they read the data dir."""
-    return FolderLock(DataDir(data_dir).lock, data_dir)
+    """The lock of a data dir: ``.<name>.lock`` beside it (the data dir holds only what the
+    ingests write), or ``.lock`` in it where its parent folder is not writable; ingests hold
+    it exclusively, runs shared while they read the data dir."""
+    data_dir = Path(data_dir)
+    parent = data_dir.absolute().parent
+    beside = parent / f".{data_dir.absolute().name}.lock"
+    if beside.exists() or (parent.is_dir() and os.access(parent, os.W_OK)) or not parent.exists():
+        return FolderLock(beside, data_dir)
+    return FolderLock(data_dir / ".lock", data_dir)
 
 
 def lock_for_writing(lock: FolderLock, doing: str) -> FolderLock:

@@ -61,8 +61,10 @@ def run_simulation(cfg: Config, year: int, scheduler: str | None = None,
     """Compute the scenario's fleet-year and write all outputs; returns the run directory.
 
     An interrupted run resumes: finished partitions (written atomically) are not recomputed.
-    A run directory holding a run of another configuration is refused (:class:`InputError`
-    naming both digests), or with *force* replaced as a whole (see :func:`claim_run_dir`).
+    A run directory holding a run of another configuration or of other input files is
+    refused (:class:`InputError` naming both digests), or with *force* replaced as a whole
+    (see :func:`claim_run_dir`). A run folder another process runs in, or a data dir another
+    run reads while this one would ingest into it, is refused (docs/run_folders.md).
     *max_partitions* stops after that many new partitions (for tests of resuming).
     """
     from .prepare import check_year
