@@ -173,6 +173,17 @@ def test_calendar_with_start_after_end(tmp_path):
     feed = write_feed(tmp_path / "g.zip", {**t, "calendar.txt": two})
     repaired(_ingest_gtfs(feed, tmp_path), "calendar.txt: 1 of 2 services have a start_date after "
              "their end_date (first: service WD at line 2, 20241231 > 20240101), so no dates; dropped")
+    # left with two dates of calendar_dates.txt: the run's refusal says so
+    from vipvflow.errors import InputError
+    from vipvflow.simulation.prepare import _run_service_dates
+
+    dates = "service_id,date,exception_type\nWD,20240304,1\nWD,20241104,1\n"
+    feed = write_feed(tmp_path / "h.zip", {**t, "calendar.txt": swapped, "calendar_dates.txt": dates})
+    repaired(_ingest_gtfs(feed, tmp_path), "calendar.txt: 1 of 1 services")
+    trips = pd.read_parquet(tmp_path / "data" / "gtfs" / "trips.parquet")
+    with pytest.raises(InputError, match=r"no service in 2024 \(months \[6\]\); it runs from "
+                                        r"2024-03-04 to 2024-11-04, on 2 dates in 2024"):
+        _run_service_dates(tmp_path / "data", trips, 2024, {6})
 
 
 def test_stops_outside_the_area_of_the_crs(tmp_path):

@@ -289,13 +289,17 @@ def _run_service_dates(data_dir: Path, trips, year: int, months: set):
     from ..inputs.gtfs.schedule import service_dates
 
     gdir = DataDir(data_dir).gtfs.root
-    sd = service_dates(data_dir, year)
-    sd = sd[sd["date"].dt.month.isin(months) & sd["service_id"].isin(set(trips["service_id"]))]
+    year_sd = service_dates(data_dir, year)
+    year_sd = year_sd[year_sd["service_id"].isin(set(trips["service_id"]))]
+    sd = year_sd[year_sd["date"].dt.month.isin(months)]
     if sd.empty:
         lo, hi = _calendar_range(gdir)
         which = "" if len(months) == 12 else f" (months {sorted(months)})"
+        # a calendar of a few dates (its services dropped at ingest, say) is said so
+        n = year_sd["date"].nunique()
+        few = f", on {n} dates in {year}" if n else ""
         raise InputError(f"{gdir / 'calendar.parquet'}: the GTFS calendar has no service in "
-                         f"{year}{which}; it runs from {lo} to {hi}")
+                         f"{year}{which}; it runs from {lo} to {hi}{few}")
     return sd
 
 
