@@ -145,17 +145,20 @@ def test_ingest_reports_bytes_read(demo_small, tmp_path, capsys):
 
 
 def test_dashboard_on_8787_when_free_else_any_port():
+    """The dashboard's address: on 127.0.0.1 (dask.host) only, the configured port when it is
+    free there, else any."""
     from vipvflow.simulation.cluster import dashboard_address
 
     with socket.socket() as s:
-        s.bind(("", 0))
+        s.bind(("127.0.0.1", 0))
         taken = s.getsockname()[1]
-        assert dashboard_address(taken) == ":0"
-    assert dashboard_address(None) == ":0"
+        assert dashboard_address(taken) == "127.0.0.1:0"
+    assert dashboard_address(None) == "127.0.0.1:0"
     with socket.socket() as s:
-        s.bind(("", 0))
+        s.bind(("127.0.0.1", 0))
         free = s.getsockname()[1]
-    assert dashboard_address(free) == f":{free}"
+    assert dashboard_address(free) == f"127.0.0.1:{free}"
+    assert dashboard_address(free, "0.0.0.0") == f"0.0.0.0:{free}"
 
 
 def test_simulate_into_a_log_reads_line_by_line(small_config, tmp_path):

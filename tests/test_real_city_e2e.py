@@ -10,8 +10,8 @@ simulated for June 2019 with the default whole-day harvest, under a CAMS-format 
 file of Berlin's coordinates written by the demo's generator (no CAMS file of Berlin can be
 shipped).
 
-Then a feed and a city model of different places (Cairns, Hamburg): one clear line, no
-traceback.
+Then a feed and a city model of different places (Cairns, Hamburg): one clear line naming
+the stops outside the city model's CRS, no traceback.
 """
 from __future__ import annotations
 
@@ -162,8 +162,9 @@ def test_berlin_ingest_alone_by_the_docs(shared_data, tmp_path):
 
 
 def test_lines_that_miss_the_city_model(shared_data, tmp_path):
-    """Cairns' feed with Hamburg's tile: no overlap at all: one line saying the routes miss
-    the city model, before any cluster starts; never a traceback."""
+    """Cairns' feed with Hamburg's tile: no overlap at all: one line saying that the feed's
+    stops lie outside the area of use of the city model's CRS (EPSG:25832, where the GTFS
+    ingest would project them), before any cluster starts; never a traceback."""
     from vipvflow.demo.cams import write_cams_csv
 
     cams = tmp_path / "cams_cairns.csv"
@@ -178,5 +179,7 @@ def test_lines_that_miss_the_city_model(shared_data, tmp_path):
     res = _cli("simulate", "--config", path, "--year", 2014, "--quiet", cwd=tmp_path)
     err = res.stderr.strip()
     assert res.returncode == 2 and "Traceback" not in res.stderr + res.stdout, res.stderr[-3000:]
-    assert len(err.splitlines()) == 1 and "the routes miss the city model" in err, err
+    assert len(err.splitlines()) == 1, err
+    assert "cairns_gtfs.zip" in err and "lie outside the area of use of EPSG:25832" in err, err
+    assert "(the city model's CRS, city/tiles.json)" in err and "around -16.9" in err, err
     assert "dask dashboard" not in res.stdout

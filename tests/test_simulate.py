@@ -519,7 +519,8 @@ def test_a_dashboard_port_taken_meanwhile_is_not_warned_about(small_config, tmp_
         taken.bind(("", 0))
         taken.listen()
         port = taken.getsockname()[1]
-        monkeypatch.setattr(cluster_mod, "dashboard_address", lambda _port: f":{port}")
+        monkeypatch.setattr(cluster_mod, "dashboard_address",
+                            lambda _port, host="127.0.0.1": f"{host}:{port}")
         with warnings.catch_warnings(record=True) as seen:
             warnings.simplefilter("always")
             client, cluster = cluster_mod.make_client(_cfg(small_config, tmp_path), None, 1)

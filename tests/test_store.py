@@ -26,8 +26,9 @@ def _named_by_store(data_dir, run_dir) -> set:
     tiles = set(json.loads(data.city.tiles_json.read_text())["tiles"])
     tiles |= set(pd.read_parquet(data.gtfs.segments, columns=["tile"])["tile"].astype(str))
     city, gtfs, rad = data.city, data.gtfs, data.radiation
-    names = {city.tiles_json, city.report, city.stamp, city.terrain, city.coverage, gtfs.feed_json, gtfs.stamp,
-             rad.table, rad.report, rad.stamp, run.manifest, run.config_stamp, run.report,
+    names = {city.tiles_json, city.report, city.stamp, city.terrain, city.coverage,
+             gtfs.feed_json, gtfs.stamp, rad.table, rad.report, rad.stamp,
+             run.manifest, run.config_stamp, run.inputs_stamp, run.report,
              run.output("summary.json"), run.output("city.glb")}
     names |= {city.mesh(t) for t in tiles} | {city.surface_part(t) for t in tiles}
     names |= {gtfs.table(n) for n in GTFS_TABLES}
@@ -63,6 +64,15 @@ def test_every_file_of_a_run_is_one_the_store_names(small_run):
     assert computed, "no partitions"
     for tile in computed:
         assert run.tile_part("geometry", tile).is_file() and run.tile_part("horizon", tile).is_file()
+
+
+def test_every_entry_of_a_run_folder_is_one_a_run_writes(small_run):
+    """``simulate --force`` replaces a folder holding only what a run writes: a finished run
+    holds nothing else (an output added without its name in the data dictionary fails here)."""
+    entries = sorted(p.name for p in small_run.iterdir())
+    assert "manifest.json" in entries and "parts" in entries
+    assert [e for e in entries if not RunDir.written_by_run(e)] == []
+    assert not RunDir.written_by_run("notes.txt") and not RunDir.written_by_run("my.parquet")
 
 
 def test_partitions_hold_the_key_columns_the_store_declares(small_run):

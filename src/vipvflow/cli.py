@@ -93,7 +93,7 @@ def main(argv: list[str] | None = None) -> int:
               f"pip install 'vipvflow[{extra}]'", file=sys.stderr)
         return 2
     except OSError as exc:
-        if exc.errno not in DISK_ERRORS:
+        if exc.errno not in DISK_ERRORS | PATH_ERRORS:
             raise
         print(f"vipvflow {args.command}: error: {disk_error_line(exc)}", file=sys.stderr)
         return 2
@@ -108,10 +108,19 @@ def main(argv: list[str] | None = None) -> int:
 DISK_ERRORS = {errno.EACCES, errno.EPERM, errno.EROFS, errno.ENOSPC, errno.EDQUOT, errno.EFBIG}
 
 
+#: errors of a path naming a file where a folder is expected, or the other way round (an
+#: output option given an existing file): the commands check their own options first, this
+#: catches the rest
+PATH_ERRORS = {errno.EEXIST, errno.ENOTDIR, errno.EISDIR}
+
+
 def disk_error_line(exc: OSError) -> str:
-    """``<file>: <reason> (<what to do>)`` of an OSError of :data:`DISK_ERRORS`."""
+    """``<file>: <reason> (<what to do>)`` of an OSError of :data:`DISK_ERRORS` or
+    :data:`PATH_ERRORS`."""
     where = f"{exc.filename}: " if exc.filename else ""
     reason = " ".join(str(exc.strerror or os.strerror(exc.errno)).split())
+    if exc.errno in PATH_ERRORS:
+        return f"{where}{reason} (a file where a folder is expected, or a folder where a file is)"
     if exc.errno in (errno.ENOSPC, errno.EDQUOT, errno.EFBIG):
         hint = "free space or choose another out_dir / data_dir; the same command then resumes"
     else:

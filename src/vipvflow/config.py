@@ -14,6 +14,7 @@ import copy
 import hashlib
 import json
 import os
+import re
 from importlib.util import find_spec
 from pathlib import Path
 from typing import Any, Literal
@@ -65,7 +66,8 @@ def scenario_path(name: str | Path) -> Path:
 
 
 class _Model(BaseModel):
-    model_config = ConfigDict(extra="forbid", validate_assignment=True)
+    # no inf or nan: "kwp: .inf" passed validation and failed only after the map
+    model_config = ConfigDict(extra="forbid", validate_assignment=True, allow_inf_nan=False)
 
 
 class DemoSpec(_Model):
@@ -182,6 +184,9 @@ class DaskCfg(_Model):
     worker_profile: bool = False
     # the LocalCluster's dashboard: this port when free, else (or null) any free one
     dashboard_port: int | None = Field(8787, ge=0, le=65535)
+    # the address the LocalCluster's scheduler, workers and dashboard listen on: this
+    # machine only by default; 0.0.0.0 (every interface) to reach them from elsewhere
+    host: str = "127.0.0.1"
 
 
 class RunCfg(_Model):
@@ -292,6 +297,31 @@ class DbCfg(_Model):
     dsn: str | None = None
 
 
+#: how far (km) a radiation location may lie from the city model (without one: from the
+#: routes) before a run is refused (``radiation_far``): CAMS series are point values of a
+#: 3-5 km satellite pixel; 50 km keeps a city's own weather, not another region's
+RADIATION_MAX_KM = 50.0
+
+#: the plausibility findings a run or an ingest refuses, each in one line naming it, unless
+#: it is listed in ``checks.accept`` (or given with ``--accept``): docs/checks.md
+PLAUSIBILITY_FINDINGS = {
+    "radiation_far": f"a radiation location more than {RADIATION_MAX_KM:g} km from the city "
+                     "model (without one: from the routes)",
+    "radiation_components": "GHI below DHI, or above the clear-sky GHI by more than the margin, "
+                            "for more than a few minutes (columns swapped or in other units)",
+    "crs_area": "the city model or the feed's stops outside the area of use of the CRS they "
+                "are put in",
+}
+
+
+class ChecksCfg(_Model):
+    """Plausibility checks of the inputs before a run (docs/checks.md)."""
+
+    # findings accepted for the rare real case: each refusal names its finding
+    accept: list[Literal["radiation_far", "radiation_components", "crs_area"]] = Field(
+        default_factory=list)
+
+
 class Config(_Model):
     scenario: str = "default"
     data_dir: Path = Path("data/default")
@@ -309,17 +339,27 @@ class Config(_Model):
     radiation: RadiationCfg = Field(default_factory=RadiationCfg)
     fleet: FleetCfg = Field(default_factory=FleetCfg)
     charging: ChargingCfg = Field(default_factory=ChargingCfg)
+    checks: ChecksCfg = Field(default_factory=ChecksCfg)
     dask: DaskCfg = Field(default_factory=DaskCfg)
     db: DbCfg = Field(default_factory=DbCfg)
 
     # where the values came from, for error messages and the run manifest
     _source: str = "<defaults>"
 
+    @field_validator("scenario")
+    @classmethod
+    def _scenario_name(cls, v: str) -> str:
+        # the run folder is <out_dir>/<scenario>/<year>: a name, never a path out of out_dir
+        if not re.fullmatch(r"[A-Za-z0-9][A-Za-z0-9._-]*", v or "") or v in (".", ".."):
+            raise ValueError(f"{v!r} is not a scenario name (letters, digits, '.', '_', '-'; no "
+                             "'/' or '..'): it names the run folder <out_dir>/<scenario>/<year>")
+        return v
+
     def pv_system(self) -> PVSystem:
         """The PV system chosen by ``pv.system``, with ``pv.overrides`` applied."""
         catalog = _read_yaml(CONF_DIR / "pv_systems.yaml")
         return _catalog_entry(catalog, self.pv.system, self.pv.overrides, PVSystem,
-                              CONF_DIR / "pv_systems.yaml", "pv.system")
+                              CONF_DIR / "pv_systems.yaml", "pv", self._source)
 
     def vehicle_params(self):
         """The vehicle chosen by ``vehicle.model`` (a :class:`vipvflow.models.vehicle.VehicleParams`)."""
@@ -327,7 +367,7 @@ class Config(_Model):
 
         catalog = _read_yaml(CONF_DIR / "vehicles.yaml")
         return _catalog_entry(catalog, self.vehicle.model, self.vehicle.overrides,
-                              VehicleParams, CONF_DIR / "vehicles.yaml", "vehicle.model")
+                              VehicleParams, CONF_DIR / "vehicles.yaml", "vehicle", self._source)
 
     def monthly_temperature_c(self) -> list[float]:
         """The run's monthly mean air temperature (deg C, Jan..Dec): the scenario's
@@ -368,8 +408,10 @@ class Config(_Model):
     def digest(self) -> str:
         """A stable hash of what decides a run's results (for run manifests and resuming):
         the validated configuration without where it runs (``dask``), where it writes
-        (``out_dir``) and where it mirrors (``db``)."""
-        text = json.dumps(self.model_dump(mode="json", exclude={"dask", "db", "out_dir"}), sort_keys=True)
+        (``out_dir``), where it mirrors (``db``) and which plausibility findings it accepts
+        (``checks``: they change no number)."""
+        text = json.dumps(self.model_dump(mode="json", exclude={"dask", "db", "out_dir", "checks"}),
+                          sort_keys=True)
         return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 
@@ -435,16 +477,30 @@ def _format_errors(exc: ValidationError, files: list[tuple[Path, dict]], prefix:
     return "; ".join(lines)             # one line, however many keys are wrong
 
 
-def _catalog_entry(catalog: dict, name: str, overrides: dict, model, path: Path, key: str):
+def _catalog_entry(catalog: dict, name: str, overrides: dict, model, path: Path, section: str,
+                   source: str):
+    """Catalog entry *name* of *path* with *overrides* (``<section>.overrides`` of the
+    scenario file *source*) applied, validated; an error names the scenario file and its
+    key (``pv.overrides.kwp``) when the value came from there, else the catalog's."""
+    choice = "model" if section == "vehicle" else "system"
     if name not in catalog:
         known = ", ".join(sorted(catalog)) or "none"
-        raise ConfigError(f"{path}: {key} '{name}' is not in the catalog (known: {known})")
+        raise ConfigError(f"{source}: key '{section}.{choice}': '{name}' is not in the catalog "
+                          f"{path} (known: {known})")
     data = _merge(catalog[name], overrides or {})
     data.setdefault("name", name)
     try:
         return model.model_validate(data)
     except ValidationError as exc:
-        raise ConfigError(_format_errors(exc, [(path, catalog[name])], prefix=f"{name}.")) from None
+        files = [(path, catalog[name]), (Path(source), overrides or {})]
+        lines = []
+        for err in exc.errors():
+            loc = tuple(err["loc"])
+            mine = _has_path(overrides or {}, loc)
+            key = f"{section}.overrides." if mine else f"{name}."
+            msg = "unknown key" if err["type"] == "extra_forbidden" else err["msg"]
+            lines.append(f"{files[1][0] if mine else path}: key '{key}{'.'.join(map(str, loc))}': {msg}")
+        raise ConfigError("; ".join(lines)) from None
 
 
 def load_config(path: str | Path | None = None, overrides: dict | None = None) -> Config:

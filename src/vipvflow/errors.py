@@ -11,3 +11,8 @@ class ConfigError(VipvError):
 
 class InputError(VipvError):
     """An input data file is unreadable or wrong; the message names file and place."""
+
+
+def accept_hint(finding: str) -> str:
+    """How a user accepts a plausibility *finding* that is right after all (docs/checks.md)."""
+    return f"(if it is right after all: --accept {finding}, or checks.accept: [{finding}])"

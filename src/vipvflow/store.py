@@ -217,6 +217,8 @@ class RunDir:
     manifest = _Entry("manifest.json")
     config_stamp = _Entry("config_digest.txt", 'Digest of the configuration the partitions under '
                           '``parts/`` were computed with.', within="parts")
+    inputs_stamp = _Entry("inputs.json", "Content digests (SHA-256) of the input files the "
+                          "partitions under ``parts/`` were computed from.", within="parts")
 
     @property
     def timeline(self) -> Path:
@@ -268,6 +270,21 @@ class RunDir:
     def output(self, name: str) -> Path:
         """An output of the reduce beside ``parts/``: ``summary.json``, ``trip_energy.parquet``..."""
         return self.root / name
+
+    @staticmethod
+    def written_by_run(name: str) -> bool:
+        """Whether an entry *name* of a run folder's top level is one a run writes: ``parts/``,
+        ``figures/``, ``vecto/``, ``manifest.json``, ``summary.json``, ``report.html``, the
+        outputs of the data dictionary (``<name>.parquet``) and the atomic writers'
+        temporary files (``.<name>.<pid>.tmp``). ``simulate --force`` replaces only a folder
+        holding nothing else."""
+        from .simulation.dictionary import OUTPUTS
+
+        if name in ("parts", "figures", "vecto", "manifest.json", "summary.json", "report.html"):
+            return True
+        if name.endswith(".parquet") and name[:-len(".parquet")] in OUTPUTS:
+            return True
+        return name.startswith(".") and ".tmp" in name
 
 
 # --------------------------------------------------------------------------- atomic writes
@@ -534,6 +551,110 @@ def pid_alive(pid: int) -> bool:
     except PermissionError:
         return True
     return True
+
+
+class FolderLock:
+    """An advisory lock (``flock``) on the file *path*, guarding *folder* against a second
+    vipvflow process: exclusive for whoever writes, shared for readers that need it to stay
+    as it is. Taken without waiting (:meth:`take` says whether it was); released by
+    :meth:`release`, or by the operating system when the process ends, however it ends. The
+    exclusive holder writes its process id into the file, for the refusal of another."""
+
+    def __init__(self, path: str | Path, folder: str | Path):
+        self.path, self.folder = Path(path), Path(folder)
+        self._fh = None
+
+    def take(self, shared: bool = False) -> bool:
+        """Take the lock (shared or exclusive; an exclusive one held is converted); False
+        when another process holds it in a way that excludes this."""
+        try:
+            import fcntl
+        except ImportError:             # not POSIX: no locking
+            return True
+        if self._fh is None:
+            self.path.parent.mkdir(parents=True, exist_ok=True)
+            self._fh = open(self.path, "a+", encoding="utf-8")
+        try:
+            fcntl.flock(self._fh, (fcntl.LOCK_SH if shared else fcntl.LOCK_EX) | fcntl.LOCK_NB)
+        except BlockingIOError:
+            return False
+        if not shared:
+            self._fh.seek(0)
+            self._fh.truncate()
+            self._fh.write(f"{os.getpid()}\n")
+            self._fh.flush()
+        return True
+
+    def holder(self) -> str:
+        """`` (pid N)`` of the process that last took the lock exclusively, when it runs."""
+        try:
+            pid = int(self.path.read_text().split()[0])
+        except (OSError, ValueError, IndexError):
+            return ""
+        return f" (pid {pid})" if pid != os.getpid() and pid_alive(pid) else ""
+
+    def release(self) -> None:
+        if self._fh is not None:
+            self._fh.close()            # closing the file releases the lock
+            self._fh = None
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.release()
+
+
+def run_dir_lock(run_dir: str | Path) -> FolderLock:
+    """The lock of a run folder: ``.<year>.lock`` beside it (it outlives the folder's
+    replacement by ``--force``)."""
+    run_dir = Path(run_dir)
+    return FolderLock(run_dir.parent / f".{run_dir.name}.lock", run_dir)
+
+
+def data_dir_lock(data_dir: str | Path) -> FolderLock:
+    """The lock of a data dir: ``.<name>.lock`` beside it (the data dir holds only what the
+    ingests write), or ``.lock`` in it where its parent folder is not writable; ingests hold
+    it exclusively, runs shared while they read the data dir."""
+    data_dir = Path(data_dir)
+    parent = data_dir.absolute().parent
+    beside = parent / f".{data_dir.absolute().name}.lock"
+    if beside.exists() or (parent.is_dir() and os.access(parent, os.W_OK)) or not parent.exists():
+        return FolderLock(beside, data_dir)
+    return FolderLock(data_dir / ".lock", data_dir)
+
+
+def lock_for_writing(lock: FolderLock, doing: str) -> FolderLock:
+    """*lock* taken exclusively, or :class:`InputError` in one line naming the folder and
+    the process holding it."""
+    if not lock.take():
+        raise InputError(f"{lock.folder}: another vipvflow process{lock.holder()} is using this "
+                         f"folder; wait for it to finish, then {doing} again")
+    return lock
+
+
+def file_path(path: str | Path, what: str, example: str) -> Path:
+    """*path* as a file to write: :class:`InputError` naming it when it is a folder (the
+    file *example* in it is suggested), or a folder above it exists as a file."""
+    path = Path(path)
+    if path.is_dir():
+        raise InputError(f"{path}: {what} names a folder; give the file to write, e.g. "
+                         f"{path / example}")
+    folder_path(path.parent, f"the folder of {what}")
+    return path
+
+
+def folder_path(path: str | Path, what: str) -> Path:
+    """*path* as a folder to write into: :class:`InputError` naming it when it, or a folder
+    above it, exists as something else than a folder (a file named as ``--out``)."""
+    path = Path(path)
+    for p in (path, *path.parents):
+        if p.exists() or p.is_symlink():
+            if not p.is_dir():
+                where = "" if p == path else f" (in {path})"
+                raise InputError(f"{p}: {what} must be a folder, and this is a file{where}")
+            break
+    return path
 
 
 def sha256(path: str | Path) -> str:

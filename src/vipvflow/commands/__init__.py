@@ -49,3 +49,28 @@ def port_number(suggest: int, allow_zero: bool = False):
 
     parse.__name__ = "port"
     return parse
+
+
+def add_accept(parser) -> None:
+    """Add ``--accept FINDING`` (repeatable) to *parser*: a plausibility finding to accept for
+    the rare real case, added to ``checks.accept`` of the scenario (docs/checks.md)."""
+    from ..config import PLAUSIBILITY_FINDINGS
+
+    parser.add_argument("--accept", action="append", default=[], metavar="FINDING",
+                        choices=sorted(PLAUSIBILITY_FINDINGS),
+                        help="accept a plausibility finding the inputs are refused for, when it is "
+                        "right after all (also checks.accept): " + "; ".join(
+                            f"{k}: {v}" for k, v in PLAUSIBILITY_FINDINGS.items()))
+
+
+def accepted(cfg, args) -> tuple[str, ...]:
+    """The plausibility findings accepted: ``checks.accept`` of *cfg* and ``--accept``."""
+    return tuple(sorted({*cfg.checks.accept, *(getattr(args, "accept", None) or [])}))
+
+
+def ingest_lock(data_dir):
+    """The data dir's lock taken for an ingest (exclusively), as a context manager; a data
+    dir that is a file, or that another vipvflow process uses, is refused in one line."""
+    from ..store import data_dir_lock, folder_path, lock_for_writing
+
+    return lock_for_writing(data_dir_lock(folder_path(data_dir, "--data-dir")), "ingest")

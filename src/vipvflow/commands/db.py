@@ -44,7 +44,9 @@ def _say(msg):
 
 def run_start(args):
     from ..db import server
+    from ..store import folder_path
 
+    folder_path(args.dir, "--dir")
     srv = server.start(args.dir, port=args.port, say=_say, citus_workers=args.citus_workers)
     print(srv.dsn)  # stdout holds only the DSN: DSN=$(vipvflow db start --dir data/pg)
     return 0

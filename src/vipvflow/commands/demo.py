@@ -27,8 +27,10 @@ def run(args):
     set_quiet(args.quiet)
     from ..demo import generate_demo
     from ..simulation.prepare import check_year, mark_demo
+    from ..store import folder_path
 
     check_year(args.year)
+    folder_path(args.out, "--out")
     res = generate_demo(args.out, year=args.year, seed=args.seed, size=args.size)
     mark_demo(args.out, args.year, args.seed, args.size)
     c = res["counts"]

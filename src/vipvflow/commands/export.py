@@ -67,8 +67,10 @@ def run_gltf(args):
 def run(args):
     from ..outputs import write_dynamizers
     from ..simulation.rundir import open_run
+    from ..store import file_path
 
     open_run(args.run_dir)      # the run and its data dir, or one line saying what is missing
+    file_path(args.out, "--out", "twin.gml")
     res = write_dynamizers(args.run_dir, args.out, encoding=args.encoding, embed=args.embed,
                            max_segments=args.segments, aggregate=args.aggregate, routes=args.routes,
                            months=args.months, reflectors=args.reflectors)

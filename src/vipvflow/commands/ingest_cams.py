@@ -5,7 +5,7 @@ from pathlib import Path
 
 from ..config import load_config
 from ..errors import InputError
-from . import add_config
+from . import accepted, add_accept, add_config, ingest_lock
 
 
 def register(sub):
@@ -19,6 +19,7 @@ def register(sub):
     p.add_argument("--data-dir", type=Path, default=None,
                    help="scenario data dir (default: data_dir of the config)")
     add_config(p)
+    add_accept(p)
     p.set_defaults(func=run)
 
 
@@ -29,7 +30,8 @@ def run(args):
     files = list(args.files) or list(cfg.inputs.cams)
     if not files:
         raise InputError("no CAMS file given (pass FILE... or set inputs.cams in --config)")
-    report = ingest_cams(files, args.data_dir or cfg.data_dir)
+    with ingest_lock(args.data_dir or cfg.data_dir):
+        report = ingest_cams(files, args.data_dir or cfg.data_dir, accept=accepted(cfg, args))
     for f in report["files"]:
         print(f"{f['file']}: {f['rows']} rows, step {f['time_step']}, {f['time_reference']}; "
               f"gaps {f['gaps']}, negative {f['negative']}, GHI>1.1 TOA {f['ghi_above_toa']}, "
@@ -49,6 +51,8 @@ def findings(report: dict) -> list[str]:
 
     lines = []
     for f in report["files"]:
+        if f.get("encoding", "utf-8") not in ("utf-8", "utf-8-sig"):
+            lines.append(f"{f['file']}: encoded in {f['encoding']}, not UTF-8: read as {f['encoding']}")
         short = f.get("rows_end_before_declared_s", 0)
         if short:
             lines.append(f"{f['file']}: rows end {f['end']}, {short / 86400:.1f} days before the "

@@ -6,7 +6,7 @@ from pathlib import Path
 from ..config import load_config
 from ..errors import InputError
 from ..progress import set_quiet
-from . import add_config
+from . import accepted, add_accept, add_config, ingest_lock
 
 
 def register(sub):
@@ -28,6 +28,7 @@ def register(sub):
                         "of use, easting first when both do), epsg (always the EPSG order), "
                         "xy (always easting/longitude first)")
     add_config(p)
+    add_accept(p)
     p.add_argument("--quiet", "-q", action="store_true",
                    help="no progress bars or progress lines")
     p.set_defaults(func=run)
@@ -43,7 +44,9 @@ def run(args):
         raise InputError("no CityGML file given (pass FILE... or set inputs.citygml in --config)")
     data_dir = args.data_dir or cfg.data_dir
     crs = args.crs or cfg.inputs.citygml_crs
-    report = ingest_city(files, data_dir, cfg.city, crs=crs, axis_order=args.axis_order)
+    with ingest_lock(data_dir):
+        report = ingest_city(files, data_dir, cfg.city, crs=crs, axis_order=args.axis_order,
+                             accept=accepted(cfg, args))
     print(report.summary())
     print(f"report: {report.report_path}")
     return 0

@@ -4,7 +4,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..store import DataDir
-from . import add_config
+from . import accepted, add_accept, add_config, ingest_lock
 
 
 def register(sub):
@@ -27,6 +27,7 @@ def register(sub):
                    help="ground height (m above sea level) where the city model has no relief and "
                         "no building within 100 m (default: trajectory.ground_elevation_m of "
                         "--config, else the altitude in the header of the ingested CAMS files)")
+    add_accept(p)
     p.set_defaults(func=run)
 
 
@@ -38,10 +39,11 @@ def run(args) -> int:
     traj = cfg.trajectory
     if args.ground_elevation is not None:
         traj = traj.model_copy(update={"ground_elevation_m": args.ground_elevation})
-    report = ingest_gtfs(Path(args.feed), Path(args.data_dir), traj, crs=args.crs,
-                         dist_units=args.dist_units,
-                         timezone=args.timezone or cfg.inputs.gtfs_timezone,
-                         route_types=cfg.run.route_types)
+    with ingest_lock(args.data_dir):
+        report = ingest_gtfs(Path(args.feed), Path(args.data_dir), traj, crs=args.crs,
+                             dist_units=args.dist_units,
+                             timezone=args.timezone or cfg.inputs.gtfs_timezone,
+                             route_types=cfg.run.route_types, accept=accepted(cfg, args))
     print(f"GTFS {args.feed} -> {DataDir(args.data_dir).gtfs.root}  ({report['seconds']} s)")
     print(f"  CRS {report['crs']} ({report['crs_source']}), timezone {report['timezone']}, "
           f"timing {report['timing']}")

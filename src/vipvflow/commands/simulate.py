@@ -5,7 +5,8 @@ from pathlib import Path
 
 from ..config import load_config
 from ..progress import set_quiet
-from . import add_config, port_number
+from ..store import folder_path
+from . import accepted, add_accept, add_config, port_number
 
 
 def register(sub):
@@ -30,8 +31,10 @@ def register(sub):
     p.add_argument("--quiet", "-q", action="store_true",
                    help="no progress bars or progress lines")
     p.add_argument("--force", action="store_true",
-                   help="replace a run of another configuration in the run directory (refused "
-                   "without: the two configuration digests are named)")
+                   help="replace a run of another configuration or of other input files in the "
+                   "run directory (refused without: the two digests are named); only a folder "
+                   "holding nothing but a run's files is replaced")
+    add_accept(p)
     p.set_defaults(func=run)
 
 
@@ -50,14 +53,16 @@ def run(args):
 
 
 def scenario(args):
-    """The configuration the options make: the scenario, then ``--db``, ``--dashboard-port``
-    and ``--out`` over it."""
+    """The configuration the options make: the scenario, then ``--db``, ``--dashboard-port``,
+    ``--out`` and ``--accept`` over it."""
     overrides = {"db": {"dsn": args.db}} if args.db else {}
     if args.dashboard_port is not None:
         overrides["dask"] = {"dashboard_port": args.dashboard_port or None}
     cfg = load_config(args.config, overrides=overrides)
     if args.out is not None:
+        folder_path(args.out, "--out")
         cfg = load_config(args.config, overrides={**overrides, **under(cfg, args.out)})
+    cfg.checks.accept = list(accepted(cfg, args))
     return cfg
 
 

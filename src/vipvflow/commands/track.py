@@ -6,8 +6,8 @@ from pathlib import Path
 
 from ..config import load_config
 from ..errors import InputError
-from ..store import DataDir
-from . import add_config
+from ..store import DataDir, file_path
+from . import accepted, add_accept, add_config
 
 
 def register(sub):
@@ -23,12 +23,13 @@ def register(sub):
     p.add_argument("--crs", default=None, help="CRS of x/y columns (default: the city's)")
     p.add_argument("--out", type=Path, required=True, help="output CSV")
     add_config(p)
+    add_accept(p)
     p.set_defaults(func=run)
 
 
 def run(args):
     from ..models.sun_sky import RadiationTable
-    from ..simulation.track import fit_stats, model_track, read_track
+    from ..simulation.track import check_track_times, fit_stats, model_track, read_track
 
     cfg = load_config(args.config)
     if (args.city / "manifest.json").is_file():      # a run folder: the city of its data dir
@@ -39,8 +40,10 @@ def run(args):
     if not tiles_json.is_file():
         raise InputError(f"{tiles_json}: not found; run 'vipvflow ingest city' first")
     city_crs = json.loads(tiles_json.read_text())["crs"]
+    file_path(args.out, "--out", "track_irradiance.csv")
     track = read_track(args.track, city_crs, args.crs)
-    table = RadiationTable.from_cams(args.cams)
+    table = RadiationTable.from_cams(args.cams, accept=accepted(cfg, args))
+    check_track_times(track, table, args.track, args.cams)
     out = model_track(track, args.city, table, cfg.irradiance, cfg.trajectory.roof_height_m,
                       ground_albedo=cfg.city.albedo.ground, road_albedo=cfg.city.albedo.road)
     args.out.parent.mkdir(parents=True, exist_ok=True)

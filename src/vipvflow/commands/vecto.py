@@ -66,6 +66,9 @@ def run_vmod(args):
 
 
 def run_job(args):
+    from ..store import folder_path
+
+    folder_path(args.out, "--out")
     cfg = load_config(args.config)
     cyc = cfg.trajectory.cycle
     paths = vecto.write_vecto_job(args.out, cfg.vehicle_params(), cycles=args.cycles,

@@ -32,7 +32,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ..errors import InputError
+from ..errors import InputError, accept_hint
 from ..store import DataDir, RadiationDir, staging_dir, swap_dir, write_json
 
 #: irradiance columns kept (W/m2): all-sky and clear-sky global horizontal, direct normal,
@@ -76,14 +76,48 @@ _GRID_S = 60
 
 
 # --------------------------------------------------------------------------- reading
-def _scan_header(path: Path) -> dict:
+#: byte order marks and the encodings they name (UTF-32 before UTF-16: FF FE starts both)
+_BOMS = ((b"\xff\xfe\x00\x00", "utf-32"), (b"\x00\x00\xfe\xff", "utf-32"),
+         (b"\xef\xbb\xbf", "utf-8-sig"), (b"\xff\xfe", "utf-16"), (b"\xfe\xff", "utf-16"))
+#: bytes Windows-1252 leaves undefined: a file holding one is read as latin-1
+_NOT_CP1252 = (b"\x81", b"\x8d", b"\x8f", b"\x90", b"\x9d")
+
+
+def file_encoding(path: Path) -> str:
+    """The encoding to read a CAMS CSV in: ``utf-8``, or as its byte order mark says
+    (``utf-8-sig``, ``utf-16``, ``utf-32``), else ``cp1252`` (or ``latin-1`` where a byte is
+    undefined in cp1252) for a file that is not UTF-8. Streamed: memory stays at one block."""
+    import codecs
+
+    try:
+        fh = open(path, "rb")
+    except OSError as exc:
+        raise InputError(f"{path}: cannot open CAMS file: {exc.strerror}") from None
+    with fh:
+        head = fh.read(4)
+        bom = next((enc for b, enc in _BOMS if head.startswith(b)), None)
+        if bom is not None:
+            return bom
+        fh.seek(0)
+        utf8, ok, cp1252 = codecs.getincrementaldecoder("utf-8")(), True, True
+        while block := fh.read(1 << 20):
+            if ok:
+                try:
+                    utf8.decode(block)
+                except UnicodeDecodeError:
+                    ok = False
+            cp1252 = cp1252 and not any(b in block for b in _NOT_CP1252)
+        return "utf-8" if ok else ("cp1252" if cp1252 else "latin-1")
+
+
+def _scan_header(path: Path, encoding: str = "utf-8") -> dict:
     """Check the '#' header of a CAMS CSV; return the line numbers and values found."""
     import pvlib  # here and below imported where used: a worker's radiation lookups never need it
     try:
-        fh = open(path, encoding="utf-8", errors="replace")
+        fh = open(path, encoding=encoding, errors="replace")
     except OSError as exc:
         raise InputError(f"{path}: cannot open CAMS file: {exc.strerror}") from None
-    info: dict = {"lines": {}}
+    info: dict = {"lines": {}, "encoding": encoding}
     with fh:
         first_data = None
         for no, line in enumerate(fh, start=1):
@@ -119,13 +153,16 @@ def _scan_header(path: Path) -> dict:
         where = f"line {info['lines']['Time reference']}" if "Time reference" in info else "header"
         raise InputError(f"{path}: {where}: time reference must be 'Universal time (UT)' or "
                          f"'True solar time (TST)', got {ref!r}")
-    for key in ("Latitude", "Longitude"):
+    for key, limit in (("Latitude", 90.0), ("Longitude", 180.0)):
         full = next((k for k in info if isinstance(k, str) and k.startswith(key + " ")), None)
         try:
             info[key.lower()] = float(info[full])
         except (TypeError, ValueError):
             where = f"line {info['lines'][full]}" if full else "header"
             raise InputError(f"{path}: {where}: {key} missing or not a number") from None
+        if not -limit <= info[key.lower()] <= limit:
+            raise InputError(f"{path}: line {info['lines'][full]}: {key} {info[full]} is not a "
+                             f"{key.lower()} (-{limit:g} to {limit:g} degrees)")
     alt = next((k for k in info if isinstance(k, str) and k.startswith("Altitude")), None)
     try:
         info["altitude"] = float(info[alt]) if alt else 0.0
@@ -139,7 +176,7 @@ def _scan_header(path: Path) -> dict:
     if line.count(";") + 1 != len(info["columns"]):
         raise InputError(f"{path}: line {no}: {line.count(';') + 1} fields but the header "
                          f"(line {cols_line}) names {len(info['columns'])} columns")
-    last = _last_line(path)
+    last = _last_line(path, encoding)
     if not last.startswith("#") and last.count(";") + 1 != len(info["columns"]):
         raise InputError(f"{path}: last line: {last.count(';') + 1} fields but the header "
                          f"(line {cols_line}) names {len(info['columns'])} columns (file "
@@ -153,12 +190,27 @@ def _scan_header(path: Path) -> dict:
     return info
 
 
-def _last_line(path: Path, tail: int = 1 << 16) -> str:
+def _last_line(path: Path, encoding: str = "utf-8", tail: int = 1 << 16) -> str:
     """The last non-empty line of a text file, read from its end only."""
+    width = {"utf-16": 2, "utf-32": 4}.get(encoding, 1)
     with open(path, "rb") as fh:
+        bom = fh.read(4)
         fh.seek(0, os.SEEK_END)
-        fh.seek(max(0, fh.tell() - tail))
-        lines = fh.read().decode("utf-8", errors="replace").rstrip("\r\n").splitlines()
+        size = fh.tell()
+        start = max(0, size - tail)
+        start -= start % width                   # whole code units of UTF-16 / UTF-32
+        fh.seek(start)
+        data = fh.read()
+    if width > 1:
+        # the tail has no byte order mark: the file's first bytes say the byte order
+        big = bom.startswith(b"\xfe\xff") or bom.startswith(b"\x00\x00\xfe\xff")
+        codec = f"{encoding}-{'be' if big else 'le'}"
+        if start == 0:
+            data = data[width if width == 2 else 4:]
+    else:
+        codec = encoding
+    text = data.decode(codec, errors="replace").lstrip("\ufeff")
+    lines = text.rstrip("\r\n").splitlines()
     return lines[-1] if lines else ""
 
 
@@ -181,7 +233,8 @@ def tst_to_utc(t_tst: pd.DatetimeIndex, longitude: float) -> pd.DatetimeIndex:
     return (naive - shift).tz_localize("UTC")
 
 
-def read_cams_file(path, clear_sky_margin=CLEAR_SKY_MARGIN) -> tuple[pd.DataFrame, dict]:
+def read_cams_file(path, clear_sky_margin=CLEAR_SKY_MARGIN,
+                   accept=()) -> tuple[pd.DataFrame, dict]:
     """Read one CAMS Radiation or McClear CSV into mean irradiances with quality flags.
 
     Parameters
@@ -190,6 +243,11 @@ def read_cams_file(path, clear_sky_margin=CLEAR_SKY_MARGIN) -> tuple[pd.DataFram
         CAMS CSV (1 min, 15 min, 1 h, daily or monthly; UT or true solar time).
     clear_sky_margin : (float, float)
         GHI is flagged above ``factor x ghi_clear + offset`` (W/m2).
+    accept : iterable of str
+        Plausibility findings accepted (``checks.accept``): with ``radiation_components``,
+        GHI below DHI or above the clear-sky margin for more than
+        :data:`MAX_IMPLAUSIBLE_MINUTES` is read (the values above the margin flagged and
+        interpolated) instead of refused.
 
     Returns
     -------
@@ -211,17 +269,20 @@ def read_cams_file(path, clear_sky_margin=CLEAR_SKY_MARGIN) -> tuple[pd.DataFram
     import pvlib
 
     path = Path(path)
-    info = _scan_header(path)
+    encoding = file_encoding(path)
+    info = _scan_header(path, encoding)
     try:
-        data, _ = pvlib.iotools.read_cams(path, integrated=False, label="left", map_variables=True)
-    except Exception as exc:  # pandas parse errors: name the file
-        raise InputError(f"{path}: cannot parse CAMS data rows: {exc}") from None
+        with open(path, encoding=encoding, newline="") as fh:
+            data, _ = pvlib.iotools.read_cams(fh, integrated=False, label="left",
+                                              map_variables=True)
+    except Exception as exc:  # pandas parse errors: name the file, the line and the column
+        raise InputError(f"{path}: {_bad_row(path, info) or 'cannot parse CAMS data rows: ' + _one_line(exc)}") from None
     period = data["Observation period"].astype(str).str.split("/")
     try:
         start = pd.DatetimeIndex(pd.to_datetime(period.str[0], format="ISO8601"))
         end = pd.DatetimeIndex(pd.to_datetime(period.str[1], format="ISO8601"))
     except (ValueError, TypeError) as exc:
-        raise InputError(f"{path}: column 'Observation period': not ISO 8601 start/end ({exc})") from None
+        raise InputError(f"{path}: {_bad_row(path, info) or 'column Observation period: not ISO 8601 start/end (' + _one_line(exc) + ')'}") from None
     # checked on the file's own clock: true solar time shifts each day by the equation of time
     step = _STEPS_S.get(info["time_step"])
     coverage = _check_periods(path, info, start, end, step)
@@ -272,6 +333,8 @@ def read_cams_file(path, clear_sky_margin=CLEAR_SKY_MARGIN) -> tuple[pd.DataFram
             above_extra |= out[col].to_numpy() > dni_extra + 1.0
     flag[above_extra] |= FLAG_DNI_EXTRA
     _check_plausible(path, info, out, core, dni_extra, neg)
+    if has_all and "radiation_components" not in accept:
+        _check_components(path, out, above_clear, (step or 60) / 60.0, clear_sky_margin)
     if not has_all:
         flag |= FLAG_NO_ALLSKY
     out["flag"] = flag
@@ -279,6 +342,7 @@ def read_cams_file(path, clear_sky_margin=CLEAR_SKY_MARGIN) -> tuple[pd.DataFram
             "altitude": info["altitude"], "altitude_declared": info["altitude_declared"],
             "time_step": info["time_step"],
             "time_reference": info["time_reference"], "has_all_sky": has_all,
+            "encoding": encoding,
             "rows": int(len(data)), "gaps": int(((flag & FLAG_GAP) > 0).sum()),
             "negative": int(neg.sum()), "ghi_above_toa": int(above_toa.sum()),
             "ghi_above_clear": int(np.asarray(above_clear).sum()),
@@ -286,6 +350,40 @@ def read_cams_file(path, clear_sky_margin=CLEAR_SKY_MARGIN) -> tuple[pd.DataFram
             "start": str(out["t_start"].iloc[0]) if len(out) else None,
             "end": str(out["t_end"].iloc[-1]) if len(out) else None, **coverage}
     return out, meta
+
+
+def _one_line(exc: Exception) -> str:
+    """An exception's message on one line (pandas' parse errors run over several)."""
+    return " ".join(str(exc).split())[:300]
+
+
+def _bad_row(path: Path, info: dict) -> str | None:
+    """Where the data rows of a CAMS file stop being readable: ``line N: observation period
+    '...' is not an ISO 8601 date`` or ``line N: GHI 'abc' is not a number``; None when
+    every row reads."""
+    try:
+        rows = pd.read_csv(path, sep=";", comment="#", header=None, names=info["columns"],
+                           dtype=str, keep_default_na=False, encoding=info["encoding"])
+    except (ValueError, OSError, UnicodeDecodeError):
+        return None
+    first = info["columns"][0]
+    periods = rows[first].str.strip().str.split("/")
+    for part, what in ((0, "start"), (1, "end")):
+        text = periods.str[part]
+        parsed = pd.to_datetime(text, format="ISO8601", errors="coerce")
+        bad = (parsed.isna() | text.isna()).to_numpy()
+        if bad.any():
+            i = int(np.flatnonzero(bad)[0])
+            return (f"line {_line_of(info, i)}: observation period {rows[first].iloc[i]!r}: its "
+                    f"{what} is not an ISO 8601 date and time")
+    for col in info["columns"][1:]:
+        text = rows[col].str.strip()
+        empty = text.isin(["", "nan", "NaN"])
+        bad = (~empty & pd.to_numeric(text.where(~empty), errors="coerce").isna()).to_numpy()
+        if bad.any():
+            i = int(np.flatnonzero(bad)[0])
+            return f"line {_line_of(info, i)}: {col} {rows[col].iloc[i]!r} is not a number"
+    return None
 
 
 def _line_of(info: dict, row: int) -> int:
@@ -379,6 +477,45 @@ def _check_plausible(path: Path, info: dict, out: pd.DataFrame, core, dni_extra,
                          "radiation series")
 
 
+#: minutes of a file (in total) with GHI below DHI, or above the clear-sky GHI by more than
+#: the margin, beyond which the file is refused (``radiation_components``): CAMS derives
+#: DHI and GHI together (DHI <= GHI) and the all-sky GHI from the clear-sky one, so a real
+#: series holds none; a few minutes are flagged and interpolated
+MAX_IMPLAUSIBLE_MINUTES = 15
+#: DHI counts as above GHI when it exceeds ``factor x GHI + offset_wm2`` (rounding of the
+#: Wh/m2 sums over a minute)
+DHI_ABOVE_GHI = (1.05, 10.0)
+
+
+def _check_components(path: Path, out: pd.DataFrame, above_clear, step_min: float,
+                      clear_sky_margin) -> None:
+    """Refuse a file whose GHI lies below its DHI, or above its clear-sky GHI by more than
+    *clear_sky_margin*, for more than :data:`MAX_IMPLAUSIBLE_MINUTES` (swapped columns, or a
+    column in another unit), naming the first instant and the values there."""
+    ghi, dhi, clear = (out[c].to_numpy() for c in ("ghi", "dhi", "ghi_clear"))
+    fac, off = DHI_ABOVE_GHI
+    with np.errstate(invalid="ignore"):
+        below = dhi > fac * ghi + off
+    hint = accept_hint("radiation_components")
+    for bad, what in ((below, "GHI below DHI"),
+                      (np.asarray(above_clear, bool),
+                       f"GHI above {clear_sky_margin[0]:g} x the clear-sky GHI + "
+                       f"{clear_sky_margin[1]:g} W/m2")):
+        minutes = float(bad.sum()) * step_min
+        if minutes <= MAX_IMPLAUSIBLE_MINUTES:
+            continue
+        i = int(np.flatnonzero(bad)[0])
+        at = f"{out['t_start'].iloc[i]:%Y-%m-%d %H:%M} UTC"
+        if what.startswith("GHI below"):
+            found = (f"GHI {ghi[i]:.0f} W/m2, DHI {dhi[i]:.0f} W/m2: the diffuse part of the light "
+                     "cannot exceed the whole; are the GHI and DHI columns swapped?")
+        else:
+            found = (f"GHI {ghi[i]:.0f} W/m2, clear-sky GHI {clear[i]:.0f} W/m2: are the all-sky "
+                     "and clear-sky columns swapped, or GHI in other units?")
+        raise InputError(f"{path}: {what} for {minutes:,.0f} minutes (first at {at}: {found}) "
+                         f"{hint}")
+
+
 def _insert_gap_rows(frame: pd.DataFrame, step_s: int) -> pd.DataFrame:
     """Insert NaN rows for periods missing from a regular series."""
     t0 = frame["t_start"].to_numpy("datetime64[s]").astype(np.int64)
@@ -451,7 +588,7 @@ def gap_runs(t_utc, flag) -> list[dict]:
              "minutes": int(b - a)} for a, b in zip(first, stop)]
 
 
-def ingest_cams(paths, data_dir, clear_sky_margin=CLEAR_SKY_MARGIN) -> dict:
+def ingest_cams(paths, data_dir, clear_sky_margin=CLEAR_SKY_MARGIN, accept=()) -> dict:
     """Read CAMS files and write ``radiation/radiation.parquet`` + ``ingest_report.json``.
 
     Files of the same location (lat/lon to 4 decimals) are merged: a Radiation Service file
@@ -463,6 +600,8 @@ def ingest_cams(paths, data_dir, clear_sky_margin=CLEAR_SKY_MARGIN) -> dict:
     ----------
     paths : list of str or Path
     data_dir : str or Path
+    accept : iterable of str
+        Plausibility findings accepted (see :func:`read_cams_file`).
 
     Returns
     -------
@@ -479,7 +618,7 @@ def ingest_cams(paths, data_dir, clear_sky_margin=CLEAR_SKY_MARGIN) -> dict:
     by_loc: dict = {}
     files = []
     for p in paths:
-        frame, meta = read_cams_file(p, clear_sky_margin)
+        frame, meta = read_cams_file(p, clear_sky_margin, accept=accept)
         if meta["time_step"] not in _STEPS_S:
             raise InputError(f"{p}: time step {meta['time_step']} (daily/monthly means) cannot "
                              "drive a per-pass simulation; give 1 min, 15 min or 1 h data")

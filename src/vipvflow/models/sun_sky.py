@@ -260,12 +260,13 @@ class RadiationTable:
         return out
 
     @classmethod
-    def from_cams(cls, paths) -> "RadiationTable":
-        """Read CAMS files straight into a table (no data dir), for single runs and tracks."""
+    def from_cams(cls, paths, accept=()) -> "RadiationTable":
+        """Read CAMS files straight into a table (no data dir), for single runs and tracks
+        (*accept*: the plausibility findings accepted, see :func:`ingest_cams`)."""
         import tempfile
 
         with tempfile.TemporaryDirectory() as tmp:
-            ingest_cams(paths, tmp)
+            ingest_cams(paths, tmp, accept=accept)
             table = pd.read_parquet(DataDir(tmp).radiation.table)
         locs = table[["lat", "lon", "altitude"]].drop_duplicates().to_numpy()
         grid = np.arange(table["t_utc"].min(), table["t_utc"].max() + 1, _GRID_S, dtype=np.float64)

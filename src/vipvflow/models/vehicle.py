@@ -92,7 +92,7 @@ class HvacCurve(BaseModel):
 class VehicleParams(BaseModel):
     """A battery-electric bus (catalog entry of ``conf/vehicles.yaml``); SI units unless named."""
 
-    model_config = ConfigDict(extra="forbid", validate_assignment=True)
+    model_config = ConfigDict(extra="forbid", validate_assignment=True, allow_inf_nan=False)
 
     name: str = ""
     description: str = ""

@@ -6,6 +6,7 @@ import os
 import warnings
 
 from ..config import Config
+from ..errors import InputError
 
 log = logging.getLogger(__name__)
 
@@ -38,8 +39,9 @@ def make_client(cfg: Config, scheduler: str | None, n_workers: int | None):
                      "distributed.worker", "distributed.http.proxy"):
             logging.getLogger(name).setLevel(logging.WARNING)
     if scheduler:
-        return Client(scheduler), None
+        return _remote_client(Client, scheduler), None
     n, threads = local_cluster_size(cfg, n_workers)
+    host = cfg.dask.host
     # the dashboard's port was free a moment ago (dashboard_address); a run starting at the
     # same time may take it first: Dask then serves on another port and warns, but the
     # command prints the dashboard's address itself
@@ -50,11 +52,87 @@ def make_client(cfg: Config, scheduler: str | None, n_workers: int | None):
                 "vipvflow.worker-failure-log": log.isEnabledFor(logging.INFO)}
     settings.update(_forkserver())
     with dask.config.set(settings):     # the nannies hand this configuration to their workers
+        # the scheduler, the nannies, the workers and the dashboard listen on *host* only
+        # (127.0.0.1 unless dask.host says otherwise): Dask's ":8787" was every interface
         cluster = LocalCluster(n_workers=n, threads_per_worker=threads,
-                               processes=True, memory_limit=cfg.dask.memory_limit,
-                               dashboard_address=dashboard_address(cfg.dask.dashboard_port),
+                               processes=True, memory_limit=cfg.dask.memory_limit, host=host,
+                               dashboard_address=dashboard_address(cfg.dask.dashboard_port, host),
                                silence_logs=logging.ERROR)
     return Client(cluster), cluster
+
+
+def _refusal(address: str, what: str, exc: BaseException) -> InputError:
+    reason = " ".join(str(exc).split())[:200] or type(exc).__name__
+    return InputError(f"--scheduler {address} (or dask.scheduler): {what} ({reason}); start one "
+                      "(dask scheduler) or leave it out for a LocalCluster on this machine")
+
+
+def check_scheduler(address: str) -> None:
+    """A scheduler address must be one Dask can read, and a TCP one must answer: else
+    :class:`InputError` in one line, at once (before a run ingests anything; Dask itself
+    retried a refused connection until its connect timeout, then raised a traceback)."""
+    import socket
+
+    import dask
+    from distributed.comm.addressing import parse_address, parse_host_port
+    from distributed.comm.registry import backends
+
+    try:
+        scheme, location = parse_address(address)
+        if scheme not in backends:
+            raise ValueError(f"unknown scheme {scheme!r}; Dask knows {', '.join(sorted(backends))}")
+        if scheme == "tcp":
+            host, port = parse_host_port(location)
+            if not 0 < port < 65536:
+                raise ValueError(f"port {port} out of range")
+    except (ValueError, TypeError) as exc:
+        raise _refusal(address, "not a scheduler address", exc) from None
+    if scheme == "tcp":
+        timeout = dask.config.get("distributed.comm.timeouts.connect")
+        try:
+            socket.create_connection((host.strip("[]"), port),
+                                     timeout=dask.utils.parse_timedelta(timeout, "s")).close()
+        except OSError as exc:
+            raise _refusal(address, "no Dask scheduler answers there", exc) from None
+
+
+def _remote_client(Client, address: str):
+    """A client of the scheduler at *address* (:func:`check_scheduler` first), or
+    :class:`InputError` in one line when it does not answer within Dask's connect timeout
+    (``distributed.comm.timeouts.connect``)."""
+    import dask
+
+    check_scheduler(address)
+
+    class _Quiet(Client):
+        # a client whose connection failed is closed again when it is collected, and that
+        # close times out: said as "Exception ignored in Client.__del__" with a traceback
+        def __del__(self):
+            try:
+                super().__del__()
+            except Exception:  # noqa: BLE001
+                pass
+
+    timeout = dask.config.get("distributed.comm.timeouts.connect")
+    try:
+        return _Quiet(address)
+    except OSError as exc:                           # TimeoutError is an OSError
+        raise _refusal(address, f"no Dask scheduler answered there within {timeout}", exc) from None
+    except (ValueError, TypeError) as exc:
+        raise _refusal(address, "not a scheduler address", exc) from None
+
+
+def bound_dashboard(client, cluster) -> str:
+    """The dashboard's address as it was bound: for a LocalCluster the address its HTTP
+    server's socket listens on (``http://127.0.0.1:8787/status``), else the scheduler's own
+    link."""
+    link = client.dashboard_link
+    server = getattr(getattr(cluster, "scheduler", None), "http_server", None)
+    try:
+        host, port = next(iter(server._sockets.values())).getsockname()[:2]
+    except (AttributeError, StopIteration, OSError, TypeError, ValueError):
+        return link
+    return f"http://{'[' + host + ']' if ':' in host else host}:{port}/status"
 
 
 #: the module the forkserver of a run's LocalCluster loads before it forks the workers
@@ -86,21 +164,23 @@ def _forkserver() -> dict:
 def local_cluster_size(cfg: Config, n_workers: int | None = None) -> tuple[int, int]:
     """Workers and threads per worker of the LocalCluster a run starts: *n_workers*, else
     ``dask.n_workers``, else one per core; ``dask.threads_per_worker``, else 1."""
+    if n_workers is not None and n_workers < 1:
+        raise InputError(f"--workers {n_workers}: a LocalCluster needs at least one worker")
     return n_workers or cfg.dask.n_workers or os.cpu_count() or 1, cfg.dask.threads_per_worker or 1
 
 
-def dashboard_address(port: int | None) -> str:
-    """``:port`` when that port is free on this machine, else ``:0`` (any free port)."""
+def dashboard_address(port: int | None, host: str = "127.0.0.1") -> str:
+    """``host:port`` when that port is free on *host*, else ``host:0`` (any free port)."""
     import socket
 
     if port is None:
-        return ":0"
+        return f"{host}:0"
     with socket.socket() as s:
         try:
-            s.bind(("", port))
+            s.bind((host, port))
         except OSError:
-            return ":0"
-    return f":{port}"
+            return f"{host}:0"
+    return f"{host}:{port}"
 
 
 def close_client(client, cluster) -> None:

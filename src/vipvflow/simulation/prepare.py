@@ -1,4 +1,5 @@
-"""Inputs of a run: generate the demo when asked, ingest each input once (cached by fingerprint)."""
+"""Inputs of a run: generate the demo when asked, ingest each input once (cached by the
+content digests of its files and the settings), check them before a cluster starts."""
 from __future__ import annotations
 
 import json
@@ -10,11 +11,6 @@ from ..errors import InputError
 from ..store import DataDir, GtfsDir, sha256, write_text
 
 log = logging.getLogger(__name__)
-
-
-def _fingerprint(paths: list[Path], extra: dict) -> dict:
-    return {"files": [{"path": str(p), "size": p.stat().st_size, "mtime_ns": p.stat().st_mtime_ns}
-                      for p in paths], "config": extra}
 
 
 def _cached(stamp: Path, fp: dict) -> bool:
@@ -77,15 +73,11 @@ def ensure_demo(cfg: Config, year: int, say=print) -> None:
     _stamp(marker, want)
 
 
-def ensure_ingested(cfg: Config, say=print) -> dict:
-    """Ingest city, GTFS and CAMS inputs into ``cfg.data_dir`` unless already done for the same
-    files and settings. Returns the inputs' checksums for the run manifest."""
-    from ..inputs.cams import ingest_cams
-    from ..inputs.city import ingest_city
-    from ..inputs.gtfs import ingest_gtfs
-    from ..models.mesh import MESH_FORMAT
+def input_digests(cfg: Config) -> "InputDigests":
+    """The content digests (SHA-256) of the scenario's input files, which must exist; the
+    timetable and the radiation are required."""
+    from .manifest import InputDigests
 
-    data_dir = Path(cfg.data_dir)
     city_files = [Path(p) for p in cfg.inputs.citygml]
     cams_files = [Path(p) for p in cfg.inputs.cams]
     gtfs = Path(cfg.inputs.gtfs) if cfg.inputs.gtfs else None
@@ -95,53 +87,104 @@ def ensure_ingested(cfg: Config, say=print) -> dict:
                          + " (see data_manifest.yaml and `make data`)")
     if gtfs is None or not cams_files:
         raise InputError(f"{cfg._source}: inputs.gtfs and inputs.cams are required")
+    not_files = [str(p) for p in [*city_files, *cams_files] if not p.is_file()]
+    if not_files:
+        raise InputError(f"{cfg._source}: inputs name folders, not files: {', '.join(not_files)}")
+    return InputDigests({"inputs.citygml": {str(p): sha256(p) for p in city_files},
+                         "inputs.gtfs": {str(gtfs): sha256(gtfs)},
+                         "inputs.cams": {str(p): sha256(p) for p in cams_files}})
 
-    # the ingests' format versions: a data dir ingested before (city: no meshes for the
-    # tiles within the buffer, no coverage area, an older mesh file; GTFS: no ground sources)
-    # is ingested again
-    city_fp = _fingerprint(city_files, {"city": cfg.city.model_dump(mode="json"),
-                                        "crs": cfg.inputs.citygml_crs, "format": 2,
-                                        "mesh_format": MESH_FORMAT})
+
+#: the ingests' format versions: a data dir ingested before (city: no meshes for the tiles
+#: within the buffer, no coverage area, no check of --crs's area, an older mesh file (the
+#: mesh format is part of it too); GTFS: no ground sources, no
+#: duplicate rows or service-day checks; radiation: no gaps listed, no check of GHI against
+#: DHI and the clear sky) is ingested again
+_FORMATS = {"city": 3, "radiation": 4, "gtfs": 3}
+
+
+def _fingerprints(cfg: Config, inputs) -> dict:
+    """What each ingested folder of the data dir must have been made from: the contents
+    (SHA-256) of its input files and the settings that shape it."""
+    def shas(role):
+        return sorted(inputs.files[role].values())
+
+    from ..models.mesh import MESH_FORMAT
+
+    city = {"files": shas("inputs.citygml"), "config": {
+        "city": cfg.city.model_dump(mode="json"), "crs": cfg.inputs.citygml_crs,
+        "format": _FORMATS["city"], "mesh_format": MESH_FORMAT}}
+    radiation = {"files": shas("inputs.cams"), "config": {"checks": _FORMATS["radiation"]}}
+    gtfs = {"files": shas("inputs.gtfs"), "config": {
+        "trajectory": cfg.trajectory.model_dump(mode="json"), "city": city,
+        "radiation": radiation, "timezone": cfg.inputs.gtfs_timezone,
+        "route_types": cfg.run.route_types, "format": _FORMATS["gtfs"]}}
+    return {"city": city, "radiation": radiation, "gtfs": gtfs}
+
+
+def ingest_needed(cfg: Config, inputs) -> list[str]:
+    """The folders of the data dir (``city``, ``radiation``, ``gtfs``) that
+    :func:`ensure_ingested` would ingest again for these inputs and settings."""
+    data = DataDir(cfg.data_dir)
+    fps = _fingerprints(cfg, inputs)
+    return [name for name in ("city", "radiation", "gtfs")
+            if (name != "city" or cfg.inputs.citygml)
+            and not _cached(getattr(data, name).stamp, fps[name])]
+
+
+def ensure_ingested(cfg: Config, say=print, inputs=None):
+    """Ingest city, GTFS and CAMS inputs into ``cfg.data_dir`` unless already done from the
+    same file contents and settings (each folder's ``.inputs.json`` records the SHA-256 of
+    its files). Returns the inputs' :class:`~vipvflow.simulation.manifest.InputDigests`
+    (computed when *inputs* is not given)."""
+    from ..inputs.cams import ingest_cams
+    from ..inputs.city import ingest_city
+    from ..inputs.gtfs import ingest_gtfs
+
+    if inputs is None:
+        inputs = input_digests(cfg)
+    data_dir = Path(cfg.data_dir)
+    city_files = [Path(p) for p in cfg.inputs.citygml]
+    cams_files = [Path(p) for p in cfg.inputs.cams]
+    gtfs = Path(cfg.inputs.gtfs)
+    fps = _fingerprints(cfg, inputs)
     data = DataDir(data_dir)
     stamp = data.city.stamp
-    if city_files and not _cached(stamp, city_fp):
+    if city_files and not _cached(stamp, fps["city"]):
         say(f"ingesting {len(city_files)} CityGML file(s)")
-        report = ingest_city(city_files, data_dir, cfg.city, crs=cfg.inputs.citygml_crs)
+        report = ingest_city(city_files, data_dir, cfg.city, crs=cfg.inputs.citygml_crs,
+                             accept=cfg.checks.accept)
         say("  " + report.summary())
-        _stamp(stamp, city_fp)
+        _stamp(stamp, fps["city"])
     # the radiation before the timetable: its header's altitude is the ground where the
     # city model has none
-    # the checks' version: data ingested before gaps were listed is read again
-    cams_fp = _fingerprint(cams_files, {"checks": 3})
     stamp = data.radiation.stamp
-    if not _cached(stamp, cams_fp):
+    if not _cached(stamp, fps["radiation"]):
         say(f"ingesting {len(cams_files)} CAMS file(s)")
         from ..commands.ingest_cams import findings
 
-        report = ingest_cams(cams_files, data_dir)
+        report = ingest_cams(cams_files, data_dir, accept=cfg.checks.accept)
         for line in findings(report):
             say("  " + line)
-        _stamp(stamp, cams_fp)
+        _stamp(stamp, fps["radiation"])
     else:
         _earlier(data.radiation.report, "gaps", say)
-    gtfs_fp = _fingerprint([gtfs], {"trajectory": cfg.trajectory.model_dump(mode="json"), "city": city_fp,
-                                    "radiation": cams_fp, "timezone": cfg.inputs.gtfs_timezone,
-                                    "route_types": cfg.run.route_types, "format": 2})
     stamp = data.gtfs.stamp
-    if not _cached(stamp, gtfs_fp):
+    if not _cached(stamp, fps["gtfs"]):
         from ..commands.ingest_gtfs import findings, summary_lines
 
         say(f"ingesting GTFS feed {gtfs}")
         report = ingest_gtfs(gtfs, data_dir, cfg.trajectory, crs=cfg.inputs.citygml_crs,
-                             timezone=cfg.inputs.gtfs_timezone, route_types=cfg.run.route_types)
+                             timezone=cfg.inputs.gtfs_timezone, route_types=cfg.run.route_types,
+                             accept=cfg.checks.accept)
         for line in summary_lines(report):
             say("  " + line)
         for line in findings(report):
             say("  " + line)
-        _stamp(stamp, gtfs_fp)
+        _stamp(stamp, fps["gtfs"])
     else:
         _earlier(data.gtfs.feed_json, "problems", say)
-    return {str(p): sha256(p) for p in [*city_files, gtfs, *cams_files]}
+    return inputs
 
 
 def _earlier(report_path: Path, what: str, say) -> None:
@@ -193,6 +236,8 @@ def preflight(cfg: Config, year: int, say=print) -> dict:
     - ``run.routes`` name routes of the feed;
     - the GTFS calendar has service in the run's months of *year* (else its range is named);
     - the city model covers at least part of the routes (same tiles);
+    - every radiation location lies within :data:`vipvflow.config.RADIATION_MAX_KM` of the
+      city model (without one: of the routes), unless ``radiation_far`` is accepted;
     - the radiation data cover every service day's trips (first departure to last arrival,
       UTC) without a gap longer than ``radiation.max_gap_minutes``; shorter gaps within
       those hours are counted (they were interpolated at ingest).
@@ -216,6 +261,8 @@ def preflight(cfg: Config, year: int, say=print) -> dict:
     sd = _run_service_dates(data_dir, trips, year, set(cfg.run.months))
     # the shapes the run drives: of the trips with service in its months
     _check_city_covers(data_dir, trips[trips["service_id"].isin(set(sd["service_id"]))], say)
+    if "radiation_far" not in cfg.checks.accept:
+        check_radiation_place(data_dir)
     days, lo, hi = _hours_on_the_road(gdir, trips, sd, feed["timezone"])
     n_short, short_min = _check_radiation(data_dir, days, lo, hi, cfg.radiation.max_gap_minutes)
     if n_short:
@@ -249,13 +296,17 @@ def _run_service_dates(data_dir: Path, trips, year: int, months: set):
     from ..inputs.gtfs.schedule import service_dates
 
     gdir = DataDir(data_dir).gtfs.root
-    sd = service_dates(data_dir, year)
-    sd = sd[sd["date"].dt.month.isin(months) & sd["service_id"].isin(set(trips["service_id"]))]
+    year_sd = service_dates(data_dir, year)
+    year_sd = year_sd[year_sd["service_id"].isin(set(trips["service_id"]))]
+    sd = year_sd[year_sd["date"].dt.month.isin(months)]
     if sd.empty:
         lo, hi = _calendar_range(gdir)
         which = "" if len(months) == 12 else f" (months {sorted(months)})"
+        # a calendar of a few dates (its services dropped at ingest, say) is said so
+        n = year_sd["date"].nunique()
+        few = f", on {n} dates in {year}" if n else ""
         raise InputError(f"{gdir / 'calendar.parquet'}: the GTFS calendar has no service in "
-                         f"{year}{which}; it runs from {lo} to {hi}")
+                         f"{year}{which}; it runs from {lo} to {hi}{few}")
     return sd
 
 
@@ -292,6 +343,78 @@ def _check_city_covers(data_dir: Path, trips, say) -> None:
             f"{km.sum() / 1000:.1f} km) lie outside the city model: computed under the open "
             "sky there (no building known to shade them); summary.json gives the figures "
             "inside and outside it")
+
+
+def _lonlat_box(crs: str, xmin: float, ymin: float, xmax: float, ymax: float):
+    """(west, south, east, north) in degrees of a box in projected *crs* (edges densified)."""
+    from pyproj import Transformer
+
+    t = Transformer.from_crs(crs, "EPSG:4326", always_xy=True)
+    return tuple(float(v) for v in t.transform_bounds(xmin, ymin, xmax, ymax, densify_pts=21))
+
+
+def _km_to_box(lat: float, lon: float, box) -> float:
+    """Great-circle distance (km) from a point to the nearest point of a lon/lat box (0
+    inside it; the box's nearest corner or edge by clamping, exact enough at these scales)."""
+    import numpy as np
+
+    w, s, e, n = box
+    la, lo = min(max(lat, s), n), min(max(lon, w), e)
+    p1, p2, l1, l2 = map(np.radians, (lat, la, lon, lo))
+    h = np.sin((p2 - p1) / 2) ** 2 + np.cos(p1) * np.cos(p2) * np.sin((l2 - l1) / 2) ** 2
+    return float(2 * 6371.0 * np.arcsin(np.sqrt(min(1.0, h))))
+
+
+def _place(data: DataDir):
+    """(what, lon/lat box) of the place the run is about: the city model's buildings (the
+    tiles holding its own surfaces), else the routes' segments; None when neither is there."""
+    import pandas as pd
+
+    if data.city.tiles_json.is_file():
+        city = json.loads(data.city.tiles_json.read_text())
+        bounds = [t["bounds"] for t in city.get("tiles", {}).values() if t.get("n_surfaces", 1)]
+        if bounds and city.get("crs"):
+            b = list(zip(*bounds))
+            return "the city model", _lonlat_box(city["crs"], min(b[0]), min(b[1]), max(b[2]),
+                                                 max(b[3]))
+    if data.gtfs.segments.is_file() and data.gtfs.feed_json.is_file():
+        crs = json.loads(data.gtfs.feed_json.read_text()).get("crs")
+        seg = pd.read_parquet(data.gtfs.segments, columns=["x", "y"])
+        if crs and len(seg):
+            return "the routes", _lonlat_box(crs, seg["x"].min(), seg["y"].min(), seg["x"].max(),
+                                             seg["y"].max())
+    return None
+
+
+def check_radiation_place(data_dir: Path) -> None:
+    """Every radiation location must lie within :data:`vipvflow.config.RADIATION_MAX_KM` of
+    the city model (without one: of the routes): a CAMS file of another place (Sydney's for
+    Luxembourg gave 116 instead of 314 kWh/kWp) is an :class:`InputError` naming the file,
+    its location and the distance."""
+    from ..config import RADIATION_MAX_KM
+    from ..errors import accept_hint
+
+    data = DataDir(data_dir)
+    place = _place(data)
+    try:
+        rad = json.loads(data.radiation.report.read_text())
+    except (OSError, ValueError):
+        return                          # _check_radiation names the missing report
+    if place is None:
+        return
+    what, box = place
+    for loc in rad.get("locations", []):
+        km = _km_to_box(loc["lat"], loc["lon"], box)
+        if km <= RADIATION_MAX_KM:
+            continue
+        files = [f["file"] for f in rad.get("files", [])
+                 if round(f["latitude"], 4) == loc["lat"] and round(f["longitude"], 4) == loc["lon"]]
+        w, s, e, n = box
+        raise InputError(f"{', '.join(files) or data.radiation.table}: the radiation's location "
+                         f"{loc['lat']:.4f}, {loc['lon']:.4f} lies {km:,.0f} km from {what} "
+                         f"({s:.2f}..{n:.2f} N, {w:.2f}..{e:.2f} E), more than "
+                         f"{RADIATION_MAX_KM:g} km: a CAMS file of another place? "
+                         f"{accept_hint('radiation_far')}")
 
 
 def _hours_on_the_road(gdir: Path, trips, sd, timezone: str):
@@ -352,6 +475,10 @@ def _check_radiation(data_dir: Path, days, lo, hi, limit_min: float) -> tuple[in
     return n_short, short_min
 
 
+#: the longest span :func:`_dark` samples (s): two days
+MAX_DARK_SPAN_S = 2 * 86400.0
+
+
 def _dark(t0, t1, loc: dict, step_s: float = 300.0):
     """Whether the sun stays below the horizon (apparent elevation < -1 deg) at the radiation
     location from *t0* to *t1* (Unix s, arrays; an empty span is dark)."""
@@ -362,6 +489,11 @@ def _dark(t0, t1, loc: dict, step_s: float = 300.0):
     out = np.ones(len(t0), bool)
     for i, (a, b) in enumerate(zip(np.asarray(t0, float), np.asarray(t1, float))):
         if b <= a:
+            continue
+        if b - a > MAX_DARK_SPAN_S:
+            # longer than any service day: not a night (and not sampled every 5 min: a
+            # stop time at 999999999:00:00 asked for 89 GiB here)
+            out[i] = False
             continue
         times = pd.to_datetime(np.append(np.arange(a, b, step_s), b), unit="s", utc=True)
         sun = pvlib.solarposition.get_solarposition(times, loc["lat"], loc["lon"])

@@ -1,6 +1,7 @@
 """Run a scenario-year on a Dask cluster: prepare, map over partitions, reduce, write."""
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import gc
 import importlib
@@ -15,9 +16,11 @@ from pathlib import Path
 import pandas as pd
 
 from ..config import Config
+from ..errors import InputError
 from ..progress import FolderProgress
-from ..store import DataDir
-from .cluster import close_client, local_cluster_size, make_client
+from ..store import DataDir, FolderLock, data_dir_lock, folder_path, lock_for_writing, run_dir_lock
+from .cluster import (bound_dashboard, check_scheduler, close_client, local_cluster_size,
+                      make_client)
 from .manifest import claim_run_dir, write_manifest
 from .network import selected_network
 from .partition import RunContext, partition_done, worker_bvh_builds
@@ -58,26 +61,53 @@ def run_simulation(cfg: Config, year: int, scheduler: str | None = None,
     """Compute the scenario's fleet-year and write all outputs; returns the run directory.
 
     An interrupted run resumes: finished partitions (written atomically) are not recomputed.
-    A run directory holding a run of another configuration is refused (:class:`InputError`
-    naming both digests), or with *force* replaced as a whole (see :func:`claim_run_dir`).
+    A run directory holding a run of another configuration or of other input files is
+    refused (:class:`InputError` naming both digests), or with *force* replaced as a whole
+    (see :func:`claim_run_dir`). A run folder another process runs in, or a data dir another
+    run reads while this one would ingest into it, is refused (docs/run_folders.md).
     *max_partitions* stops after that many new partitions (for tests of resuming).
     """
-    from .prepare import check_year, ensure_demo, ensure_ingested, preflight
+    from .prepare import check_year
+
+    check_year(year)
+    if n_workers is not None and n_workers < 1:
+        raise InputError(f"--workers {n_workers}: a LocalCluster needs at least one worker")
+    if scheduler or cfg.dask.scheduler:
+        check_scheduler(scheduler or cfg.dask.scheduler)
+    folder_path(cfg.out_dir, "out_dir")
+    folder_path(cfg.data_dir, "data_dir")
+    with contextlib.ExitStack() as held:        # the locks of the run folder and the data dir
+        return _run(cfg, year, scheduler, n_workers, say, max_partitions, force, held)
+
+
+def _run(cfg: Config, year: int, scheduler, n_workers, say, max_partitions, force,
+         held: contextlib.ExitStack) -> Path:
+    """:func:`run_simulation` holding its locks in *held*."""
+    from .manifest import check_run_dir
+    from .prepare import ensure_demo, ensure_ingested, input_digests, preflight
     from .reduce import reduce_run
 
     t_start = time.perf_counter()
     timings: dict[str, float] = {}
-    check_year(year)
+    run_dir = run_dir_of(cfg, year)
     # the cluster starts (worker processes, their imports) while the inputs are checked
     # and the timeline is written; closed again if those stop the run
     starting = _Starting(cfg, scheduler, n_workers)
     timeline = None
     try:
         ensure_demo(cfg, year, say=say)
-        checksums = ensure_ingested(cfg, say=say)
+        inputs = input_digests(cfg)
+        # a folder of another run (configuration or input files) is refused before the data
+        # dir is ingested again for this one
+        check_run_dir(run_dir, cfg.digest(), inputs, force)
+        data_lock = held.enter_context(_lock_data_dir(cfg, inputs))
+        inputs = ensure_ingested(cfg, say=say, inputs=inputs)
         preflight(cfg, year, say=say)
-        run_dir = run_dir_of(cfg, year)
-        claim_run_dir(run_dir, cfg.digest(), force=force, say=say)
+        data_lock.take(shared=True)             # other runs may read the data dir with this one
+        # one run at a time in a run folder: a second one (another configuration with
+        # --force, say) is refused before it writes there
+        held.enter_context(lock_for_writing(run_dir_lock(run_dir), "run the command"))
+        claim_run_dir(run_dir, cfg.digest(), force=force, say=say, inputs=inputs)
         timings["prepare_s"] = time.perf_counter() - t_start
         ctx, tiles = _run_context(cfg, year, run_dir)
         routes = cfg.run.routes
@@ -105,6 +135,8 @@ def run_simulation(cfg: Config, year: int, scheduler: str | None = None,
     froze = False
     try:
         n_workers_now = len(client.scheduler_info()["workers"])
+        if not n_workers_now:
+            n_workers_now = _wait_for_workers(client, scheduler or cfg.dask.scheduler)
         # a LocalCluster's workers share the machine's cores for ray casting
         ray_threads = cfg.dask.ray_threads or (
             max(1, (os.cpu_count() or 1) // max(1, n_workers_now)) if cluster is not None else 1)
@@ -166,20 +198,22 @@ def run_simulation(cfg: Config, year: int, scheduler: str | None = None,
         if froze:
             gc.unfreeze()
     timings["total_s"] = time.perf_counter() - t_start
-    write_manifest(cfg, year, run_dir, checksums, timings, results, builds)
+    write_manifest(cfg, year, run_dir, inputs, timings, results, builds)
     say(_summary_line(summary))
     say(f"outputs in {run_dir}")
     return run_dir
 
 
 def _dashboard_line(client, cluster, port: int | None) -> str:
-    """Where the Dask dashboard is; for a LocalCluster whose configured port was taken, that
-    it serves on another."""
+    """Where the Dask dashboard is (the address its socket is bound to); for a LocalCluster
+    whose configured port was taken, that it serves on another."""
     from urllib.parse import urlsplit
+
+    from .cluster import bound_dashboard
 
     if not importlib.util.find_spec("bokeh"):
         return "dask dashboard: off (it needs bokeh: pip install 'vipvflow[app]')"
-    link = client.dashboard_link
+    link = bound_dashboard(client, cluster)       # the address its socket is bound to
     if cluster is not None and port and urlsplit(link).port != port:
         return f"dask dashboard: {link} (port {port} is taken)"
     return f"dask dashboard: {link}"
@@ -202,6 +236,44 @@ def _run_context(cfg: Config, year: int, run_dir: Path) -> tuple[RunContext, lis
         # the progress view's kWh per route, by the routes' public names
         route_of_trip=dict(zip(trips["trip_id"], trips["route_short_name"].astype(str))))
     return ctx, tiles
+
+
+#: how long a run waits for the first worker of a scheduler that has none (s)
+WORKER_WAIT_S = 60.0
+
+
+def _wait_for_workers(client, address) -> int:
+    """The workers of a scheduler that had none, once one joined; :class:`InputError` when
+    none joins within :data:`WORKER_WAIT_S` (the run would wait for ever)."""
+    try:
+        client.wait_for_workers(1, timeout=WORKER_WAIT_S)
+    except (TimeoutError, OSError):
+        raise InputError(f"--scheduler {address}: the scheduler has no workers (none joined "
+                         f"within {WORKER_WAIT_S:g} s): start some (dask worker {address})") from None
+    return len(client.scheduler_info()["workers"])
+
+
+def _lock_data_dir(cfg: Config, inputs) -> FolderLock:
+    """The data dir's lock, taken exclusively (this run may ingest into it), or shared when
+    another run reads it and these inputs need no ingest; else :class:`InputError` in one
+    line naming the folder and the process holding it."""
+    from .prepare import ingest_needed
+
+    lock = data_dir_lock(folder_path(cfg.data_dir, "data_dir"))
+    if lock.take():
+        return lock
+    if not lock.take(shared=True):
+        lock.release()
+        raise InputError(f"{cfg.data_dir}: another vipvflow process{lock.holder()} is ingesting "
+                         "into this data dir; wait for it to finish, then run the command again")
+    needed = ingest_needed(cfg, inputs)
+    if needed:
+        lock.release()
+        raise InputError(f"{cfg.data_dir}: another vipvflow run{lock.holder()} is reading this data "
+                         f"dir, and this scenario's inputs would replace its "
+                         f"{', '.join(n + '/' for n in needed)}: "
+                         "wait for that run to finish, or give this scenario a data_dir of its own")
+    return lock
 
 
 class _Background:

@@ -60,11 +60,29 @@ def read_track(path, city_crs: str, crs: str | None = None) -> pd.DataFrame:
 
     try:
         df = pd.read_csv(path)
-    except (OSError, pd.errors.ParserError) as exc:
-        raise InputError(f"{path}: cannot read track CSV: {exc}") from None
+    except pd.errors.EmptyDataError:
+        raise InputError(f"{path}: empty: a track CSV needs a header (time, lat, lon or x, y) "
+                         "and one row per point") from None
+    except (OSError, pd.errors.ParserError, UnicodeDecodeError) as exc:
+        raise InputError(f"{path}: cannot read track CSV: {' '.join(str(exc).split())}") from None
     if "time" not in df.columns:
-        raise InputError(f"{path}: column 'time' missing (have: {', '.join(df.columns)})")
+        raise InputError(f"{path}: column 'time' missing (have: {', '.join(map(str, df.columns))})")
+    if df.empty:
+        raise InputError(f"{path}: no points (a header and no rows)")
     out = pd.DataFrame({"t_utc": _parse_time(df["time"], path)})
+    bad = ~np.isfinite(out["t_utc"].to_numpy(float))
+    if bad.any():
+        i = int(np.flatnonzero(bad)[0])
+        raise InputError(f"{path}: line {i + 2}: time {df['time'].iloc[i]!r} is missing or not a "
+                         "time")
+    if crs is not None:
+        from pyproj import CRS
+        from pyproj.exceptions import CRSError
+
+        try:
+            CRS.from_user_input(crs)
+        except CRSError:
+            raise InputError(f"--crs {crs}: not a CRS PROJ knows (give one such as EPSG:2169)") from None
     to_city = None
     if {"lat", "lon"} <= set(df.columns):
         to_city = Transformer.from_crs("EPSG:4326", city_crs, always_xy=True)
@@ -83,6 +101,24 @@ def read_track(path, city_crs: str, crs: str | None = None) -> pd.DataFrame:
         if col in df.columns:
             out[col] = pd.to_numeric(df[col], errors="coerce").to_numpy(float)
     return out
+
+
+def check_track_times(track: pd.DataFrame, table, path, cams) -> None:
+    """Every point's time must lie within the radiation data (its first to its last minute):
+    outside them the lookup has no value and the point would read 0 W/m2. Raises
+    :class:`InputError` naming the points outside, the track's and the data's spans."""
+    t = track["t_utc"].to_numpy(float)
+    lo, hi = table.t0 - table.step_s / 2, table.t_end + table.step_s / 2
+    out = (t < lo) | (t > hi)
+    if not out.any():
+        return
+
+    def day(x):
+        return pd.Timestamp(x, unit="s", tz="UTC").strftime("%Y-%m-%d %H:%M")
+    files = ", ".join(str(c) for c in cams)
+    raise InputError(f"{path}: {int(out.sum())} of {len(t)} points (from {day(t[out].min())} to "
+                     f"{day(t[out].max())} UTC) lie outside the radiation data of {files} "
+                     f"({day(lo)} to {day(hi)} UTC): give CAMS data covering the track")
 
 
 def fit_stats(measured, modelled) -> dict:

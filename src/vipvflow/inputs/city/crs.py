@@ -182,6 +182,46 @@ def area_bounds(crs: str) -> tuple[float, float, float, float] | None:
     return None
 
 
+def area_of_use_deg(crs) -> tuple[float, float, float, float] | None:
+    """(west, south, east, north) in degrees of *crs*'s area of use widened by
+    :data:`AREA_MARGIN_DEG` (west > east: across the antimeridian); None when PROJ knows none."""
+    from pyproj import CRS
+
+    aou = CRS.from_user_input(crs).area_of_use
+    if aou is None:
+        return None
+    m = AREA_MARGIN_DEG
+    return (aou.west - m, max(aou.south - m, -90.0), aou.east + m, min(aou.north + m, 90.0))
+
+
+def in_area_of_use(lon, lat, crs) -> np.ndarray:
+    """Per point (degrees): inside *crs*'s area of use widened by :data:`AREA_MARGIN_DEG`
+    (all True when PROJ knows no area of use)."""
+    lon, lat = np.asarray(lon, float), np.asarray(lat, float)
+    box = area_of_use_deg(crs)
+    if box is None:
+        return np.isfinite(lon) & np.isfinite(lat)
+    w, s, e, n = box
+    lon_ok = (lon >= w) & (lon <= e) if w <= e else (lon >= w) | (lon <= e)
+    return lon_ok & (lat >= s) & (lat <= n)
+
+
+def describe_area(crs) -> str:
+    """``EPSG:25832 (ETRS89 / UTM zone 32N; area of use 6.0..12.0 E, 47.3..55.1 N)``."""
+    from pyproj import CRS
+
+    c = CRS.from_user_input(crs)
+    code = c.to_string()
+    aou = c.area_of_use
+    if aou is None:
+        return f"{code} ({c.name})"
+
+    def deg(v, pos, neg):
+        return f"{abs(v):.1f} {pos if v >= 0 else neg}"
+    return (f"{code} ({c.name}; area of use {deg(aou.west, 'E', 'W')}..{deg(aou.east, 'E', 'W')}, "
+            f"{deg(aou.south, 'N', 'S')}..{deg(aou.north, 'N', 'S')})")
+
+
 def inside(xy: np.ndarray, bounds) -> np.ndarray:
     """Per point (n, >=2, x = east): finite and inside *bounds* (None: finite only)."""
     ok = np.isfinite(xy[:, 0]) & np.isfinite(xy[:, 1])

@@ -325,7 +325,8 @@ def _surface_mesh(chunk: _Chunk, name: str, bounds: np.ndarray, buffer_m: float)
 
 
 def ingest_city(paths, data_dir, city_cfg: CityCfg | None = None, crs: str | None = None,
-                chunk_surfaces: int = CHUNK_SURFACES, axis_order: str = "auto") -> IngestReport:
+                chunk_surfaces: int = CHUNK_SURFACES, axis_order: str = "auto",
+                accept=()) -> IngestReport:
     """Read CityGML files into tiled surfaces, tile meshes and a terrain model.
 
     Parameters
@@ -347,6 +348,9 @@ def ingest_city(paths, data_dir, city_cfg: CityCfg | None = None, crs: str | Non
         ``auto`` (default): each file's axis order from its CRS and data (docs/city.md);
         ``epsg``: the EPSG order (latitude / northing first where EPSG says so); ``xy``:
         easting / longitude first.
+    accept : iterable of str
+        Plausibility findings accepted (``checks.accept``): with ``crs_area``, a *crs* whose
+        area of use does not hold the city model is used anyway instead of refused.
 
     Returns
     -------
@@ -375,7 +379,7 @@ def ingest_city(paths, data_dir, city_cfg: CityCfg | None = None, crs: str | Non
     try:
         spool.mkdir()
         acc = _Accumulator(spool, cfg, chunk_surfaces)
-        read = _CityRead(acc, cfg, target, report, counts, bar, axis_order)
+        read = _CityRead(acc, cfg, target, report, counts, bar, axis_order, accept)
         read.files(paths)
         acc.flush()
         target = report.crs = read.target
@@ -416,7 +420,12 @@ def _input_paths(paths, crs: str | None) -> tuple[list[Path], str | None]:
     for path in paths:
         if not path.exists():
             raise InputError(f"{path}: file not found")
-    target = horizontal(normalise_crs(crs)) if crs else None
+    try:
+        name = normalise_crs(crs) if crs else None
+    except InputError:
+        raise InputError(f"--crs {crs} (or inputs.citygml_crs): not a CRS name (EPSG:2169, "
+                         "urn:ogc:def:crs:EPSG::25832 or an OGC URL)") from None
+    target = horizontal(name) if name else None
     if target and not is_projected(target):
         raise InputError(f"--crs {crs}: tiles need a projected CRS in metres, not {target}")
     return paths, target
@@ -426,8 +435,10 @@ class _CityRead:
     """One pass over the CityGML files: their city objects into the accumulator, counted."""
 
     def __init__(self, acc: _Accumulator, cfg: CityCfg, target: str | None,
-                 report: IngestReport, counts: _Counts, bar: Progress, axis_order: str):
+                 report: IngestReport, counts: _Counts, bar: Progress, axis_order: str,
+                 accept=()):
         self.acc, self.cfg, self.target, self.axis_order = acc, cfg, target, axis_order
+        self.accept = tuple(accept)
         self.report, self.counts, self.bar = report, counts, bar
         self.albedo = cfg.albedo.model_dump()
         self.ignored = Counter()               # city objects not read, per class
@@ -452,7 +463,7 @@ class _CityRead:
                 self.bar.advance_to(self.read_before + file_position(fh))
             if src is None and _has_coordinates(feature):
                 src, self.target = _resolve_crs(reader, label, feature, self.target,
-                                                self.report, self.axis_order)
+                                                self.report, self.axis_order, self.accept)
             _add_feature(feature, self.acc, src, self.target, self.cfg, self.albedo, self.counts)
             self._count(feature)
         self.ignored.update(reader.ignored)
@@ -513,8 +524,13 @@ def _has_coordinates(feature) -> bool:
 
 
 def _resolve_crs(reader: CityGMLReader, label: str, feature, target: str | None,
-                 report: IngestReport, axis_order: str = "auto"):
-    """(how this file's coordinates are read, output CRS), settled on its first feature."""
+                 report: IngestReport, axis_order: str = "auto", accept=()):
+    """(how this file's coordinates are read, output CRS), settled on its first feature.
+
+    A given output CRS (``--crs``, ``inputs.citygml_crs``) whose area of use does not hold
+    the file's first building is refused (the city would be tiled in a projection's far
+    distortion: EPSG:32618, New York's UTM zone, for Luxembourg), unless ``crs_area`` is in
+    *accept*."""
     if reader.srs_name:
         name = parse_srs_name(reader.srs_name)
     elif target:
@@ -542,7 +558,30 @@ def _resolve_crs(reader: CityGMLReader, label: str, feature, target: str | None,
                  src.axis_order)
     else:
         log.info("coordinates of %s (%s) read as %s", label, src.crs, src.axis_order)
+        if src.crs != target and "crs_area" not in accept:
+            _check_target_area(label, feature, sample, src, target)
     return src, target
+
+
+def _check_target_area(label: str, feature, sample: np.ndarray, src: SourceCRS,
+                       target: str) -> None:
+    """The file's first building (*sample*, as written) must lie in the area of use of the
+    output CRS *target* it is put in (widened by AREA_MARGIN_DEG)."""
+    from ...errors import accept_hint
+    from .crs import describe_area, in_area_of_use
+
+    xy = src.read(np.column_stack([sample, np.zeros(len(sample))]))[:, :2]
+    xy = xy[inside(xy, src.bounds)]
+    if not len(xy):
+        return                       # outside its own CRS's area: skipped and counted later
+    lonlat = transform_xyz(np.column_stack([xy, np.zeros(len(xy))]), src.crs, "EPSG:4326")
+    lon, lat = np.median(lonlat[:, 0]), np.median(lonlat[:, 1])
+    if not np.isfinite([lon, lat]).all() or in_area_of_use([lon], [lat], target).all():
+        return
+    raise InputError(f"{label}: its city objects ({src.crs}, the first, {feature.feature_id}, at "
+                     f"{lat:.2f}, {lon:.2f}) lie outside the area of use of {describe_area(target)}, "
+                     "the CRS given by --crs or inputs.citygml_crs: leave it out to keep the "
+                     f"file's CRS, or give one for the city's place {accept_hint('crs_area')}")
 
 
 def _add_feature(feature, acc: _Accumulator, src: SourceCRS | None, target: str, cfg: CityCfg,

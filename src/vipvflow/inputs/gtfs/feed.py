@@ -85,21 +85,52 @@ def route_type_set(route_types) -> frozenset | None:
     return frozenset(int(t) for t in route_types)
 
 
-def check_tables(path: Path, max_line: int = MAX_LINE_BYTES) -> None:
+#: encodings a GTFS table is read in when it is not UTF-8 (GTFS requires UTF-8): a byte order
+#: mark names UTF-16 or UTF-32; otherwise Windows-1252 (a superset of latin-1's printable
+#: characters), or latin-1 where a byte is undefined in Windows-1252
+_BOMS = ((b"\xff\xfe\x00\x00", "utf-32"), (b"\x00\x00\xfe\xff", "utf-32"),
+         (b"\xef\xbb\xbf", "utf-8-sig"), (b"\xff\xfe", "utf-16"), (b"\xfe\xff", "utf-16"))
+_NOT_CP1252 = (b"\x81", b"\x8d", b"\x8f", b"\x90", b"\x9d")
+_ENCODING_NAMES = {"utf-16": "UTF-16 (with a byte order mark)",
+                   "utf-32": "UTF-32 (with a byte order mark)",
+                   "cp1252": "Windows-1252 (cp1252, latin-1 with more letters)", "latin-1": "latin-1 (ISO 8859-1)"}
+
+
+def check_tables(path: Path, max_line: int = MAX_LINE_BYTES) -> dict[str, str]:
     """Stream every ``.txt`` table of a GTFS zip or folder once, before pandas reads it.
 
     A corrupt or truncated zip, a member that does not inflate, or a line longer than
     *max_line* bytes (a table that is not CSV, which pandas would try to hold whole) raises
     :class:`InputError` naming the file, member and line; memory stays at one chunk.
+
+    Returns
+    -------
+    dict
+        The tables that are not UTF-8, by name, with the encoding to read them in
+        (``utf-16``, ``utf-32``, ``cp1252`` or ``latin-1``; see :data:`_BOMS`).
     """
+    import codecs
     import zipfile
     import zlib
 
     chunk = min(1 << 20, max_line)
+    found: dict[str, str] = {}
 
     def scan(fh, name: str) -> None:
         since_nl, lines = 0, 0          # bytes since the last newline, newlines seen
+        utf8 = codecs.getincrementaldecoder("utf-8")()
+        encoding, cp1252 = None, True
+        first = True
         while block := fh.read(chunk):
+            if first:
+                encoding = next((enc for bom, enc in _BOMS if block.startswith(bom)), None)
+                first = False
+            if encoding is None:
+                try:
+                    utf8.decode(block)
+                except UnicodeDecodeError:
+                    encoding = "8bit"
+            cp1252 = cp1252 and not any(b in block for b in _NOT_CP1252)
             last = block.rfind(b"\n")
             if last < 0:
                 since_nl += len(block)
@@ -113,12 +144,16 @@ def check_tables(path: Path, max_line: int = MAX_LINE_BYTES) -> None:
             if since_nl > max_line:
                 raise InputError(f"{path}: {name} line {lines + 1} is longer than "
                                  f"{max_line // 1024} kB: not a GTFS table")
+        if encoding == "8bit":
+            encoding = "cp1252" if cp1252 else "latin-1"
+        if encoding not in (None, "utf-8-sig"):
+            found[name] = encoding
 
     if path.is_dir():
         for member in sorted(path.glob("*.txt")):
             with open(member, "rb") as fh:
                 scan(fh, member.name)
-        return
+        return found
     try:
         with zipfile.ZipFile(path) as zf:
             for info in zf.infolist():
@@ -128,6 +163,38 @@ def check_tables(path: Path, max_line: int = MAX_LINE_BYTES) -> None:
                     scan(fh, info.filename)
     except (zipfile.BadZipFile, zlib.error, EOFError, OSError, NotImplementedError) as exc:
         raise InputError(f"{path}: not a readable GTFS zip ({type(exc).__name__}: {exc})") from None
+    return found
+
+
+def _as_utf8(path: Path, encodings: dict[str, str], folder: Path) -> Path:
+    """The ``.txt`` tables of the feed at *path* written to *folder* in UTF-8, those named in
+    *encodings* decoded from theirs (streamed, a line at a time); returns *folder*."""
+    import io
+    import shutil
+    import zipfile
+
+    def copy(fh, name: str) -> None:
+        dest = folder / Path(name).name
+        enc = encodings.get(name)
+        if enc is None:
+            with open(dest, "wb") as out:
+                shutil.copyfileobj(fh, out)
+            return
+        text = io.TextIOWrapper(fh, encoding=enc, newline="")
+        with open(dest, "w", encoding="utf-8", newline="") as out:
+            shutil.copyfileobj(text, out)
+
+    if path.is_dir():
+        for member in sorted(path.glob("*.txt")):
+            with open(member, "rb") as fh:
+                copy(fh, member.name)
+    else:
+        with zipfile.ZipFile(path) as zf:
+            for info in zf.infolist():
+                if not info.is_dir() and info.filename.endswith(".txt"):
+                    with zf.open(info) as fh:
+                        copy(fh, info.filename)
+    return folder
 
 
 def _check_timezone(name: str, where: str) -> str:
@@ -168,13 +235,16 @@ def read_feed(feed_path, dist_units: str | None = None, timezone: str | None = N
     import gtfs_kit as gk
 
     path = Path(feed_path)
-    gfeed = _read_tables(gk, path, dist_units)
     problems: list[str] = []
+    gfeed = _read_tables(gk, path, dist_units, problems)
+    _drop_duplicates(gfeed, path, problems)
     _check_dates(gfeed, path)
+    _check_calendar_spans(gfeed, path, problems)
     _clean_coordinates(gfeed, path, problems)
     tz = _feed_timezone(gfeed, path, timezone, problems)
     gfeed = _select_routes(gfeed, path, route_types, problems)
     _fill_single_times(gfeed, path, problems)
+    _frequencies_within_service_day(gfeed, path, problems)
     gfeed, n_freq = _expand_frequencies(gk, gfeed, path, problems)
     # trips without stop times and stop times of unknown trips or stops go before any shape
     # is built from the stops (gtfs-kit's create_shapes fails on a trip without stop times)
@@ -183,7 +253,7 @@ def read_feed(feed_path, dist_units: str | None = None, timezone: str | None = N
     _drop_unusable_shapes(gfeed, problems)
     gfeed, n_built = _build_missing_shapes(gk, gfeed, path, problems)
     st = _stop_times_in_seconds(gfeed.stop_times, problems)
-    trips = gfeed.trips
+    st, trips = _within_service_day(st, gfeed.trips, path, problems)
     return Feed(path=path, timezone=tz, routes=gfeed.routes, trips=trips.reset_index(drop=True),
                 stops=gfeed.stops, stop_times=st, shapes=gfeed.shapes, calendar=gfeed.calendar,
                 calendar_dates=gfeed.calendar_dates, dist_units=gfeed.dist_units,
@@ -207,14 +277,32 @@ def library_call(path: Path, what: str, fn, *args, **kwargs):
         raise InputError(f"{path}: {what} failed ({kind}: {msg})") from None
 
 
-def _read_tables(gk, path: Path, dist_units: str | None):
-    """gtfs-kit's feed of *path*, with the trips, stop times, stops and a calendar it needs."""
+def _read_tables(gk, path: Path, dist_units: str | None, problems: list[str]):
+    """gtfs-kit's feed of *path*, with the trips, stop times, stops and a calendar it needs.
+
+    Tables that are not UTF-8 (a byte order mark of UTF-16 or UTF-32, or Windows-1252 /
+    latin-1 text) are read in their encoding, each named in a problem line; a value that is
+    not a number in a numeric column is named with its table, line and column."""
+    import tempfile
+
     if not path.exists():
         raise InputError(f"{path}: GTFS feed not found")
-    check_tables(path)
-    gfeed = library_call(path, "reading the feed (gtfs-kit read_feed)",
-                         (lambda: gk.read_feed(path, dist_units=dist_units)) if dist_units
-                         else (lambda: _read_infer(gk, path)))
+    encodings = check_tables(path)
+    for enc in sorted(set(encodings.values())):
+        names = sorted(Path(n).name for n, e in encodings.items() if e == enc)
+        problems.append(f"{', '.join(names)} {'is' if len(names) == 1 else 'are'} encoded in "
+                        f"{_ENCODING_NAMES[enc]}, not UTF-8 as GTFS requires: read as {enc}")
+    with tempfile.TemporaryDirectory(prefix="vipvflow-gtfs-") as tmp:
+        source = _as_utf8(path, encodings, Path(tmp)) if encodings else path
+        try:
+            gfeed = library_call(path, "reading the feed (gtfs-kit read_feed)",
+                                 (lambda: gk.read_feed(source, dist_units=dist_units)) if dist_units
+                                 else (lambda: _read_infer(gk, source)))
+        except InputError:
+            bad = _bad_value(source)
+            if bad:
+                raise InputError(f"{path}: {bad}") from None
+            raise
     for name in ("trips", "stop_times", "stops"):
         if getattr(gfeed, name) is None or getattr(gfeed, name).empty:
             raise InputError(f"{path}: {name}.txt missing or empty")
@@ -222,6 +310,85 @@ def _read_tables(gk, path: Path, dist_units: str | None):
             gfeed.calendar_dates is None or gfeed.calendar_dates.empty):
         raise InputError(f"{path}: neither calendar.txt nor calendar_dates.txt has service dates")
     return gfeed
+
+
+def _bad_value(source: Path) -> str | None:
+    """The first value of a GTFS table at *source* (zip or folder of UTF-8 tables) that
+    gtfs-kit cannot read as the number its column holds: ``"stops.txt line 3: stop_lat
+    'north' is not a number"``; None when there is none."""
+    import zipfile
+
+    from gtfs_kit.constants import DTYPES
+
+    def check(fh, name: str) -> str | None:
+        table = Path(name).stem
+        kinds = {c: t for c, t in DTYPES.get(table, {}).items() if t != "string"}
+        if not kinds:
+            return None
+        try:
+            df = pd.read_csv(fh, dtype=str, keep_default_na=False, encoding="utf-8-sig")
+        except (ValueError, UnicodeDecodeError):
+            return None
+        df.columns = [str(c).strip() for c in df.columns]
+        for col, kind in kinds.items():
+            if col not in df:
+                continue
+            text = df[col].str.strip()
+            empty = text.isin(["", "nan", "NaN", "null"])
+            num = pd.to_numeric(text.where(~empty), errors="coerce")
+            bad = ~empty & num.isna()
+            if kind != "float":
+                bad |= ~empty & num.notna() & (num % 1 != 0)
+            if bad.any():
+                i = int(np.flatnonzero(bad.to_numpy())[0])
+                what = "a number" if kind == "float" else "an integer"
+                return f"{Path(name).name} line {i + 2}: {col} {df[col].iloc[i]!r} is not {what}"
+        return None
+
+    if source.is_dir():
+        for member in sorted(source.glob("*.txt")):
+            with open(member, "rb") as fh:
+                if found := check(fh, member.name):
+                    return found
+        return None
+    with zipfile.ZipFile(source) as zf:
+        for info in zf.infolist():
+            if not info.is_dir() and info.filename.endswith(".txt"):
+                with zf.open(info) as fh:
+                    if found := check(fh, info.filename):
+                        return found
+    return None
+
+
+#: the columns that identify a row of each GTFS table (GTFS reference: "Primary key");
+#: a later row repeating them is dropped, the first kept (:func:`_drop_duplicates`)
+PRIMARY_KEYS = {"routes": ("route_id",), "trips": ("trip_id",), "stops": ("stop_id",),
+                "stop_times": ("trip_id", "stop_sequence"), "calendar": ("service_id",),
+                "calendar_dates": ("service_id", "date"),
+                "shapes": ("shape_id", "shape_pt_sequence"),
+                "frequencies": ("trip_id", "start_time")}
+
+
+def _drop_duplicates(gfeed, path: Path, problems: list[str]) -> None:
+    """Rows repeating the primary key of an earlier row of their table are dropped, the
+    first kept, and counted per table with the first one's line (a repeated route or trip
+    doubled every trip of it; a repeated stop time made a trip stop twice)."""
+    for table, key in PRIMARY_KEYS.items():
+        frame = getattr(gfeed, table, None)
+        if frame is None or frame.empty or not set(key) <= set(frame.columns):
+            continue
+        ids = frame[list(key)].astype("string").apply(lambda c: c.str.strip())
+        dup = ids.duplicated(keep="first").to_numpy()
+        if not dup.any():
+            continue
+        first = int(np.flatnonzero(dup)[0])
+        same = frame.astype("string").duplicated(keep="first").to_numpy()
+        example = ", ".join(f"{k} {ids[k].iloc[first]}" for k in key)
+        problems.append(f"{table}.txt: {int(dup.sum())} rows repeat the {' and '.join(key)} of an "
+                        f"earlier row ({int(same.sum())} of them identical to it; first: {example} "
+                        f"at line {int(frame.index[first]) + 2}): the first row kept, the others "
+                        "dropped")
+        setattr(gfeed, table, frame[~dup])
 
 
 def _feed_timezone(gfeed, path: Path, timezone: str | None, problems: list[str]) -> str:
@@ -328,6 +495,91 @@ def _stop_times_in_seconds(stop_times: pd.DataFrame, problems: list[str]) -> pd.
                         "to arrival")
         st.loc[bad, "dep_s"] = st.loc[bad, "arr_s"]
     return st.sort_values(["trip_id", "stop_sequence"], kind="stable").reset_index(drop=True)
+
+
+#: the longest plausible service day (h): GTFS times count from noon minus 12 h of the
+#: service date and pass 24:00:00 for trips after midnight, but a bus timetable's day ends
+#: by 30:00:00 (06:00 the next morning); a later (or negative) time is a shifted or broken
+#: timetable (:func:`_within_service_day`)
+SERVICE_DAY_H = 30.0
+
+
+def _fmt_hms(seconds: float) -> str:
+    sign, seconds = ("-" if seconds < 0 else ""), abs(seconds)
+    return f"{sign}{int(seconds // 3600)}:{int(seconds % 3600 // 60):02d}:{int(seconds % 60):02d}"
+
+
+def _within_service_day(st: pd.DataFrame, trips: pd.DataFrame, path: Path,
+                        problems: list[str]) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """(stop times, trips) without the trips that have a time before 0:00:00 or after
+    :data:`SERVICE_DAY_H` (counted, the first named); none left is an :class:`InputError`."""
+    limit = SERVICE_DAY_H * 3600.0
+    t = st[["arr_s", "dep_s"]].to_numpy(float)
+    out = ((t < 0) | (t > limit)).any(axis=1)
+    if not out.any():
+        return st, trips
+    bad_trips = set(st.loc[out, "trip_id"])
+    first = st.loc[out].iloc[0]
+    worst = t[(t < 0) | (t > limit)]
+    span = (f"from {_fmt_hms(worst.min())}" if worst.min() == worst.max() else
+            f"from {_fmt_hms(worst.min())} to {_fmt_hms(worst.max())}")
+    what = (f"{len(bad_trips)} of {trips['trip_id'].nunique()} trips have stop times beyond a "
+            f"service day (before 0:00:00 or after {SERVICE_DAY_H:g}:00:00: {span}; first: trip "
+            f"{first['trip_id']} at stop_sequence {first['stop_sequence']})")
+    if len(bad_trips) >= trips["trip_id"].nunique():
+        raise InputError(f"{path}: stop_times.txt: {what}: no trip left (a timetable shifted "
+                         "by days, or times in another unit?)")
+    problems.append(f"stop_times.txt: {what}; dropped")
+    st = st[~st["trip_id"].isin(bad_trips)].reset_index(drop=True)
+    return st, trips[~trips["trip_id"].isin(bad_trips)].reset_index(drop=True)
+
+
+def _frequencies_within_service_day(gfeed, path: Path, problems: list[str]) -> None:
+    """frequencies.txt rows whose start or end time lies beyond a service day (see
+    :data:`SERVICE_DAY_H`), or whose headway is not a positive number of seconds, are dropped
+    and counted before they are expanded into trips (an end time at 999999:00:00 would make
+    billions)."""
+    fr = gfeed.frequencies
+    if fr is None or fr.empty:
+        return
+    limit = SERVICE_DAY_H * 3600.0
+    start, end = time_to_seconds(fr["start_time"]), time_to_seconds(fr["end_time"])
+    headway = pd.to_numeric(fr["headway_secs"], errors="coerce").to_numpy(float)
+    bad = ~(np.isfinite(start) & np.isfinite(end) & (start >= 0) & (end <= limit)
+            & (end >= start) & np.isfinite(headway) & (headway > 0))
+    if not bad.any():
+        return
+    i = int(np.flatnonzero(bad)[0])
+    problems.append(f"frequencies.txt: {int(bad.sum())} rows with a start_time, end_time or "
+                    f"headway_secs outside a service day of {SERVICE_DAY_H:g} h (first: line "
+                    f"{int(fr.index[i]) + 2}, {fr['start_time'].iloc[i]}-{fr['end_time'].iloc[i]} "
+                    f"every {fr['headway_secs'].iloc[i]} s); dropped")
+    gfeed.frequencies = fr[~bad]
+
+
+def _check_calendar_spans(gfeed, path: Path, problems: list[str]) -> None:
+    """calendar.txt rows whose start_date is after their end_date have no dates: dropped and
+    counted; when no service date is left in calendar.txt and calendar_dates.txt, the feed
+    is refused naming the first such row."""
+    cal = gfeed.calendar
+    if cal is None or cal.empty:
+        return
+    start, end = cal["start_date"].astype(str).str.strip(), cal["end_date"].astype(str).str.strip()
+    reversed_ = (start > end).to_numpy()       # YYYYMMDD: text order is date order
+    if not reversed_.any():
+        return
+    i = int(np.flatnonzero(reversed_)[0])
+    what = (f"calendar.txt: {int(reversed_.sum())} of {len(cal)} services have a start_date after "
+            f"their end_date (first: service {cal['service_id'].iloc[i]} at line "
+            f"{int(cal.index[i]) + 2}, {start.iloc[i]} > {end.iloc[i]}), so no dates")
+    cd = gfeed.calendar_dates
+    added = (cd is not None and not cd.empty and
+             (pd.to_numeric(cd["exception_type"], errors="coerce") == 1).any())
+    if reversed_.all() and not added:
+        raise InputError(f"{path}: {what}: the feed has no service date (start_date and "
+                         "end_date swapped?)")
+    problems.append(f"{what}; dropped")
+    gfeed.calendar = cal[~reversed_]
 
 
 def _drop_unmatched(trips: pd.DataFrame, st: pd.DataFrame, stops: pd.DataFrame, path: Path,

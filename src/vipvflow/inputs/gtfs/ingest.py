@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ...errors import InputError
+from ...errors import InputError, accept_hint
 from ...store import TILE_SIZE_M, DataDir, GtfsDir, staging_dir, swap_dir, write_parquet, write_text
 from .feed import read_feed
 from .schedule import pattern_segment_times, project_stops_monotone
@@ -156,15 +156,44 @@ def _city_fit(segs: pd.DataFrame, data_dir: Path, problems: list[str]) -> dict:
 def _choose_crs(feed, data_dir: Path, crs):
     import geopandas as gpd
     from pyproj import CRS
+    from pyproj.exceptions import CRSError
 
     city_crs, tile_size = _city_grid(data_dir)
     if city_crs:
         return CRS.from_user_input(city_crs), tile_size, "city/tiles.json"
     if crs:
-        return CRS.from_user_input(crs), None, "argument"
+        try:
+            return CRS.from_user_input(crs), None, "argument"
+        except CRSError:
+            raise InputError(f"--crs {crs}: not a CRS PROJ knows (give one such as EPSG:2169 "
+                             "or EPSG:25832)") from None
     pts = gpd.GeoSeries(gpd.points_from_xy(feed.stops["stop_lon"], feed.stops["stop_lat"]),
                         crs="EPSG:4326")
     return pts.estimate_utm_crs(), None, "local UTM zone"
+
+
+def _stops_in_crs_area(feed, crs_obj, crs_source: str, problems: list[str], accept=()) -> None:
+    """The stops the trips serve must lie in the area of use of the CRS they are projected
+    into (widened by :data:`vipvflow.inputs.city.crs.AREA_MARGIN_DEG`): a feed of another
+    place than the city model (Cairns' stops in Hamburg's EPSG:25832) is an
+    :class:`InputError` naming both, unless ``crs_area`` is in *accept*; some stops outside
+    are counted."""
+    from ..city.crs import describe_area, in_area_of_use
+
+    used = feed.stops[feed.stops["stop_id"].isin(set(feed.stop_times["stop_id"]))]
+    lon, lat = used["stop_lon"].to_numpy(float), used["stop_lat"].to_numpy(float)
+    ok = in_area_of_use(lon, lat, crs_obj)
+    if ok.all() or not len(used):
+        return
+    where = ("the city model's CRS, city/tiles.json" if crs_source == "city/tiles.json"
+             else "--crs" if crs_source == "argument" else crs_source)
+    what = (f"{int((~ok).sum())} of the {len(used)} stops the trips serve (around "
+            f"{np.median(lat[~ok]):.2f}, {np.median(lon[~ok]):.2f}) lie outside the area of use of "
+            f"{describe_area(crs_obj)} ({where})")
+    if not ok.any() and "crs_area" not in accept:
+        raise InputError(f"{feed.path}: {what}: is the city model of the place this feed "
+                         f"serves? {accept_hint('crs_area')}")
+    problems.append(f"{what}: projected there anyway, with that CRS's distortion")
 
 
 def _dist_factor(st: pd.DataFrame, shape_len: dict, feed_units: str | None, problems):
@@ -260,7 +289,7 @@ def _route_type_counts(routes: pd.DataFrame, trips: pd.DataFrame) -> dict:
 
 
 def ingest_gtfs(feed_path, data_dir, traj_cfg, crs=None, dist_units: str | None = None,
-                timezone: str | None = None, route_types="bus") -> dict:
+                timezone: str | None = None, route_types="bus", accept=()) -> dict:
     """Read a GTFS feed and write the trajectory stage files under ``data_dir/gtfs/``.
 
     Parameters
@@ -282,6 +311,9 @@ def ingest_gtfs(feed_path, data_dir, traj_cfg, crs=None, dist_units: str | None 
     route_types : "bus", "all" or list of int
         GTFS route types to keep (``run.route_types``): buses by default
         (:data:`vipvflow.inputs.gtfs.feed.BUS_ROUTE_TYPES`).
+    accept : iterable of str
+        Plausibility findings accepted (``checks.accept``): with ``crs_area``, stops that all
+        lie outside the CRS's area of use are a problem line instead of an error.
 
     Returns
     -------
@@ -298,6 +330,7 @@ def ingest_gtfs(feed_path, data_dir, traj_cfg, crs=None, dist_units: str | None 
     crs_obj, tile_size, crs_source = _choose_crs(feed, data_dir, crs)
     if not crs_obj.is_projected:
         raise InputError(f"{crs_obj.to_string()}: the trajectory CRS must be projected (metres)")
+    _stops_in_crs_area(feed, crs_obj, crs_source, problems, accept)
     tile_size = float(tile_size or TILE_SIZE_M)
     to_xy = Transformer.from_crs("EPSG:4326", crs_obj, always_xy=True)
 
