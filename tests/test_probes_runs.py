@@ -102,8 +102,8 @@ def test_replaced_cams_is_refused_or_recomputed_whole(small_config, small_run, t
     clean = json.loads((run_simulation(clean_cfg, 2024, **QUIET) / "summary.json").read_text())
     assert _numbers(forced) == pytest.approx(_numbers(clean), rel=1e-9)
     # the new file's light, not the old one's (the session's run of the same scenario)
-    before = json.loads((small_run / "summary.json").read_text())["kwh_per_kwp_allsky"]
-    assert forced["kwh_per_kwp_allsky"] == pytest.approx(0.8 * before, rel=0.05)
+    before = json.loads((small_run / "summary.json").read_text())["kwh_per_kwp_driving"]
+    assert forced["kwh_per_kwp_driving"] == pytest.approx(0.8 * before, rel=0.05)
 
     shutil.copyfile(original, cams)                     # item 1: replaced after a finished run
     with pytest.raises(InputError, match=f"inputs digest {new}; these inputs' digest is {old}"):
@@ -300,13 +300,13 @@ def test_export_out_naming_a_folder(small_run, tmp_path):
 
 def test_app_port_out_of_range_or_busy(small_run):
     one_line_error(vipvflow("app", small_run, "--port", "99999"),
-                   "--port 99999: not a TCP port (0..65535")
+                   "argument --port: '99999' is not a port number (0..65535): try 5006")
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
         s.listen()
         port = s.getsockname()[1]
         one_line_error(vipvflow("app", small_run, "--port", port),
-                       f"--host 127.0.0.1 --port {port}: cannot listen there (Address already in use)")
+                       f"port {port} on 127.0.0.1 is in use (another app?): try --port")
 
 
 def test_raw_websocket_request_is_one_log_line(small_run):
@@ -405,4 +405,4 @@ def test_db_help_says_how_it_authenticates():
                          capture_output=True, text=True)
     text = " ".join(res.stdout.split())
     assert res.returncode == 0 and "trust authentication" not in text
-    assert "127.0.0.1 only and asks for a password (scram-sha-256)" in text
+    assert "127.0.0.1 only and asks for the password of role postgres (scram-sha-256)" in text

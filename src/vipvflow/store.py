@@ -274,13 +274,15 @@ class RunDir:
     @staticmethod
     def written_by_run(name: str) -> bool:
         """Whether an entry *name* of a run folder's top level is one a run writes: ``parts/``,
-        ``figures/``, ``vecto/``, ``manifest.json``, ``summary.json``, ``report.html``, the
+        ``figures/``, ``vecto/``, ``geoparquet/``, ``manifest.json``, ``summary.json``,
+        ``report.html``, ``city.glb``, the
         outputs of the data dictionary (``<name>.parquet``) and the atomic writers'
         temporary files (``.<name>.<pid>.tmp``). ``simulate --force`` replaces only a folder
         holding nothing else."""
         from .simulation.dictionary import OUTPUTS
 
-        if name in ("parts", "figures", "vecto", "manifest.json", "summary.json", "report.html"):
+        if name in ("parts", "figures", "vecto", "geoparquet", "manifest.json", "summary.json",
+                    "report.html", "city.glb"):
             return True
         if name.endswith(".parquet") and name[:-len(".parquet")] in OUTPUTS:
             return True

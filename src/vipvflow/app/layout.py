@@ -7,6 +7,7 @@ formatting.  The trip's numbers are in a ``Div`` with stable ids (``#trip-number
 """
 from __future__ import annotations
 
+import contextlib
 import html
 import json
 import logging
@@ -408,6 +409,42 @@ def _monthly_figure(src_mon: ColumnDataSource):
 #: one thread computes the trips of every session in turn (the model's caches are not shared
 #: between threads); the page's event loop stays free to take the next control change
 _EXECUTOR = ThreadPoolExecutor(max_workers=1, thread_name_prefix="vipvflow-app")
+
+async def _written() -> None:
+    """An awaitable for the session's pending writes: the events were sent in one message."""
+
+
+@contextlib.contextmanager
+def _one_message(doc):
+    """Every change of the document made in the block reaches each page as ONE ``PATCH-DOC``
+    message, so the page never shows a state between two of them (Bokeh's ``hold`` collects
+    the events but still sends each in a message of its own).  Outside a server session
+    (a test's document, ``bokeh.io``) it is a plain ``hold("combine")``."""
+    session = getattr(getattr(doc, "session_context", None), "_session", None) if doc else None
+    connections = list(getattr(session, "_subscribed_connections", None) or [])
+    if doc is not None:
+        doc.hold("combine")
+    sent: dict = {}
+    originals = {}
+    try:
+        yield
+    finally:
+        if doc is not None:
+            for conn in connections:           # collect what unhold would send, per page
+                originals[conn] = conn.send_patch_document
+                conn.send_patch_document = (lambda event, conn=conn:
+                                            sent.setdefault(conn, []).append(event) or _written())
+            try:
+                doc.unhold()
+            finally:
+                for conn, send in originals.items():
+                    conn.send_patch_document = send
+            pending = getattr(session, "_pending_writes", None)
+            for conn, events in sent.items():
+                write = conn._socket.send_message(conn.protocol.create("PATCH-DOC", events))
+                if pending is not None:
+                    pending.append(write)
+
 _MODEL_LOCK = threading.Lock()
 
 
@@ -499,10 +536,7 @@ def _wire(model: TripModel, c: SimpleNamespace, v: SimpleNamespace):
         return partial(job, p) if prepare_only else job(p)
 
     def apply(result: dict) -> None:
-        doc = c.numbers.document
-        if doc is not None:
-            doc.hold("combine")          # every change below reaches the page as one message
-        try:
+        with _one_message(c.numbers.document):    # every change below: one message to the page
             applicable(c)
             if "error" in result:
                 c.error.text = f'<div id="app-error" style="color:#b00">{html.escape(str(result["error"]))}</div>'
@@ -534,9 +568,6 @@ def _wire(model: TripModel, c: SimpleNamespace, v: SimpleNamespace):
             v.src_mon.data = {k: list(mon[k]) for k in v.src_mon.data}
             c.numbers.text = numbers_html(res, _fleet_line(model, result["fleet"]))
             c.error.text = ""
-        finally:
-            if doc is not None:
-                doc.unhold()
 
     return compute, apply
 
