@@ -300,7 +300,7 @@ def test_export_out_naming_a_folder(small_run, tmp_path):
 
 def test_app_port_out_of_range_or_busy(small_run):
     one_line_error(vipvflow("app", small_run, "--port", "99999"),
-                   "argument --port: '99999' is not a port number (0..65535): try 5006")
+                   "argument --port: '99999' is not a port number (1..65535): try 5006")
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
         s.listen()

@@ -17,8 +17,8 @@ def register(sub):
                        "horizon profiles and radiation data, without ray casting.")
     p.add_argument("run_dir", nargs="?", default="out/demo/2024",
                    help="run directory out/<scenario>/<year> (default out/demo/2024)")
-    p.add_argument("--port", type=port_number(5006, allow_zero=True), default=5006,
-                   help="port to listen on, 0..65535 (default 5006; 0: any free one; when it is taken, the error "
+    p.add_argument("--port", type=port_number(5006), default=5006,
+                   help="port to listen on, 1..65535 (default 5006; when it is taken, the error "
                         "names a free one)")
     p.add_argument("--host", default="127.0.0.1",
                    help="address to listen on (default 127.0.0.1: this machine only; 0.0.0.0: "
