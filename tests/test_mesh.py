@@ -110,8 +110,11 @@ def test_simulate_ingests_a_city_of_an_older_mesh_format_again(tmp_path, monkeyp
     with pytest.raises(Stop):
         prepare.ensure_ingested(cfg, say=lambda *_: None)
     assert len(calls) == 1
-    # the stamp of this version (mesh format, and the city's own ingest format): kept
-    city_fp["config"].update(mesh_format=MESH_FORMAT, format=2)
+    # the stamp of this version (mesh format, the city's own ingest format, the trees'): kept
+    from vipvflow.models.trees import TREES_FORMAT
+
+    city_fp["config"].update(mesh_format=MESH_FORMAT, format=2, trees_format=TREES_FORMAT,
+                             trees_crs=None)
     stamp.write_text(json.dumps(city_fp))
     calls.clear()
     with pytest.raises(Exception) as err:                   # goes on to the GTFS ingest

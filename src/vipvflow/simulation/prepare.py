@@ -27,8 +27,8 @@ def _cached(stamp: Path, fp: dict) -> bool:
 #: written beside the demo inputs: the year, seed and size they were generated for
 DEMO_MARKER = "demo_generated.json"
 #: the demo generator's version: inputs of an older generator are made again (2: termini
-#: among buildings)
-DEMO_VERSION = 2
+#: among buildings; 3: street trees)
+DEMO_VERSION = 3
 
 
 def mark_demo(folder, year: int, seed: int, size: str) -> None:
@@ -84,12 +84,15 @@ def ensure_ingested(cfg: Config, say=print) -> dict:
     from ..inputs.city import ingest_city
     from ..inputs.gtfs import ingest_gtfs
     from ..models.mesh import MESH_FORMAT
+    from ..models.trees import TREES_FORMAT
 
     data_dir = Path(cfg.data_dir)
     city_files = [Path(p) for p in cfg.inputs.citygml]
+    tree_files = [Path(p) for p in cfg.inputs.trees]
     cams_files = [Path(p) for p in cfg.inputs.cams]
     gtfs = Path(cfg.inputs.gtfs) if cfg.inputs.gtfs else None
-    missing = [str(p) for p in [*city_files, *cams_files, *([gtfs] if gtfs else [])] if not p.exists()]
+    missing = [str(p) for p in [*city_files, *tree_files, *cams_files, *([gtfs] if gtfs else [])]
+               if not p.exists()]
     if missing:
         raise InputError("input file(s) not found: " + ", ".join(missing)
                          + " (see data_manifest.yaml and `make data`)")
@@ -99,14 +102,19 @@ def ensure_ingested(cfg: Config, say=print) -> dict:
     # the ingests' format versions: a data dir ingested before (city: no meshes for the
     # tiles within the buffer, no coverage area, an older mesh file; GTFS: no ground sources)
     # is ingested again
-    city_fp = _fingerprint(city_files, {"city": cfg.city.model_dump(mode="json"),
-                                        "crs": cfg.inputs.citygml_crs, "format": 2,
-                                        "mesh_format": MESH_FORMAT})
+    # (the trees: vegetation as crowns, never mesh surfaces, and the tree tables)
+    city_fp = _fingerprint(city_files + tree_files, {"city": cfg.city.model_dump(mode="json"),
+                                                     "crs": cfg.inputs.citygml_crs, "format": 2,
+                                                     "mesh_format": MESH_FORMAT,
+                                                     "trees_format": TREES_FORMAT,
+                                                     "trees_crs": cfg.inputs.trees_crs})
     data = DataDir(data_dir)
     stamp = data.city.stamp
     if city_files and not _cached(stamp, city_fp):
-        say(f"ingesting {len(city_files)} CityGML file(s)")
-        report = ingest_city(city_files, data_dir, cfg.city, crs=cfg.inputs.citygml_crs)
+        say(f"ingesting {len(city_files)} CityGML file(s)"
+            + (f" and {len(tree_files)} tree table(s)" if tree_files else ""))
+        report = ingest_city(city_files, data_dir, cfg.city, crs=cfg.inputs.citygml_crs,
+                             trees=tree_files, trees_crs=cfg.inputs.trees_crs)
         say("  " + report.summary())
         _stamp(stamp, city_fp)
     # the radiation before the timetable: its header's altitude is the ground where the
@@ -141,7 +149,7 @@ def ensure_ingested(cfg: Config, say=print) -> dict:
         _stamp(stamp, gtfs_fp)
     else:
         _earlier(data.gtfs.feed_json, "problems", say)
-    return {str(p): sha256(p) for p in [*city_files, gtfs, *cams_files]}
+    return {str(p): sha256(p) for p in [*city_files, *tree_files, gtfs, *cams_files]}
 
 
 def _earlier(report_path: Path, what: str, say) -> None:
