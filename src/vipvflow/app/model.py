@@ -356,7 +356,9 @@ class TripModel:
                 free = np.flatnonzero(T > 0)
                 T[free] = crowns.transmittance(o[free] - scene.origin, d[free], L,
                                                np.repeat(cls[pi[sel]], P)[free])
-            lit[pi[sel], gi[sel]] = T.reshape(-1, P).sum(1) / np.float32(P)
+            # each point's factor through the crowns: the reflector as the roof sees it
+            f = geo["group_f"][pair[sel], :, cls[pi[sel]]]
+            lit[pi[sel], gi[sel]] = (T.reshape(-1, P) * f).sum(1) / np.float32(P)
         return lit
 
     def sun_transmittance(self, rows, sun, visible, classes) -> np.ndarray:

@@ -349,10 +349,14 @@ def roof_irradiance(geometry, rows, sun: np.ndarray, rad: dict, scene, cfg: Irra
         visible[cand] = ~occ[:nd]
         vis_t[cand] = T[:nd]
         if len(pi):
+            # each sample point's lit fraction times its factor through the crowns (1
+            # without): the reflector as the roof sees it through them (view_factors._group_points)
+            gf = geo["group_f"]
             if rotate:
-                share = T[nd:]
+                share = T[nd:] * gf[pair, k, cls[lit[pi]]]
             else:
-                share = T[nd:].reshape(-1, P).sum(1, dtype=np.float64) * np.float64(f32(1.0 / P))
+                share = ((T[nd:].reshape(-1, P) * gf[pair, :, cls[lit[pi]]]).sum(1, dtype=np.float64)
+                         * np.float64(f32(1.0 / P)))
             beam_sum[lit] = np.bincount(pi, beam_w * share, len(lit))
     iso = isotropic_sky_view(nrm[:, 2])
     if cfg.diffuse_model != "isotropic":

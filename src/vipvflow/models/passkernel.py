@@ -79,7 +79,7 @@ def _sample_key(segment_id, t_utc):
 @njit(cache=True, nogil=True)
 def _setup(lo, hi, seg, t_start, dt, mid, row, loc_of_row, packed, cols, t0, step,
            nrm, wn, tree_month, p_local, gp_local, rotate, roulette_w, perez, sky_rows, sky_t0,
-           sky_step, rad, cos_aoi, pass_ray, pair_w, pair_pass, o, d, done):
+           sky_step, rad, cos_aoi, pass_ray, pair_w, pair_pass, pair_pt, o, d, done):
     """Radiation lookup and ray batch of passes ``lo..hi`` (see the module docstring).
 
     Fills, per pass ``i`` (chunk index ``i - lo``): ``rad`` (:data:`_RAD`, NaN as 0, sun
@@ -88,7 +88,8 @@ def _setup(lo, hi, seg, t_start, dt, mid, row, loc_of_row, packed, cols, t0, ste
     ``pass_ray[i + 1] - pass_ray[i]`` rays: its direct ray first when the sun is in front of
     the roof, then per reflector pair one ray, or P with ``rotate`` False), ``done[i]``
     False for a dark pass (every component 0).  ``pair_w`` / ``pair_pass``: per pair its
-    beam weight and pass (chunk index).  ``rad[c, _CLS]``: the crowns' class of the pass's
+    beam weight and pass (chunk index), ``pair_pt`` its (first) sample point's flat index
+    (reflector x P + point).  ``rad[c, _CLS]``: the crowns' class of the pass's
     month (*tree_month*, per geometry row; *wn* per row and class).  Returns (rays, pairs).
     """
     n_t = packed.shape[1]
@@ -160,10 +161,12 @@ def _setup(lo, hi, seg, t_start, dt, mid, row, loc_of_row, packed, cols, t0, ste
                 beam = max(wc, roulette_w)
             pair_w[npair] = beam
             pair_pass[npair] = c
-            npair += 1
             base = (r * J + g)
+            pair_pt[npair] = base * P
+            npair += 1
             if rotate:
                 k = (key + g) % P
+                pair_pt[npair - 1] = base * P + k
                 for j in range(3):
                     o[nr, j] = gp_local[base, k, j]
                 d[nr, 0], d[nr, 1], d[nr, 2] = sx, sy, sz
@@ -279,12 +282,13 @@ def _components(c, r, rad, cos_aoi, vis_t, visible, beam_sum, sky, sky_nt, iso, 
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _visibility(c, pass_ray, pair_w, pair_pass, q, occ, cos_aoi, rotate, P, o, d, tmax, cls, tr,
-                hits):
+def _visibility(c, pass_ray, pair_w, pair_pass, pair_pt, gf, q, occ, cos_aoi, rotate, P, o, d,
+                tmax, cls, tr, hits):
     """Whether the pass's sun ray misses the buildings, its transmittance (0, else the
     crowns' along it in class *cls*), its reflectors' beam sum ``sum weight x lit``
     (float64 like the reference's bincount, then float32; a sample point's ray lit in the
-    crowns' transmittance), and the next pair."""
+    crowns' transmittance, times the point's factor through the crowns *gf*), and the next
+    pair."""
     cx, cy, cz, ia2, ic2, meta, start, items, tau = tr
     trees = items.shape[0] > 0
     r0, r1 = pass_ray[c], pass_ray[c + 1]
@@ -307,6 +311,7 @@ def _visibility(c, pass_ray, pair_w, pair_pass, q, occ, cos_aoi, rotate, P, o, d
                 if trees:
                     t = transmit_one(o[r0, 0], o[r0, 1], o[r0, 2], d[r0, 0], d[r0, 1], d[r0, 2],
                                      tmax, cls, cx, cy, cz, ia2, ic2, meta, start, items, tau, hits)
+            t = t * gf[pair_pt[q], cls]
             acc += np.float64(pair_w[q] * t)
             r0 += 1
         else:
@@ -319,7 +324,7 @@ def _visibility(c, pass_ray, pair_w, pair_pass, q, occ, cos_aoi, rotate, P, o, d
                         t = transmit_one(o[i, 0], o[i, 1], o[i, 2], d[i, 0], d[i, 1], d[i, 2],
                                          tmax, cls, cx, cy, cz, ia2, ic2, meta, start, items,
                                          tau, hits)
-                    tsum += np.float64(t)
+                    tsum += np.float64(t * gf[pair_pt[q] + k, cls])
             share = tsum * np.float64(np.float32(1.0 / P))
             acc += np.float64(pair_w[q]) * share
             r0 += P
@@ -328,7 +333,7 @@ def _visibility(c, pass_ray, pair_w, pair_pass, q, occ, cos_aoi, rotate, P, o, d
 
 
 @njit(cache=True, nogil=True)
-def _finish(lo, hi, row, rad, cos_aoi, pass_ray, pair_w, pair_pass, occ, done,
+def _finish(lo, hi, row, rad, cos_aoi, pass_ray, pair_w, pair_pass, pair_pt, gf, occ, done,
             sky, sky_nt, iso, refl_sky, refl_ghi, perez, hbv, hbv_nt, refl_hor, sin_tilt, sky_cell,
             sky_f, sky_t, sky_tilted, tg_all, th_all, to_all, tg_clear, th_clear, to_clear, nrm,
             ts, rotate, P, o, d, tmax, tr, to_bins, block, visible_out, dt, seg_hour, run,
@@ -346,8 +351,9 @@ def _finish(lo, hi, row, rad, cos_aoi, pass_ray, pair_w, pair_pass, occ, done,
         if not done[c]:
             continue
         cls = np.int64(rad[c, _CLS])
-        visible, vis_t, beam_sum, q = _visibility(c, pass_ray, pair_w, pair_pass, q, occ, cos_aoi,
-                                                  rotate, P, o, d, tmax, cls, tr, hits)
+        visible, vis_t, beam_sum, q = _visibility(c, pass_ray, pair_w, pair_pass, pair_pt, gf, q,
+                                                  occ, cos_aoi, rotate, P, o, d, tmax, cls, tr,
+                                                  hits)
         _components(c, row[i], rad, cos_aoi, vis_t, visible, beam_sum, sky, sky_nt, iso,
                     refl_sky, refl_ghi, perez, hbv, hbv_nt, refl_hor, sin_tilt, sky_cell, sky_f,
                     sky_t, sky_tilted, tg_all, th_all, to_all, tg_clear, th_clear, to_clear,
@@ -495,6 +501,7 @@ class _Batch:
         self.done = np.empty(chunk, np.bool_)
         self.pair_w = np.empty(chunk * pairs_per_pass, f32)
         self.pair_pass = np.empty(chunk * pairs_per_pass, np.int64)
+        self.pair_pt = np.empty(chunk * pairs_per_pass, np.int64)
         self.o = np.empty((chunk * rays_per_pass, 3), f32)
         self.d = np.empty((chunk * rays_per_pass, 3), f32)
 
@@ -549,7 +556,8 @@ def _inputs(geo: dict, cfg, radiation_table, rows_of_segment_loc, scene=None):
              sky_nt=sky_nt.astype(f32, copy=False), iso=iso, refl_sky=r_sky.astype(f32, copy=False),
              refl_ghi=r_ghi.astype(f32, copy=False), hbv=hbv.astype(f32, copy=False),
              hbv_nt=hbv_nt.astype(f32, copy=False), refl_hor=r_hor.astype(f32, copy=False),
-             sin_tilt=sin_tilt, loc=loc, tree_month=geo["tree_month"])
+             sin_tilt=sin_tilt, loc=loc, tree_month=geo["tree_month"],
+             gf=geo["group_f"].reshape(-1, C))
     x = {k: _writable(v) for k, v in x.items()}
     perez = cfg.diffuse_model == "perez_svf"
     x.update(t0=float(radiation_table.t0), step=float(radiation_table.step_s), perez=perez,
@@ -600,7 +608,7 @@ def _run(seg, t_start, dt, mid, row, geo, cfg, radiation_table, scene, loc_of_ro
                        x["t0"], x["step"], x["nrm"], x["wn"], x["tree_month"], x["p_local"],
                        x["gp_local"], rotate, rw, x["perez"], x["sky_rows"], x["sky_t0"],
                        x["sky_step"], bt.rad, bt.cos_aoi, bt.pass_ray, bt.pair_w, bt.pair_pass,
-                       bt.o, bt.d, bt.done)
+                       bt.pair_pt, bt.o, bt.d, bt.done)
         t_b = time.perf_counter()
         occ = (scene.occluded_local(bt.o[:nr], bt.d[:nr], cfg.ray_length_m) if nr
                else np.zeros(0, bool))
@@ -678,7 +686,7 @@ def _finisher(row, dt, to_bins, block, visible, seg_hour, run, seg_bins, run_bin
     *visible*, or (*to_bins*) into *seg_bins* and *run_bins*."""
     def finish(lo, hi, x, bt, occ, P, rotate):
         _finish(lo, hi, row, bt.rad, bt.cos_aoi, bt.pass_ray, bt.pair_w, bt.pair_pass,
-                occ, bt.done, x["sky"], x["sky_nt"], x["iso"], x["refl_sky"], x["refl_ghi"],
+                bt.pair_pt, x["gf"], occ, bt.done, x["sky"], x["sky_nt"], x["iso"], x["refl_sky"], x["refl_ghi"],
                 x["perez"], x["hbv"], x["hbv_nt"], x["refl_hor"], x["sin_tilt"], x["sky_cell"],
                 x["sky_f"], x["sky_t"], x["sky_tilted"], *x["sky_tables"], x["nrm"], x["ts"],
                 rotate, P, bt.o, bt.d, x["tmax"], x["tr"], to_bins, block, visible, dt,
@@ -706,9 +714,9 @@ def warm() -> float:
                 _setup(0, 1, one_i, one_t, one_t, True, one_i, one_i, packed,
                        np.arange(_N_RAD, dtype=i64), 0.0, 60.0, o3, np.zeros((1, 1, 1, 3), f32),
                        months, o3, np.zeros((1, 1, 3), f32), rotate, f32(0.02), perez, rows, 0.0,
-                       900.0, rad, one_f, pr, one_f, one_i, o3, o3, np.zeros(1, np.bool_))
+                       900.0, rad, one_f, pr, one_f, one_i, one_i, o3, o3, np.zeros(1, np.bool_))
                 for to_bins in (False, True):
-                    _finish(0, 1, one_i, rad, one_f, pr, one_f, one_i, np.zeros(1, bool),
+                    _finish(0, 1, one_i, rad, one_f, pr, one_f, one_i, one_i, one_c, np.zeros(1, bool),
                             np.zeros(1, np.bool_), one_c, one_f, one_f, one_c, one_c, perez, one_c,
                             one_f, one_c, one_f, np.zeros((1, n_sky), np.int64),
                             np.zeros((1, n_sky), f32), np.zeros((1, n_sky), f32),

@@ -162,7 +162,7 @@ def _dominant_surface(gkey, surface, w, n_keys: int) -> np.ndarray:
     return out
 
 
-def _group_points(o, hs, gkey, w, hp, hn, w_g, n_g, P: int, lift: float):
+def _group_points(o, hs, gkey, w, hp, hn, w_g, n_g, P: int, lift: float, w_t=None):
     """P sample points per reflector group, each standing for an equal share of the group's
     weight (albedo x view factor), stratified over the group's surface in two dimensions.
 
@@ -189,10 +189,16 @@ def _group_points(o, hs, gkey, w, hp, hn, w_g, n_g, P: int, lift: float):
     P : int, points per group
     lift : float, m, the points are lifted off their surface by this along its normal
 
+    With *w_t* (h, C), each hit's weight seen through the tree crowns per class of months,
+    also each point's factor per class (m, G, P, C): its cell's share of the group's weight
+    through the crowns over its share without (1/P), so that the mean of the points' lit
+    fractions times their factors is the group's lit fraction as the roof sees it through
+    the crowns (a point of an empty cell: the group's mean).
+
     Returns
     -------
     points (m, G, P, 3), m, and their surface normals (m, G, P, 3); groups without hits keep
-    the roof point and the group normal.
+    the roof point and the group normal; the factors (None without *w_t*).
 
     References
     ----------
@@ -259,7 +265,19 @@ def _group_points(o, hs, gkey, w, hp, hn, w_g, n_g, P: int, lift: float):
     pts = np.where(used[..., None], hp[idx] + lift * hn[idx],
                    np.repeat(o, G, axis=0)[:, None, :])
     nrm = np.where(used[..., None], hn[idx], n_flat[:, None, :])
-    return pts.reshape(m, G, P, 3), nrm.reshape(m, G, P, 3)
+    factors = None
+    if w_t is not None:
+        C = w_t.shape[1]
+        cell_w = np.bincount(ckey, w, n_cell).reshape(m * G, P)
+        ratio = np.empty((m * G, P, C))
+        for c in range(C):
+            cell_c = np.bincount(ckey, w_t[:, c], n_cell).reshape(m * G, P)
+            group = np.bincount(gkey, w_t[:, c], m * G) / np.maximum(wflat, 1e-300)
+            ratio[:, :, c] = np.where(cell_w > 0, cell_c / np.where(cell_w > 0, cell_w, 1.0),
+                                      group[:, None])
+        mean = ratio.mean(1, keepdims=True)
+        factors = np.where(mean > 0, ratio / np.where(mean > 0, mean, 1.0), 1.0).reshape(m, G, P, C)
+    return pts.reshape(m, G, P, 3), nrm.reshape(m, G, P, 3), factors
 
 
 #: the surface index of the street where the city model has none (the virtual ground)
@@ -397,11 +415,13 @@ def _reflector_surroundings(scene, keys, pts, nrm, used, cfg: IrradianceCfg, str
         tn = np.where((tn[:, 2:3] < 0), -tn, tn)
         out["hits"] = {"pair": sel[g // n], "p": oo[g] + dist[g, None].astype(np.float64) * d[g],
                        "n": tn, "w": a[g] / n}
+        if C:
+            out["hits"]["T"] = h["T"][g]
     return out
 
 
 def _street(o, gw, surround, keys, cfg: IrradianceCfg, scene, lift: float, ground_z=None,
-            road_albedo: float = 0.10, crowns=None):
+            road_albedo: float = 0.10, crowns=None, gw_t=None):
     """The street the reflector groups see, as one more reflector of each segment.
 
     Its P sample points are taken from the street hits of the groups' own rays, each hit
@@ -412,7 +432,9 @@ def _street(o, gw, surround, keys, cfg: IrradianceCfg, scene, lift: float, groun
     -------
     dict of arrays: ``n`` (m, 3) weighted mean normal, ``pts`` (m, P, 3), ``used`` (m,),
     and the street's own ``sky``, ``wall`` (m,) (see :func:`_reflector_surroundings`); with
-    *crowns* ``sky_t``, ``wall_t`` (m, C) through them.
+    *crowns* ``sky_t``, ``wall_t`` (m, C) through them and the points' factors ``f`` (m, P,
+    C) (the street seen through the crowns from the groups the roof sees through them,
+    *gw_t* (m, G, C): :func:`_group_points`).
     """
     m, G = gw.shape
     P = cfg.reflector_points
@@ -430,15 +452,18 @@ def _street(o, gw, surround, keys, cfg: IrradianceCfg, scene, lift: float, groun
         z = np.zeros(m)
         out = {"n": n_s[:, 0], "pts": pts, "used": used, "sky": z, "wall": z.copy()}
         if C:
-            out.update(sky_t=np.zeros((m, C)), wall_t=np.zeros((m, C)))
+            out.update(sky_t=np.zeros((m, C)), wall_t=np.zeros((m, C)), f=np.ones((m, P, C)))
         return out
-    pts, pn = _group_points(o, seg, seg, w, h["p"], h["n"], w_s, n_s, P, lift)
+    w_t = None
+    if C:
+        w_t = (h["w"][:, None] * h["T"]) * gw_t.reshape(-1, C)[h["pair"]]
+    pts, pn, f = _group_points(o, seg, seg, w, h["p"], h["n"], w_s, n_s, P, lift, w_t)
     own = _reflector_surroundings(scene, keys, pts, pn, used[:, None], cfg, stream=3,
                                   ground_z=ground_z, road_albedo=road_albedo, crowns=crowns)
     out = {"n": n_s[:, 0], "pts": pts[:, 0], "used": used, "sky": own["sky"][:, 0],
            "wall": own["wall"][:, 0]}
     if C:
-        out.update(sky_t=own["sky_t"][:, 0], wall_t=own["wall_t"][:, 0])
+        out.update(sky_t=own["sky_t"][:, 0], wall_t=own["wall_t"][:, 0], f=f[:, 0])
     return out
 
 
@@ -587,6 +612,8 @@ def tree_columns(C: int, G: int) -> list[str]:
 TREE_MONTH_COLUMNS = [f"tree_month_{m:02d}" for m in range(1, 13)]
 #: the prefix of the crowns' loss per sky cell (``tsky_t{c}_{cell:03d}``, perez_svf)
 _TSKY = re.compile(r"tsky_t(\d+)_(\d{3})")
+#: a reflector's sample point's factor through the crowns (``r{g}_q{k}_t{c}``, ``st_q{k}_t{c}``)
+_POINT_FACTOR = re.compile(r"(r\d+|st)_q(\d+)_t(\d+)")
 
 
 def _tree_frame(crowns, scene, origin, trees: dict, acc: dict, G: int, cfg: IrradianceCfg,
@@ -608,6 +635,16 @@ def _tree_frame(crowns, scene, origin, trees: dict, acc: dict, G: int, cfg: Irra
         if G:
             out[f"st_sky_t{c}"] = acc["street"]["sky_t"][:, c].astype(f32)
             out[f"st_wall_t{c}"] = acc["street"]["wall_t"][:, c].astype(f32)
+    # each sample point's factor through the crowns (its cell's share of the reflector's
+    # weight through them over its share without; _group_points), per class
+    P = acc["f"].shape[2] if G else 0
+    for c in range(C):
+        for g in range(G):
+            for k in range(P):
+                out[f"r{g}_q{k}_t{c}"] = acc["f"][:, g, k, c].astype(f32)
+        if G:
+            for k in range(P):
+                out[f"st_q{k}_t{c}"] = acc["street"]["f"][:, k, c].astype(f32)
     if sky_x is not None:
         from .trees import sky_cell_loss
 
@@ -637,7 +674,8 @@ def _no_reflectors(origin, G: int, P: int, C: int = 0) -> dict:
                        "sky": np.zeros(n), "wall": np.zeros(n)}}
     if C:
         out.update({f"{k}_t": np.zeros((n, G, C)) for k in ("w", "sky", "gnd", "open", "wall", "hor")})
-        out["street"].update(sky_t=np.zeros((n, C)), wall_t=np.zeros((n, C)))
+        out["f"] = np.ones((n, G, P, C))
+        out["street"].update(sky_t=np.zeros((n, C)), wall_t=np.zeros((n, C)), f=np.ones((n, P, C)))
     return out
 
 
@@ -801,10 +839,11 @@ def _reflectors(scene, o, nrm, keys, N: int, cfg: IrradianceCfg, acc: dict, idx,
     w = x[hit] / N
     gkey = hs * G + _merge_groups(hs, hn, w, m, G)
     w_g = np.bincount(gkey, w, m * G).reshape(m, G)
+    w_t = None
     if crowns is not None:
-        T = h["T"][hit]
-        acc["w_t"][idx] = np.stack([np.bincount(gkey, w * T[:, c], m * G).reshape(m, G)
-                                    for c in range(T.shape[1])], -1)
+        w_t = w[:, None] * h["T"][hit]
+        acc["w_t"][idx] = np.stack([np.bincount(gkey, w_t[:, c], m * G).reshape(m, G)
+                                    for c in range(w_t.shape[1])], -1)
     n_g = np.stack([np.bincount(gkey, w * hn[:, j], m * G) for j in range(3)], -1).reshape(m, G, 3)
     p_g = np.stack([np.bincount(gkey, w * hp[:, j], m * G) for j in range(3)], -1).reshape(m, G, 3)
     nz = w_g > 0
@@ -825,7 +864,9 @@ def _reflectors(scene, o, nrm, keys, N: int, cfg: IrradianceCfg, acc: dict, idx,
     acc["surface"][idx] = _dominant_surface(gkey, surf, w, m * G).reshape(m, G)
     # sample points (lit fraction) and the groups' own surroundings (sky, street, facades)
     lift = max(cfg.ray_offset_m, _MIN_REFLECTOR_LIFT)
-    pts, pn = _group_points(o, hs, gkey, w, hp, hn, w_g, n_g, P, lift)
+    pts, pn, f = _group_points(o, hs, gkey, w, hp, hn, w_g, n_g, P, lift, w_t)
+    if f is not None:
+        acc["f"][idx] = f
     around = _reflector_surroundings(scene, keys, pts, pn, nz, cfg, ground_z=ground_z,
                                      road_albedo=road_albedo, crowns=crowns)
     for k in ("sky", "gnd", "open", "wall", "hor"):
@@ -833,7 +874,8 @@ def _reflectors(scene, o, nrm, keys, N: int, cfg: IrradianceCfg, acc: dict, idx,
         if crowns is not None:
             acc[f"{k}_t"][idx] = around[f"{k}_t"]
     acc["w"][idx], acc["n"][idx], acc["rep"][idx], acc["pts"][idx] = w_g, n_g, rep.reshape(m, G, 3), pts
-    st = _street(o, w_g, around, keys, cfg, scene, lift, ground_z, road_albedo, crowns)
+    st = _street(o, w_g, around, keys, cfg, scene, lift, ground_z, road_albedo, crowns,
+                 acc["w_t"][idx] if crowns is not None else None)
     for k in acc["street"]:
         acc["street"][k][idx] = st[k]
 
@@ -930,6 +972,18 @@ def geometry_table(geometry: pd.DataFrame):
         flat = np.ascontiguousarray(block[idx[0]][:, [where[i] for i in idx]], np.float32).ravel()
         first[idx[0]] = (prefix, pa.FixedSizeListArray.from_arrays(pa.array(flat), len(idx)))
         points[prefix] = idx
+    # the sample points' factors through the crowns: one list column ``<prefix>_q_t{c}``
+    factors: dict[tuple, list[int]] = {}
+    for i, name in enumerate(names):
+        m = _POINT_FACTOR.fullmatch(name)
+        if m:
+            factors.setdefault((m.group(1), m.group(3)), []).append(i)
+    for (prefix, c), idx in factors.items():
+        if [names[i] for i in idx] != [f"{prefix}_q{k}_t{c}" for k in range(len(idx))]:
+            raise ValueError(f"geometry columns of {prefix}'s point factors not in point order")
+        flat = np.ascontiguousarray(block[idx[0]][:, [where[i] for i in idx]], np.float32).ravel()
+        first[idx[0]] = (f"{prefix}_q_t{c}", pa.FixedSizeListArray.from_arrays(pa.array(flat), len(idx)))
+        points[f"{prefix}_q_t{c}"] = idx
     in_points = {i for idx in points.values() for i in idx}
     out_names, out_arrays = [], []
     for i, name in enumerate(names):
@@ -962,6 +1016,11 @@ def read_geometry(path, columns: list[str] | None = None) -> pd.DataFrame:
             flat = col.combine_chunks().flatten().to_numpy().reshape(-1, col.type.list_size)
             for j in range(col.type.list_size):
                 out[f"{name}_{j:03d}"] = flat[:, j]
+        elif pa.types.is_fixed_size_list(col.type) and "_q_t" in name:
+            prefix, c = name.split("_q_t")
+            flat = col.combine_chunks().flatten().to_numpy().reshape(-1, col.type.list_size)
+            for k in range(col.type.list_size):
+                out[f"{prefix}_q{k}_t{c}"] = flat[:, k]
         else:
             out[name] = col.to_numpy()
     return _frame_by_dtype(out) if out else table.to_pandas()
@@ -1145,13 +1204,29 @@ def pack_geometry(geometry: pd.DataFrame, cfg: IrradianceCfg, ground_albedo: flo
            "refl_ghi": (m * src_ghi).sum(1).astype(f32).reshape(s, C),
            "refl_hor": (m * f_h2).sum(1).astype(f32).reshape(s, C),
            "wn": np.ascontiguousarray(((m * blen)[..., None] * nrm_c).astype(f32).reshape(s, C, J, 3)),
-           "group_p": pts.reshape(s * J, -1, 3)}
+           "group_p": pts.reshape(s * J, -1, 3),
+           "group_f": _point_factors(geometry, cols, G, street, max(P, 1), C)}
     if scene is not None:
         geo["scene_origin"] = np.asarray(scene.origin, np.float64).copy()
         geo["p_local"] = scene.to_local(geo["p"])
         geo["group_p_local"] = scene.to_local(geo["group_p"])
         _check_tree_classes(geo, scene, cfg)
     return geo
+
+
+def _point_factors(geometry: pd.DataFrame, cols: set, G: int, street: bool, P: int,
+                   C: int) -> np.ndarray:
+    """Each reflector sample point's factor through the crowns per class, (s J, P, C)
+    float32 (:func:`_group_points`; 1 without crowns, or for a row without them)."""
+    s = len(geometry)
+    out = np.ones((s, G + street, P, C), np.float32)
+    for j, prefix in enumerate([f"r{g}" for g in range(G)] + (["st"] if street else [])):
+        for c in range(C):
+            names = [f"{prefix}_q{k}_t{c}" for k in range(P)]
+            if names[0] in cols:
+                v = geometry[names].to_numpy(np.float32)
+                out[:, j, :, c] = np.where(np.isfinite(v), v, np.float32(1))
+    return np.ascontiguousarray(out.reshape(s * (G + street), P, C))
 
 
 def _tree_months(geometry: pd.DataFrame, cols: set) -> np.ndarray:
