@@ -1204,7 +1204,7 @@ def pack_geometry(geometry: pd.DataFrame, cfg: IrradianceCfg, ground_albedo: flo
            "refl_ghi": (m * src_ghi).sum(1).astype(f32).reshape(s, C),
            "refl_hor": (m * f_h2).sum(1).astype(f32).reshape(s, C),
            "wn": np.ascontiguousarray(((m * blen)[..., None] * nrm_c).astype(f32).reshape(s, C, J, 3)),
-           "group_p": pts.reshape(s * J, -1, 3),
+           "group_p": pts.reshape(s * J, max(P, 1), 3),
            "group_f": _point_factors(geometry, cols, G, street, max(P, 1), C)}
     if scene is not None:
         geo["scene_origin"] = np.asarray(scene.origin, np.float64).copy()
