@@ -336,7 +336,7 @@ def test_solid_fallback_xlink_parts_terrain_vegetation(tmp_path):
     t = trees.iloc[0]
     assert (t.geometry.x, t.geometry.y, t.geometry.z) == pytest.approx((x + 32, y + 32, 260.0))
     assert t.height_m == pytest.approx(6.0) and t.crown_base_m == pytest.approx(0.35 * 6.0)
-    assert t.crown_diameter_m == pytest.approx(2 * np.sqrt(16 / np.pi))
+    assert t.crown_diameter_m == pytest.approx(4.0)      # the mean of its two widths (4 x 4 m)
     assert report.buildings == 1 and report.building_parts == 1
     assert report.terrain_features == 1 and report.vegetation_features == 1
     assert report.terrain_triangles == 32

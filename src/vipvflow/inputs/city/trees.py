@@ -383,8 +383,9 @@ def crown_of(verts: np.ndarray, x: float, y: float, z: float):
     """Height, crown diameter and crown base (m; the base None when the geometry cannot
     tell) of a tree's vertices (n, 3) around its trunk at (x, y) on the ground z: the top
     above z; the crown base the lowest vertex at least half the crown's radius from the
-    trunk; the diameter the circle of the area of the convex outline of the vertices from
-    the crown base up."""
+    trunk; the diameter, as tree surveys record it, the mean of the crown's two widths
+    across each other: its extents along the principal axes of the convex outline of the
+    vertices from the crown base up (an elliptic crown of axes a and b: (a + b) / 2)."""
     import shapely
 
     v = np.asarray(verts, np.float64)
@@ -397,8 +398,15 @@ def crown_of(verts: np.ndarray, x: float, y: float, z: float):
     base = float(v[wide, 2].min() - z)
     crown = v[v[:, 2] >= z + base - 1e-6]
     hull = shapely.MultiPoint(crown[:, :2]).convex_hull
-    diameter = 2.0 * np.sqrt(hull.area / np.pi) if hull.area > 0 else 2.0 * R
-    return height, float(diameter), (base if base > 0.05 * height else None)
+    if hull.area > 0:
+        xy = np.asarray(hull.exterior.coords)[:-1]
+        xy = xy - xy.mean(0)
+        _, axes = np.linalg.eigh(xy.T @ xy)
+        proj = xy @ axes
+        diameter = float((proj.max(0) - proj.min(0)).mean())
+    else:
+        diameter = 2.0 * R
+    return height, diameter, (base if base > 0.05 * height else None)
 
 
 def _num(v):
