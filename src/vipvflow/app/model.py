@@ -361,6 +361,39 @@ class TripModel:
             lit[pi[sel], gi[sel]] = (T.reshape(-1, P) * f).sum(1) / np.float32(P)
         return lit
 
+    def sun_visible(self, rows, sun, elevation_deg, azimuth_deg, in_front) -> np.ndarray:
+        """Whether the sun reaches the roof point, (n,) bool: from the stored horizon profile
+        (:func:`vipvflow.models.horizon.sun_visible`), and where the profile cannot tell (the sun
+        within ``HORIZON_BAND_DEG`` of it, or in an azimuth bin where it jumps by more than
+        that: a building's edge) from the simulation's own occlusion ray, so the app's direct
+        light is the run's.
+
+        Parameters
+        ----------
+        rows : (n,) int, rows of the stored geometry
+        sun : (n, 3) float32, unit vectors towards the sun
+        elevation_deg, azimuth_deg : (n,) sun position (deg)
+        in_front : (n,) bool, passes with the sun up and in front of the roof (the others
+            get no direct light whatever the answer)
+        """
+        from ..models.horizon import horizon_at
+
+        prof = self._horizon[rows]
+        h = horizon_at(prof, azimuth_deg)
+        visible = (elevation_deg > 0) & (elevation_deg > h)
+        k = prof.shape[1]
+        j = np.floor((np.asarray(azimuth_deg) % 360.0) * k / 360.0).astype(np.int64) % k
+        r = np.arange(len(rows))
+        jump = np.abs(prof[r, j] - prof[r, (j + 1) % k]) > HORIZON_BAND_DEG
+        unsure = np.flatnonzero(in_front & ((np.abs(elevation_deg - h) < HORIZON_BAND_DEG) | jump))
+        tiles = self._tile[rows[unsure]]
+        for tile in np.unique(tiles):
+            sel = unsure[tiles == tile]
+            visible[sel] = ~self._scene(tile).occluded(self._packed["p"][rows[sel]], sun[sel],
+                                                       self.cfg.irradiance.ray_length_m)
+        self.rays_for_direct = len(unsure)
+        return visible
+
     def sun_transmittance(self, rows, sun, visible, classes) -> np.ndarray:
         """The tree crowns' transmittance of the sun ray of passes the buildings let it
         through (*visible*), in each pass's class of months (float32; 0 where not visible):
