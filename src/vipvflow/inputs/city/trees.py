@@ -9,9 +9,9 @@ the source says:
   transformation matrix at its reference point) gives what the attributes leave out: the
   trunk's position (the reference point, else the middle of the vertices), the ground (the
   reference point's height, else the lowest vertex), the height (the highest vertex), the
-  crown diameter (the circle of the same area as the horizontal outline of the crown's
-  vertices) and the crown base (the lowest vertex at least half the crown's radius from the
-  trunk).  A generic attribute ``crown_base`` (``crownBase``, ``h_trunk``, ``kronenansatz``)
+  crown diameter (as tree surveys record it: the mean of the crown's two widths along the
+  principal axes of its horizontal outline) and the crown base (the lowest vertex at least
+  half the crown's radius from the trunk).  A generic attribute ``crown_base`` (``crownBase``, ``h_trunk``, ``kronenansatz``)
   gives the crown base.
 * ``PlantCover`` (hedges, shrubs, woods): its outline filled with crowns from the ground to
   ``averageHeight`` (else the geometry's top), one every ``max(2, min(height, 10))`` m.
