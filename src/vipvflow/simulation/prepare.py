@@ -84,7 +84,7 @@ def ensure_ingested(cfg: Config, say=print) -> dict:
     from ..inputs.city import ingest_city
     from ..inputs.gtfs import ingest_gtfs
     from ..models.mesh import MESH_FORMAT
-    from ..models.trees import TREES_FORMAT
+    from ..models.tree_table import TREES_FORMAT
 
     data_dir = Path(cfg.data_dir)
     city_files = [Path(p) for p in cfg.inputs.citygml]

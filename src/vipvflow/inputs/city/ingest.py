@@ -675,7 +675,7 @@ def _write_trees(city_dir: Path, collector, cfg: CityCfg, crs: str | None, mesh_
     trees' report (:class:`vipvflow.inputs.city.trees.TreeReport`)."""
     import geopandas as gpd
 
-    from ...models.trees import LEAF_TYPES, TREE_SOURCES
+    from ...models.tree_table import LEAF_TYPES, TREE_SOURCES
     from .terrain import TerrainModel
 
     city = CityDir(city_dir)

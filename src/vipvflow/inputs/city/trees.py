@@ -40,7 +40,7 @@ from pathlib import Path
 import numpy as np
 
 from ...errors import InputError
-from ...models.trees import LEAF_TYPES, TREE_SOURCES, TreeTable, month_mask
+from ...models.tree_table import LEAF_TYPES, TREE_SOURCES, TreeTable, month_mask
 from .crs import inside, transform_xyz
 
 #: genera of urban trees by leaf type (lower case; the first word of a botanical name)
