@@ -362,7 +362,8 @@ SUMMARY: dict[str, Column] = {
                                                    "shading_loss_allsky_without_trees"),
     "trees_in_city_model": Column("count", "trees (crowns) the city ingest kept from the CityGML "
                                            "vegetation and the tree tables (0 when "
-                                           "irradiance.trees.enabled is false)"),
+                                           "irradiance.trees.enabled is false; null when the "
+                                           "ingest's report cannot be read)"),
     "reflection_gain_allsky": Column("fraction", "reflected / unshaded light, all-sky"),
     "net_building_effect_allsky": Column("fraction", "light with buildings / without - 1 (shading and "
                                                      "reflections together), all-sky"),

@@ -1056,14 +1056,14 @@ def _tree_figures(cfg: Config, tot: pd.Series) -> dict:
     """The trees' part of the shading loss on the road (all-sky): the loss with the
     buildings alone (the ``_no_trees`` light) and what the crowns add to it, and how many
     trees the city model holds (the city ingest's count; 0 with ``irradiance.trees.enabled``
-    false)."""
+    false; None when the ingest's report cannot be read: unknown, not 0)."""
     import json
 
     report = DataDir(cfg.data_dir).city.report
     try:
         kept = int(json.loads(report.read_text()).get("trees", {}).get("kept", 0))
-    except (OSError, ValueError, AttributeError):
-        kept = 0
+    except (OSError, ValueError, AttributeError, TypeError):
+        kept = None
     without = float(shading_loss(tot["h_direct_no_trees"], tot["h_diffuse_no_trees"],
                                  tot["h_total_unshaded"]))
     with_trees = float(shading_loss(tot["h_direct"], tot["h_diffuse"], tot["h_total_unshaded"]))
