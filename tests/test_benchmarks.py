@@ -63,6 +63,10 @@ def test_facts_in_the_tiny_results(tiny_results):
             assert set(per_worker) == {"worker1", "worker2"}, table
     line = json.loads((results / "line_year.tiny.json").read_text())["figures"]
     assert line["passes"] > 0 and line["partitions"] > 0
+    # the trees' cost is measured on a demo that has trees, in the three legs of a round
+    sky = json.loads((results / "sky.tiny.json").read_text())["figures"]
+    assert sky["trees_in_city_model"] > 0
+    assert len(sky["perez_ratio_rounds"]) == len(sky["trees_ratio_rounds"]) == len(sky["both_ratio_rounds"]) == 1
     if "postgis" in names:
         pg = json.loads((results / "postgis.tiny.json").read_text())["figures"]
         # every disagreement between PostGIS and Embree must be a graze (1 mm changes it)

@@ -328,8 +328,15 @@ def test_solid_fallback_xlink_parts_terrain_vegetation(tmp_path):
     path = tmp_path / "mixed.gml"
     path.write_text(city(NS2, [building, relief, tree]))
     report = ingest_city(path, tmp_path / "out", CityCfg(tile_size_m=500, buffer_m=100))
-    # the solid wins over the lod2MultiSurface; xlinks resolved; typed from the normal
-    assert report.surfaces == {"roof": 1, "wall": 4, "ground": 1, "terrain": 32, "vegetation": 1}
+    # the solid wins over the lod2MultiSurface; xlinks resolved; typed from the normal; the
+    # tree is a crown (its polygon's extent), never a surface of the mesh
+    assert report.surfaces == {"roof": 1, "wall": 4, "ground": 1, "terrain": 32}
+    assert report.trees["kept"] == 1 and report.trees["crown_base_from"] == {"default": 1}
+    trees = gpd.read_parquet(tmp_path / "out" / "city" / "trees.parquet")
+    t = trees.iloc[0]
+    assert (t.geometry.x, t.geometry.y, t.geometry.z) == pytest.approx((x + 32, y + 32, 260.0))
+    assert t.height_m == pytest.approx(6.0) and t.crown_base_m == pytest.approx(0.35 * 6.0)
+    assert t.crown_diameter_m == pytest.approx(4.0)      # the mean of its two widths (4 x 4 m)
     assert report.buildings == 1 and report.building_parts == 1
     assert report.terrain_features == 1 and report.vegetation_features == 1
     assert report.terrain_triangles == 32

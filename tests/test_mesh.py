@@ -103,7 +103,7 @@ def test_simulate_ingests_a_city_of_an_older_mesh_format_again(tmp_path, monkeyp
                              "inputs": {"citygml": [str(gml)], "gtfs": str(gml), "cams": [str(gml)]}})
     city_fp = prepare._fingerprints(cfg, prepare.input_digests(cfg))["city"]
     current = dict(city_fp["config"])
-    for key in ("mesh_format", "format"):                   # a stamp from before the formats
+    for key in ("mesh_format", "format", "trees_format"):   # a stamp from before the formats
         del city_fp["config"][key]
     stamp = tmp_path / "data" / "city" / ".inputs.json"
     stamp.parent.mkdir(parents=True)
@@ -112,8 +112,10 @@ def test_simulate_ingests_a_city_of_an_older_mesh_format_again(tmp_path, monkeyp
     with pytest.raises(Stop):
         prepare.ensure_ingested(cfg, say=lambda *_: None)
     assert len(calls) == 1
-    # the stamp of this version (mesh format, and the city's own ingest format): kept
-    assert current["mesh_format"] == MESH_FORMAT
+    # the stamp of this version (mesh format, the city's own ingest format, the trees'): kept
+    from vipvflow.models.trees import TREES_FORMAT
+
+    assert current["mesh_format"] == MESH_FORMAT and current["trees_format"] == TREES_FORMAT
     city_fp["config"] = current
     stamp.write_text(json.dumps(city_fp))
     calls.clear()

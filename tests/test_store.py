@@ -31,6 +31,7 @@ def _named_by_store(data_dir, run_dir) -> set:
              run.manifest, run.config_stamp, run.inputs_stamp, run.report,
              run.output("summary.json"), run.output("city.glb")}
     names |= {city.mesh(t) for t in tiles} | {city.surface_part(t) for t in tiles}
+    names |= {city.tree_points} | {city.trees_file(t) for t in tiles}     # the trees' crowns
     names |= {gtfs.table(n) for n in GTFS_TABLES}
     names |= {run.output(f"{name}.parquet") for name in OUTPUTS}
     names |= {run.timeline_table(n) for n in TIMELINE_TABLES}

@@ -85,6 +85,11 @@ class Inputs(_Model):
     # IANA zone of the timetable for a feed without agency.txt (the feed's own wins)
     gtfs_timezone: str | None = None
     cams: list[Path] = Field(default_factory=list)
+    # tree tables (CSV or GeoParquet points: height, crown_diameter, optional crown_base,
+    # leaf_type or genus, leaf_off_months), their trees beside the CityGML vegetation
+    trees: list[Path] = Field(default_factory=list)
+    # CRS of a CSV tree table's x/y columns (default: the city's; lon/lat columns are WGS84)
+    trees_crs: str | None = None
 
 
 class Albedo(_Model):
@@ -96,8 +101,23 @@ class Albedo(_Model):
     road: float = Field(0.10, ge=0, le=1)
     closure: float = Field(0.0, ge=0, le=1)
     terrain: float = Field(0.20, ge=0, le=1)
-    vegetation: float = Field(0.18, ge=0, le=1)
     other: float = Field(0.20, ge=0, le=1)
+
+    @model_validator(mode="before")
+    @classmethod
+    def _no_vegetation(cls, data):
+        if isinstance(data, dict) and "vegetation" in data:
+            raise ValueError("vegetation is gone: trees are crowns that let through a share of "
+                             "the light (irradiance.trees), not reflecting surfaces")
+        return data
+
+
+class CityTreesCfg(_Model):
+    """How the ingest makes crowns of trees whose data says less than a crown needs."""
+
+    # the crown base (lowest leaves) of a tree whose data gives none, as a share of its
+    # height (a crown of two thirds of the tree, as urban trees' live crown ratios go)
+    crown_base_fraction: float = Field(0.35, ge=0, lt=1)
 
 
 class CityCfg(_Model):
@@ -107,6 +127,7 @@ class CityCfg(_Model):
     albedo: Albedo = Field(default_factory=Albedo)
     planarity_tolerance_m: float = Field(0.10, gt=0)
     min_area_m2: float = Field(0.01, ge=0)
+    trees: CityTreesCfg = Field(default_factory=CityTreesCfg)
 
 
 

@@ -80,6 +80,10 @@ class CityDir(_Ingested):
                                   "``surfaces/tile=<T>/part-0.parquet``.")
     coverage = _Entry("coverage.parquet", "GeoParquet, one row: the area the city model covers "
                                           "(its footprints closed and widened).")
+    trees = _Entry("trees", "The tree crowns each tile's rays meet (its own trees and its "
+                            "buffer's): ``trees/<T>.npz`` (:class:`vipvflow.models.trees.TreeTable`).")
+    tree_points = _Entry("trees.parquet", "GeoParquet, every tree the ingest kept: trunk point, "
+                                          "height, crown diameter and base, leaf type, source.")
 
     def mesh(self, tile: str) -> Path:
         """Triangle mesh of *tile*, its own surfaces and the buffer around it."""
@@ -87,6 +91,10 @@ class CityDir(_Ingested):
 
     def surface_part(self, tile: str) -> Path:
         return self.surfaces / f"tile={tile}" / "part-0.parquet"
+
+    def trees_file(self, tile: str) -> Path:
+        """The trees whose crowns *tile*'s rays can meet (own and buffer)."""
+        return self.trees / f"{tile}.npz"
 
 
 #: the tables of ``gtfs/``, each ``<name>.parquet``

@@ -319,7 +319,7 @@ class TripModel:
 
         return get_scene(self.data_dir, tile, cache_size=64)
 
-    def reflector_lit(self, rows, sun, facing) -> np.ndarray:
+    def reflector_lit(self, rows, sun, facing, classes=None) -> np.ndarray:
         """Sunlit fraction (0..1) of each stored reflector's sample points, (n, J).
 
         Parameters
@@ -327,26 +327,38 @@ class TripModel:
         rows : (n,) int, rows of the stored geometry
         sun : (n, 3) float32, unit vectors towards the sun
         facing : (n, J) bool, reflectors facing the sun (the others stay 0)
+        classes : (n,) int, optional, each pass's class of months (the tree crowns'
+            transmittance of a ray the buildings let through; 0)
 
         One occlusion ray per sample point, from the same origins as the simulation's
         (``reflector_sampling: all``): the mean of its one-point-per-pass estimate.
         """
         geo = self._packed
-        J = geo["wn"].shape[1]
+        J = geo["wn"].shape[2]
         gp = geo["group_p"]
         P = gp.shape[1]
         lit = np.zeros(facing.shape, np.float32)
         pi, gi = np.nonzero(facing)
         if not len(pi):
             return lit
+        cls = np.zeros(len(rows), np.int64) if classes is None else np.asarray(classes, np.int64)
         pair = rows[pi] * J + gi
         tiles = self._tile[rows[pi]]
+        L = self.cfg.irradiance.ray_length_m
         for tile in np.unique(tiles):
             sel = np.flatnonzero(tiles == tile)
             o = gp[pair[sel]].reshape(-1, 3)
             d = np.repeat(sun[pi[sel]], P, axis=0)
-            occ = self._scene(tile).occluded(o, d, self.cfg.irradiance.ray_length_m)
-            lit[pi[sel], gi[sel]] = (P - occ.reshape(-1, P).sum(1)) / np.float32(P)
+            scene = self._scene(tile)
+            T = (~scene.occluded(o, d, L)).astype(np.float32)
+            crowns = scene.crowns(self.cfg.irradiance)
+            if crowns is not None:
+                free = np.flatnonzero(T > 0)
+                T[free] = crowns.transmittance(o[free] - scene.origin, d[free], L,
+                                               np.repeat(cls[pi[sel]], P)[free])
+            # each point's factor through the crowns: the reflector as the roof sees it
+            f = geo["group_f"][pair[sel], :, cls[pi[sel]]]
+            lit[pi[sel], gi[sel]] = (T.reshape(-1, P) * f).sum(1) / np.float32(P)
         return lit
 
     def sun_visible(self, rows, sun, elevation_deg, azimuth_deg, in_front) -> np.ndarray:
@@ -382,6 +394,22 @@ class TripModel:
         self.rays_for_direct = len(unsure)
         return visible
 
+    def sun_transmittance(self, rows, sun, visible, classes) -> np.ndarray:
+        """The tree crowns' transmittance of the sun ray of passes the buildings let it
+        through (*visible*), in each pass's class of months (float32; 0 where not visible):
+        :meth:`vipvflow.models.trees.Crowns.transmittance` from the simulation's ray origin."""
+        out = visible.astype(np.float32)
+        idx = np.flatnonzero(visible)
+        tiles = self._tile[rows[idx]]
+        for tile in np.unique(tiles):
+            sel = idx[tiles == tile]
+            scene = self._scene(tile)
+            crowns = scene.crowns(self.cfg.irradiance)
+            if crowns is not None:
+                out[sel] = crowns.transmittance(self._packed["p"][rows[sel]] - scene.origin, sun[sel],
+                                                self.cfg.irradiance.ray_length_m, classes[sel])
+        return out
+
     def irradiance(self, segment_ids, t_utc) -> dict:
         """Roof irradiance components (W/m2) of segments at times, from stored factors.
 
@@ -397,17 +425,20 @@ class TripModel:
         estimate of the reflected beam for that pass), ``sun_visible`` (bool),
         ``elevation, azimuth`` (deg), ``ghi, dni, dhi`` (W/m2).
         """
-        from ..models.irradiance import ROULETTE_WEIGHT, roof_components, sky_terms
+        from ..models.irradiance import ROULETTE_WEIGHT, pass_classes, roof_components, sky_terms
         from ..models.sky import COS_85
+        from ..models.trees import month_of
         from ..models.view_factors import isotropic_sky_view
 
         f32 = np.float32
         rows = self._row[np.asarray(segment_ids, np.int64)]
         if (rows < 0).any():
             raise KeyError("segments without stored geometry")
+        t_utc = np.asarray(t_utc, np.float64)
         loc = None if self._loc is None else self._loc[rows]
-        rad = self.radiation.lookup(np.asarray(t_utc, np.float64), location=loc, angles=True)
+        rad = self.radiation.lookup(t_utc, location=loc, angles=True)
         geo = self._packed
+        cls = pass_classes(geo, rows, month_of(t_utc))
         dni, dhi, ghi = (np.nan_to_num(np.asarray(rad[c], f32)) for c in ("dni", "dhi", "ghi"))
         sun = np.nan_to_num(np.stack([rad["sun_x"], rad["sun_y"], rad["sun_z"]], 1).astype(f32))
         elev = 90.0 - np.nan_to_num(rad["zenith"], nan=180.0).astype(np.float64)
@@ -415,28 +446,32 @@ class TripModel:
         nrm = geo["n"][rows]
         cos_aoi = np.where(up, np.maximum(np.einsum("ij,ij->i", nrm, sun), 0), 0).astype(f32)
         visible = self.sun_visible(rows, sun, elev, np.nan_to_num(rad["azimuth"]), up & (cos_aoi > 0))
+        vis_t = self.sun_transmittance(rows, sun, visible & up & (cos_aoi > 0), cls)
         iso = isotropic_sky_view(nrm[:, 2])
-        sky = geo["svf"][rows] if self.cfg.irradiance.diffuse_model != "isotropic" else iso
+        sky = geo["svf"][rows, cls] if self.cfg.irradiance.diffuse_model != "isotropic" else iso
         cfg = self.cfg.irradiance
-        J = geo["wn"].shape[1] if (cfg.reflection and cfg.max_reflector_groups) else 0
+        J = geo["wn"].shape[2] if (cfg.reflection and cfg.max_reflector_groups) else 0
         beam = np.zeros((len(rows), J), f32)
         if J:
-            beam[up] = np.einsum("igj,ij->ig", geo["wn"][rows[up]], sun[up])
+            beam[up] = np.einsum("igj,ij->ig", geo["wn"][rows[up], cls[up]], sun[up])
             beam = np.maximum(beam, 0)
-            r_sky, r_ghi = geo["refl_sky"][rows], geo["refl_ghi"][rows]
+            r_sky, r_ghi = geo["refl_sky"][rows, cls], geo["refl_ghi"][rows, cls]
         else:
             r_sky = r_ghi = np.zeros(len(rows), f32)
-        lit = self.reflector_lit(rows, sun, beam > 0)
+        lit = self.reflector_lit(rows, sun, beam > 0, cls)
         terms = None
         if cfg.diffuse_model == "perez_svf":
-            terms = {**sky_terms(geo, rows, sun[:, 2], bool(J)),
+            terms = {**sky_terms(geo, rows, sun[:, 2], bool(J), cls),
                      "f1": np.nan_to_num(np.asarray(rad["f1"], f32)),
                      "f2": np.nan_to_num(np.asarray(rad["f2"], f32))}
             if geo["sky_x"].shape[1]:            # the sky the roof point sees, as the run
                 terms["share"], terms["share_open"] = self.radiation.sky_share(
-                    np.asarray(t_utc, np.float64), geo["sky_x"][rows], nrm, loc)
+                    t_utc, geo["sky_x"][rows], nrm, loc)
+                if geo["tsky"].shape[2]:         # less what the crowns take from it
+                    terms["share"] = terms["share"] - self.radiation.sky_tree_share(
+                        t_utc, geo["tsky"][rows, cls], nrm, loc)
         direct, diffuse, reflected, unshaded = roof_components(
-            dni, dhi, ghi, cos_aoi, visible, sky, beam, lit, r_sky, r_ghi, iso, terms)
+            dni, dhi, ghi, cos_aoi, vis_t, sky, beam, lit, r_sky, r_ghi, iso, terms)
         # the run's estimate of a reflector's beam, per pass: one sample point (0 or 1),
         # faint reflectors traced only now and then at a larger weight (irradiance._roulette):
         # variance b max(b, ROULETTE_WEIGHT) L - b^2 L^2 each

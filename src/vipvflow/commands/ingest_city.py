@@ -14,7 +14,8 @@ def register(sub):
         "city", help="read CityGML LoD2 files into tiled surfaces, tile meshes and terrain",
         description="Stream-read CityGML 1.0/2.0/3.0 files (.gml, .xml, .gml.gz or .zip) and "
                     "write <data-dir>/city/: surfaces per tile (GeoParquet), tile meshes, "
-                    "tiles.json, terrain.npz and ingest_report.json.")
+                    "tiles.json, terrain.npz, the trees' crowns (CityGML vegetation and tree "
+                    "tables: trees.parquet, trees/) and ingest_report.json.")
     p.add_argument("files", nargs="*", type=Path,
                    help="CityGML files (default: inputs.citygml of the config)")
     p.add_argument("--data-dir", type=Path, default=None,
@@ -27,6 +28,12 @@ def register(sub):
                         "geographic CRSs; for projected ones the order that fits the CRS's area "
                         "of use, easting first when both do), epsg (always the EPSG order), "
                         "xy (always easting/longitude first)")
+    p.add_argument("--trees", type=Path, action="append", default=None, metavar="TABLE",
+                   help="a tree table (CSV or GeoParquet points: height, crown_diameter, ...; "
+                        "repeat for more); default: inputs.trees of the config")
+    p.add_argument("--trees-crs", default=None,
+                   help="CRS of a CSV tree table's x/y columns (default: inputs.trees_crs, else "
+                        "the city's)")
     add_config(p)
     add_accept(p)
     p.add_argument("--quiet", "-q", action="store_true",
@@ -44,9 +51,11 @@ def run(args):
         raise InputError("no CityGML file given (pass FILE... or set inputs.citygml in --config)")
     data_dir = args.data_dir or cfg.data_dir
     crs = args.crs or cfg.inputs.citygml_crs
+    trees = list(args.trees) if args.trees else list(cfg.inputs.trees)
     with ingest_lock(data_dir):
         report = ingest_city(files, data_dir, cfg.city, crs=crs, axis_order=args.axis_order,
-                             accept=accepted(cfg, args))
+                             accept=accepted(cfg, args), trees=trees,
+                             trees_crs=args.trees_crs or cfg.inputs.trees_crs)
     print(report.summary())
     print(f"report: {report.report_path}")
     return 0

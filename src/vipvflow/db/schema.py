@@ -31,7 +31,7 @@ _PV = ["pv_kwh", "pv_kwh_clear", "pv_kwh_unshaded", "pv_kwh_clear_unshaded",
        "pv_kwh_direct", "pv_kwh_diffuse", "pv_kwh_reflected"]
 _H = ["h_direct", "h_diffuse", "h_reflected", "h_total", "h_total_unshaded",
       "h_direct_clear", "h_diffuse_clear", "h_reflected_clear", "h_total_clear",
-      "h_total_clear_unshaded", "h_ghi", "h_ghi_clear"]
+      "h_total_clear_unshaded", "h_ghi", "h_ghi_clear", "h_direct_no_trees", "h_diffuse_no_trees"]
 _F = "double precision"
 
 

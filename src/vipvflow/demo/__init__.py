@@ -3,8 +3,8 @@
 :func:`generate_demo` writes, in the real input formats, everything a run needs:
 
 ``demo_city.gml``
-    CityGML 2.0 LoD2 in LUREF + NG-L heights (EPSG:2169 + EPSG:5774): terrain as TIN relief
-    and buildings along the lines (:mod:`.city`);
+    CityGML 2.0 LoD2 in LUREF + NG-L heights (EPSG:2169 + EPSG:5774): terrain as TIN relief,
+    buildings and street trees along the lines (:mod:`.city`);
 ``demo_gtfs.zip``
     GTFS feed of the lines and a year of service (:mod:`.gtfs`);
 ``cams_radiation_demo.csv``
@@ -31,7 +31,7 @@ from pyproj import Transformer
 from ..progress import Progress
 from ..store import atomic_path, write_text
 from .cams import write_cams_csv
-from .city import SRS_NAME, Terrain, place_buildings, terminus_ends, write_citygml
+from .city import SRS_NAME, Terrain, place_buildings, place_trees, terminus_ends, write_citygml
 from .gtfs import AVERAGE_SPEED_KMH, AGENCY_TZ, stop_positions, stop_offsets, trips_per_year, write_gtfs
 from .layout import CENTRE_XY, CRS, Layout, build_layout
 
@@ -51,7 +51,7 @@ def _rounded(xy, nd: int = 2) -> list:
     return np.round(np.asarray(xy, dtype=float), nd).tolist()
 
 
-def layout_document(layout: Layout, year: int, buildings, terrain: Terrain) -> dict:
+def layout_document(layout: Layout, year: int, buildings, terrain: Terrain, trees=()) -> dict:
     """The ground truth of the demo as a JSON-ready dict (coordinates in EPSG:2169)."""
     to_wgs84 = Transformer.from_crs(CRS, "EPSG:4326", always_xy=True)
     lon, lat = to_wgs84.transform(*CENTRE_XY)
@@ -75,6 +75,9 @@ def layout_document(layout: Layout, year: int, buildings, terrain: Terrain) -> d
     by_stretch: dict[str, list] = {}
     for b in buildings:
         by_stretch.setdefault(b.stretch_id, []).append(b)
+    trees_of: dict[str, int] = {}
+    for t in trees:
+        trees_of[t.stretch_id] = trees_of.get(t.stretch_id, 0) + 1
     stretches = []
     for st in layout.stretches():
         own = by_stretch.get(st.stretch_id, [])
@@ -86,7 +89,7 @@ def layout_document(layout: Layout, year: int, buildings, terrain: Terrain) -> d
             "length_m": round(st.length_m, 2), "width_m": st.width_m, "setback_m": st.setback_m,
             "building_height_m": round(float(eaves.mean()), 2),
             "building_height_range_m": [round(float(eaves.min()), 2), round(float(eaves.max()), 2)],
-            "n_buildings": len(own),
+            "n_buildings": len(own), "n_trees": trees_of.get(st.stretch_id, 0),
             "centerline": _rounded(st.xy, 3),
             "polygon": _rounded(shapely.get_coordinates(shapely.get_exterior_ring(poly)), 2),
         })
@@ -147,10 +150,11 @@ def _generate(paths: dict, seconds: dict, year: int, seed: int, size: str, bar) 
     layout = build_layout(seed, size)
     terrain = Terrain(layout.bounds(TERRAIN_MARGIN_M), seed)
     buildings = place_buildings(layout, terrain, seed)
+    trees = place_trees(layout, terrain, buildings, seed)
     near = shapely.union_all([shapely.buffer(shapely.linestrings(line.xy), TERRAIN_NEAR_M)
                               for line in layout.lines])
     with atomic_path(paths["citygml"]) as tmp:
-        city = write_citygml(tmp, buildings, terrain, near)
+        city = write_citygml(tmp, buildings, terrain, near, trees)
     seconds["citygml"] = time.perf_counter() - t
     bar.update(1, "GTFS")
 
@@ -161,7 +165,7 @@ def _generate(paths: dict, seconds: dict, year: int, seed: int, size: str, bar) 
     bar.update(1, "layout")
 
     t = time.perf_counter()
-    doc = layout_document(layout, year, buildings, terrain)
+    doc = layout_document(layout, year, buildings, terrain, trees)
     write_text(_NUMBER_LIST.sub(lambda m: "[" + " ".join(m.group(1).split()) + "]",
                                 json.dumps(doc, indent=1)) + "\n", paths["layout"])
     seconds["layout"] = time.perf_counter() - t

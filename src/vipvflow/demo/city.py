@@ -1,4 +1,4 @@
-"""The demo town as CityGML 2.0 LoD2: terrain (TIN relief) and buildings along the lines.
+"""The demo town as CityGML 2.0 LoD2: terrain (TIN relief), buildings and street trees.
 
 Buildings are rectangular footprints placed in rows along the street stretches of the
 :mod:`~vipvflow.demo.layout` (continuous perimeter-block rows in canyons, detached houses
@@ -6,8 +6,18 @@ with gaps in suburban stretches, none in open stretches), standing on the terrai
 flat, gabled or hipped roofs.  Every building is a closed shell of planar polygons whose
 vertices run counter-clockwise seen from outside (outward normals).
 
+Street trees line the canyon and suburban stretches (:func:`place_trees`): small-crowned
+limes, maples and planes on the canyons' pavements, larger crowns of several genera (a few
+pines among them) on the suburban verges, their crowns 4 m or more above the road (as
+trees over bus routes are pruned), none in a building or over another street's carriageway.
+Each is a ``veg:SolitaryVegetationObject`` with its species, height, crown and trunk diameter
+and crown base (a generic attribute), and an implicit geometry (a unit tree of trunk and
+low-poly crown, defined once per crown shape and referred to by xlink, scaled by its
+transformation matrix and placed at its reference point), as tree cadastres and LiDAR
+tree models write them.
+
 The file is written element by element (lxml, one
-``core:cityObjectMember`` per building and one ``dem:ReliefFeature`` per 1 km terrain tile),
+``core:cityObjectMember`` per building, tree and ``dem:ReliefFeature`` per 1 km terrain tile),
 so a reader can stream it.
 """
 from __future__ import annotations
@@ -27,6 +37,8 @@ NS = {
     "core": "http://www.opengis.net/citygml/2.0",
     "bldg": "http://www.opengis.net/citygml/building/2.0",
     "dem": "http://www.opengis.net/citygml/relief/2.0",
+    "veg": "http://www.opengis.net/citygml/vegetation/2.0",
+    "gen": "http://www.opengis.net/citygml/generics/2.0",
     "gml": "http://www.opengis.net/gml",
     "xlink": "http://www.w3.org/1999/xlink",
     "xsi": "http://www.w3.org/2001/XMLSchema-instance",
@@ -35,7 +47,11 @@ SCHEMA_LOCATION = (
     "http://www.opengis.net/citygml/building/2.0 "
     "http://schemas.opengis.net/citygml/building/2.0/building.xsd "
     "http://www.opengis.net/citygml/relief/2.0 "
-    "http://schemas.opengis.net/citygml/relief/2.0/relief.xsd")
+    "http://schemas.opengis.net/citygml/relief/2.0/relief.xsd "
+    "http://www.opengis.net/citygml/vegetation/2.0 "
+    "http://schemas.opengis.net/citygml/vegetation/2.0/vegetation.xsd "
+    "http://www.opengis.net/citygml/generics/2.0 "
+    "http://schemas.opengis.net/citygml/generics/2.0/generics.xsd")
 # roof type codes of the SIG3D/AdV code list used by German and Luxembourg LoD2 data
 ROOF_TYPE_CODE = {"flat": "1000", "gabled": "1030", "hipped": "1040"}
 _ROOF_MIX = {"canyon": {"flat": 0.35, "gabled": 0.5, "hipped": 0.15},
@@ -424,15 +440,16 @@ def _fragment(el: etree._Element) -> bytes:
     return _XMLNS.sub(b"", text[:end]) + text[end:]
 
 
-def write_citygml(path: Path, buildings: list[Building], terrain: Terrain, near=None) -> dict:
+def write_citygml(path: Path, buildings: list[Building], terrain: Terrain, near=None,
+                  trees: list | None = None) -> dict:
     """Write the CityGML 2.0 file; return counts of what it holds.
 
-    One ``core:cityObjectMember`` per building and per terrain tile, written one after the
-    other (the file is never held in memory).  *near* (shapely geometry, optional) limits
-    the terrain to the 1 km tiles it touches.
+    One ``core:cityObjectMember`` per building, per tree (*trees*, :func:`place_trees`) and per
+    terrain tile, written one after the other (the file is never held in memory).  *near*
+    (shapely geometry, optional) limits the terrain to the 1 km tiles it touches.
     """
     counts = {"buildings": 0, "roof_surfaces": 0, "wall_surfaces": 0, "ground_surfaces": 0,
-              "terrain_triangles": 0, "relief_features": 0}
+              "terrain_triangles": 0, "relief_features": 0, "trees": 0}
     top = max([b.ridge_z for b in buildings], default=float(terrain.grid.max()))
     lo = (*terrain.bounds[:2], float(terrain.grid.min()))
     hi = (*terrain.bounds[2:], max(top, float(terrain.grid.max())))
@@ -456,5 +473,149 @@ def write_citygml(path: Path, buildings: list[Building], terrain: Terrain, near=
             counts["buildings"] += 1
             for kind, _ in b.surfaces():
                 counts[f"{kind}_surfaces"] += 1
+        defined: set = set()
+        for tree in trees or ():
+            fh.write(_fragment(tree_member(tree, defined)))
+            counts["trees"] += 1
         fh.write(head[head.rindex(b"</"):])
     return counts
+
+
+# --------------------------------------------------------------------------- street trees
+@dataclass
+class Tree:
+    gml_id: str
+    stretch_id: str
+    species: str
+    x: float
+    y: float
+    z: float                # ground at the trunk (m)
+    height: float           # m above the ground
+    crown_diameter: float   # m
+    crown_base: float       # m above the ground
+    trunk_diameter: float   # m
+
+
+#: species of the street trees (botanical names), per stretch kind
+_SPECIES = {"canyon": ("Tilia cordata", "Acer platanoides", "Platanus x hispanica"),
+            "suburban": ("Acer platanoides", "Tilia cordata", "Betula pendula", "Quercus robur",
+                         "Prunus avium", "Pinus nigra")}
+_SPECIES_P = {"canyon": (0.45, 0.35, 0.20), "suburban": (0.25, 0.22, 0.17, 0.15, 0.13, 0.08)}
+#: unit trees (trunk to crown base share of the height) the implicit geometries refer to
+CROWN_SHAPES = (0.3, 0.4, 0.5)
+
+
+def place_trees(layout: Layout, terrain: Terrain, buildings: list[Building], seed: int) -> list[Tree]:
+    """Street trees along the canyon and suburban stretches (none in the open).
+
+    Canyons: a tree every 10-14 m on each pavement, 3 m from the facades, crowns of
+    4.5-5.2 m (clear of the facades), 9-13 m high, crown base 4.0-5.0 m.  Suburban
+    stretches: a tree every 12-18 m on each verge 1.5 m beyond the road edge, crowns of 6-10
+    m, 10-18 m high, crown base 4.0-5.5 m.  A quarter of the places stay empty (driveways,
+    crossings); a tree whose trunk stands on another street's carriageway or whose crown
+    meets a building is dropped.  Drawn from their own stream of *seed* (the buildings are
+    those of the generator without trees).
+    """
+    rng = np.random.default_rng([seed, 5])
+    footprints = shapely.STRtree(shapely.polygons([b.footprint for b in buildings])) if buildings else None
+    roads = []
+    for st in layout.stretches():
+        half = st.width_m / 2 - (3.0 if st.kind == "canyon" else 0.0)
+        roads.append((st.stretch_id, shapely.buffer(shapely.linestrings(st.xy), half, cap_style="flat")))
+    road_tree = shapely.STRtree([r for _, r in roads])
+    trees = []
+    for st in layout.stretches():
+        if st.kind not in _SPECIES:
+            continue
+        canyon = st.kind == "canyon"
+        offset = st.width_m / 2 - 3.0 if canyon else st.width_m / 2 + 1.5
+        for a, b in zip(st.xy[:-1], st.xy[1:]):
+            L = float(np.hypot(*(b - a)))
+            u = (b - a) / L
+            n = np.array([-u[1], u[0]])
+            for side in (1, -1):
+                s = float(rng.uniform(2.0, 8.0))
+                while s < L - 2.0:
+                    step = rng.uniform(10.0, 14.0) if canyon else rng.uniform(12.0, 18.0)
+                    keep = rng.random() >= 0.25
+                    if canyon:
+                        crown, height, base = rng.uniform(4.5, 5.2), rng.uniform(9.0, 13.0), rng.uniform(4.0, 5.0)
+                    else:
+                        crown, height, base = rng.uniform(6.0, 10.0), rng.uniform(10.0, 18.0), rng.uniform(4.0, 5.5)
+                    species = str(rng.choice(_SPECIES[st.kind], p=_SPECIES_P[st.kind]))
+                    p = a + s * u + side * offset * n
+                    s += step
+                    if not keep:
+                        continue
+                    trunk = shapely.Point(*p)
+                    hits = road_tree.query(trunk, predicate="intersects")
+                    if any(roads[i][0] != st.stretch_id for i in hits):
+                        continue
+                    if footprints is not None and len(footprints.query(
+                            shapely.buffer(trunk, crown / 2 + 0.3), predicate="intersects")):
+                        continue
+                    z = float(np.round(terrain.z(p[0], p[1]), 3))
+                    trees.append(Tree(f"tree_{len(trees):05d}", st.stretch_id, species,
+                                      float(np.round(p[0], 3)), float(np.round(p[1], 3)), z,
+                                      round(float(height), 2), round(float(crown), 2),
+                                      round(float(base), 2), round(float(0.025 * height + 0.1), 2)))
+    return trees
+
+
+def unit_tree(shape: float, n_az: int = 8) -> list[np.ndarray]:
+    """Polygons (rings, counter-clockwise from outside) of a unit tree: an octagonal trunk of
+    radius 0.03 from 0 to *shape* and a low-poly spheroid crown of radius 0.5 from *shape*
+    to 1 (rings at 30, 60, 90, 120 and 150 deg from its bottom)."""
+    az = 2 * np.pi * np.arange(n_az) / n_az
+    c = (1.0 - shape) / 2
+    zc = shape + c
+    polar = np.radians([30.0, 60.0, 90.0, 120.0, 150.0])
+    rings = [np.stack([0.5 * np.sin(t) * np.sin(az), 0.5 * np.sin(t) * np.cos(az),
+                       np.full(n_az, zc - c * np.cos(t))], 1) for t in polar]
+    bottom, top = np.array([0.0, 0.0, shape]), np.array([0.0, 0.0, 1.0])
+    polys = []
+    for k in range(n_az):
+        j = (k + 1) % n_az
+        polys.append(np.array([bottom, rings[0][j], rings[0][k]]))
+        for lo, hi in zip(rings[:-1], rings[1:]):
+            polys.append(np.array([lo[k], lo[j], hi[j], hi[k]]))
+        polys.append(np.array([rings[-1][k], rings[-1][j], top]))
+    tr = 0.03
+    b = [np.array([tr * np.sin(a), tr * np.cos(a), 0.0]) for a in az]
+    t = [np.array([tr * np.sin(a), tr * np.cos(a), shape]) for a in az]
+    for k in range(n_az):
+        j = (k + 1) % n_az
+        polys.append(np.array([b[k], b[j], t[j], t[k]]))
+    return polys
+
+
+def tree_member(tree: Tree, defined: set) -> etree._Element:
+    """``core:cityObjectMember`` holding the ``veg:SolitaryVegetationObject`` of *tree*: its
+    attributes and its ``lod2ImplicitRepresentation`` (the unit tree of the crown shape
+    nearest its own, inline the first time (*defined* remembers it), else by xlink)."""
+    member = _member()
+    el = etree.SubElement(member, _q("veg", "SolitaryVegetationObject"), {_q("gml", "id"): tree.gml_id})
+    etree.SubElement(el, _q("gml", "name")).text = f"street tree {tree.gml_id}"
+    att = etree.SubElement(el, _q("gen", "doubleAttribute"), name="crown_base")
+    etree.SubElement(att, _q("gen", "value")).text = f"{tree.crown_base:.2f}"
+    etree.SubElement(el, _q("veg", "species")).text = tree.species
+    etree.SubElement(el, _q("veg", "height"), uom="m").text = f"{tree.height:.2f}"
+    etree.SubElement(el, _q("veg", "trunkDiameter"), uom="m").text = f"{tree.trunk_diameter:.2f}"
+    etree.SubElement(el, _q("veg", "crownDiameter"), uom="m").text = f"{tree.crown_diameter:.2f}"
+    shape = min(CROWN_SHAPES, key=lambda f: abs(f - tree.crown_base / tree.height))
+    tid = f"unit_tree_{int(round(shape * 100)):02d}"
+    rep = etree.SubElement(el, _q("veg", "lod2ImplicitRepresentation"))
+    ig = etree.SubElement(rep, _q("core", "ImplicitGeometry"))
+    m = np.diag([tree.crown_diameter, tree.crown_diameter, tree.height, 1.0])
+    etree.SubElement(ig, _q("core", "transformationMatrix")).text = " ".join(f"{v:g}" for v in m.ravel())
+    rel = etree.SubElement(ig, _q("core", "relativeGMLGeometry"))
+    if tid in defined:
+        rel.set(_q("xlink", "href"), f"#{tid}")
+    else:
+        defined.add(tid)
+        ms = etree.SubElement(rel, _q("gml", "MultiSurface"), {_q("gml", "id"): tid})
+        for ring in unit_tree(shape):
+            _polygon(etree.SubElement(ms, _q("gml", "surfaceMember")), None, ring)
+    pt = etree.SubElement(etree.SubElement(ig, _q("core", "referencePoint")), _q("gml", "Point"))
+    etree.SubElement(pt, _q("gml", "pos"), srsDimension="3").text = f"{tree.x:.3f} {tree.y:.3f} {tree.z:.3f}"
+    return member

@@ -53,6 +53,7 @@ import pandas as pd
 
 from .params import IrradianceCfg
 from .sky import COS_85
+from .trees import month_of
 from .view_factors import _CHUNK, COMPONENTS, isotropic_sky_view, pack_geometry
 
 
@@ -212,7 +213,8 @@ def _roulette(pi, gi, weight, key):
 
 
 def roof_irradiance(geometry, rows, sun: np.ndarray, rad: dict, scene, cfg: IrradianceCfg,
-                    ground_albedo: float = 0.20, sample=None, timings: dict | None = None) -> dict:
+                    ground_albedo: float = 0.20, sample=None, timings: dict | None = None,
+                    month=None) -> dict:
     """Irradiance components for arrays of passes (the hot path), eqs. (1)-(3).
 
     Parameters
@@ -220,7 +222,11 @@ def roof_irradiance(geometry, rows, sun: np.ndarray, rad: dict, scene, cfg: Irra
     geometry : DataFrame from :func:`segment_geometry`, or its :func:`pack_geometry`
     rows : (n,) int, row of *geometry* for each pass
     sun : (n, 3) float32, unit vector towards the sun (east, north, up)
-    rad : dict of (n,) arrays ``ghi, dni, dhi, ghi_clear, dni_clear, dhi_clear`` (W/m2)
+    rad : dict of (n,) arrays ``ghi, dni, dhi, ghi_clear, dni_clear, dhi_clear`` (W/m2);
+        under the Perez sky also ``f1, f2`` (and ``_clear``) and, with the geometry's sky
+        sectors, ``sky_share, sky_open`` (and ``_clear``), with crowns in the sky
+        ``sky_tree`` (and ``_clear``): the share of DHI they take
+        (:meth:`RadiationTable.sky_tree_share`)
     scene : vipvflow.models.shading.Scene
     cfg : IrradianceCfg
     ground_albedo : float, albedo of the open ground seen by reflectors (used when packing)
@@ -233,17 +239,24 @@ def roof_irradiance(geometry, rows, sun: np.ndarray, rad: dict, scene, cfg: Irra
     timings : dict, optional
         Seconds spent are added to its ``ray_setup_s``, ``rays_s`` and ``components_s``
         (the caller times; the kernel keeps no state).
+    month : (n,) int, optional, the month (1..12) of each pass: the crowns' class of months
+        (:mod:`vipvflow.models.trees`); needed where the geometry has more than one
 
     Returns
     -------
-    dict of (n,) float32 arrays, W/m2: :data:`COMPONENTS` and ``sun_visible`` (bool).
-    Rays are cast only with the sun up and a beam in either channel: one per pass with the
-    sun in front of the roof, and for every reflector (group or street) facing the sun
-    either one ray per sample point (``reflector_sampling: all``: the lit fraction, in steps
-    of 1/P) or one ray from one sample point taken in turn (``rotate``: the lit fraction is
-    0 or 1 for that pass, and its mean over passes is the P-point lit fraction, an unbiased
-    estimate with P times fewer rays); all in one occlusion query, and the same visibility
-    serves all-sky and clear-sky.  The components are summed by :func:`roof_components`.
+    dict of (n,) float32 arrays, W/m2: :data:`COMPONENTS` and ``sun_visible`` (bool: the sun
+    ray misses the buildings; the crowns it crosses then pass their transmittance of the
+    beam).  Rays are cast only with the sun up and a beam in either channel: one per pass
+    with the sun in front of the roof, and for every reflector (group or street) facing the
+    sun either one ray per sample point (``reflector_sampling: all``: the lit fraction, in
+    steps of 1/P without crowns) or one ray from one sample point taken in turn (``rotate``:
+    the lit fraction is 0 or the crowns' transmittance for that pass, and its mean over
+    passes is the P-point lit fraction, an unbiased estimate with P times fewer rays); all
+    in one occlusion query, and the same visibility serves all-sky and clear-sky.  A ray the
+    buildings let through is traced through the tile's crowns
+    (:meth:`vipvflow.models.trees.Crowns.transmittance`).  The components are summed by
+    :func:`roof_components`; ``direct_no_trees`` and ``diffuse_no_trees`` are the direct
+    and diffuse light with the buildings alone (all-sky).
 
     References
     ----------
@@ -259,6 +272,8 @@ def roof_irradiance(geometry, rows, sun: np.ndarray, rad: dict, scene, cfg: Irra
     sun = np.asarray(sun, f32)
     n = len(rows)
     nrm = geo["n"][rows]
+    crowns = scene.crowns(cfg) if hasattr(scene, "crowns") else None
+    cls = pass_classes(geo, rows, month)
     dni, dhi, ghi = _finite(rad["dni"]), _finite(rad["dhi"]), _finite(rad["ghi"])
     dnic, dhic, ghic = _finite(rad["dni_clear"]), _finite(rad["dhi_clear"]), _finite(rad["ghi_clear"])
     perez = cfg.diffuse_model == "perez_svf"
@@ -280,14 +295,14 @@ def roof_irradiance(geometry, rows, sun: np.ndarray, rad: dict, scene, cfg: Irra
     cos_aoi = np.zeros(n, f32)
     cos_aoi[lit] = np.maximum(np.einsum("ij,ij->i", nrm[lit], sl), 0)
     cand = lit[cos_aoi[lit] > 0]
-    G = geo["wn"].shape[1] if (cfg.reflection and cfg.max_reflector_groups) else 0
+    G = geo["wn"].shape[2] if (cfg.reflection and cfg.max_reflector_groups) else 0
     # reflectors facing the sun: (pass, reflector) pairs, P points each (or one of them,
     # in turn); every ray of the chunk (direct first) goes into one occlusion query
     nd = len(cand)
     gp = geo["group_p_local"] if local else geo["group_p"]
     P = gp.shape[1]
     if G and len(lit):
-        wc = np.einsum("igj,ij->ig", geo["wn"][rows_lit], sl)
+        wc = np.einsum("igj,ij->ig", geo["wn"][rows_lit, cls[lit]], sl)
         pi, gi = np.nonzero(wc > 0)
     else:
         pi = gi = np.zeros(0, np.int64)
@@ -300,6 +315,7 @@ def roof_irradiance(geometry, rows, sun: np.ndarray, rad: dict, scene, cfg: Irra
     per_pair = 1 if rotate else P
     nr = nd + per_pair * len(pi)
     visible = np.zeros(n, bool)
+    vis_t = np.zeros(n, f32)              # the sun ray's transmittance: 0 or the crowns'
     beam_sum = np.zeros(n, f32)           # sum over reflectors of weight x cos x lit
     if nr:
         o = np.empty((nr, 3), f32 if local else np.float64)
@@ -318,22 +334,39 @@ def roof_irradiance(geometry, rows, sun: np.ndarray, rad: dict, scene, cfg: Irra
         t_rays = time.perf_counter()
         occ = (scene.occluded_local(o, d, cfg.ray_length_m) if local
                else scene.occluded(o, d, cfg.ray_length_m))
+        # the crowns along each ray the buildings let through, in its pass's class
+        T = (~occ).astype(f32)
+        if crowns is not None and nr:
+            free = np.flatnonzero(~occ)
+            ray_pass = np.empty(nr, np.int64)
+            ray_pass[:nd] = cand
+            ray_pass[nd:] = np.repeat(lit[pi], per_pair)
+            oo = o[free].astype(np.float64) - (0.0 if local else scene.origin)
+            T[free] = crowns.transmittance(oo, d[free], cfg.ray_length_m, cls[ray_pass[free]])
         t_done = time.perf_counter()
         _add_seconds(timings, ray_setup_s=t_rays - t_start, rays_s=t_done - t_rays)
         t_start = t_done
         visible[cand] = ~occ[:nd]
+        vis_t[cand] = T[:nd]
         if len(pi):
+            # each sample point's lit fraction times its factor through the crowns (1
+            # without): the reflector as the roof sees it through them (view_factors._group_points)
+            gf = geo["group_f"]
             if rotate:
-                share = (~occ[nd:]).astype(f32)
+                share = T[nd:] * gf[pair, k, cls[lit[pi]]]
             else:
-                share = (P - occ[nd:].reshape(-1, P).sum(1, dtype=np.int32)) * f32(1.0 / P)
+                share = ((T[nd:].reshape(-1, P) * gf[pair, :, cls[lit[pi]]]).sum(1, dtype=np.float64)
+                         * np.float64(f32(1.0 / P)))
             beam_sum[lit] = np.bincount(pi, beam_w * share, len(lit))
     iso = isotropic_sky_view(nrm[:, 2])
-    sky = geo["svf"][rows] if cfg.diffuse_model != "isotropic" else iso
+    if cfg.diffuse_model != "isotropic":
+        sky, sky_nt = geo["svf"][rows, cls], geo["svf_no_trees"][rows]
+    else:
+        sky = sky_nt = iso
     zero, one = np.zeros(n, f32), np.ones(n, f32)
-    r_sky, r_ghi = (geo["refl_sky"][rows], geo["refl_ghi"][rows]) if G else (zero, zero)
+    r_sky, r_ghi = (geo["refl_sky"][rows, cls], geo["refl_ghi"][rows, cls]) if G else (zero, zero)
     if perez:
-        perez_sky = sky_terms(geo, rows, sun[:, 2], G)
+        perez_sky = sky_terms(geo, rows, sun[:, 2], G, cls)
     out = {}
     for sfx, (b, dh, gh) in (("", (dni, dhi, ghi)), ("_clear", (dnic, dhic, ghic))):
         terms = None
@@ -342,17 +375,41 @@ def roof_irradiance(geometry, rows, sun: np.ndarray, rad: dict, scene, cfg: Irra
             if geo["sky_x"].shape[1]:
                 terms["share"] = _finite(rad["sky_share" + sfx])
                 terms["share_open"] = _finite(rad["sky_open" + sfx])
+                if "sky_tree" + sfx in rad:
+                    terms["share"] = terms["share"] - _finite(rad["sky_tree" + sfx])
         (out["direct" + sfx], out["diffuse" + sfx], out["reflected" + sfx],
-         unshaded) = roof_components(b, dh, gh, cos_aoi, visible, sky, beam_sum[:, None],
+         unshaded) = roof_components(b, dh, gh, cos_aoi, vis_t, sky, beam_sum[:, None],
                                      one[:, None], r_sky, r_ghi, iso, terms)
         out["total" + sfx] = out["direct" + sfx] + out["diffuse" + sfx] + out["reflected" + sfx]
         out[f"total{sfx}_unshaded"] = unshaded
+    # the buildings alone: the sun ray free of them, the sky without crowns
+    terms = None
+    if perez:
+        terms = {**sky_terms(geo, rows, sun[:, 2], G, cls, trees=False), "f1": f1, "f2": f2}
+        if geo["sky_x"].shape[1]:
+            terms["share"], terms["share_open"] = _finite(rad["sky_share"]), _finite(rad["sky_open"])
+    out["direct_no_trees"], out["diffuse_no_trees"], _, _ = roof_components(
+        dni, dhi, ghi, cos_aoi, visible.astype(f32), sky_nt, beam_sum[:, None], one[:, None],
+        r_sky, r_ghi, iso, terms)
     out["sun_visible"] = visible
     _add_seconds(timings, components_s=time.perf_counter() - t_start)
     return out
 
 
-def sky_terms(geo: dict, rows, cos_zenith, with_reflectors: bool = True) -> dict:
+def pass_classes(geo: dict, rows, month=None) -> np.ndarray:
+    """Each pass's class of months (int64): the geometry row's class of the pass's *month*
+    (1..12; :mod:`vipvflow.models.trees`), 0 where the geometry has one class only."""
+    rows = np.asarray(rows, np.int64)
+    tm = geo.get("tree_month")
+    if tm is None or not len(tm) or not tm.any():
+        return np.zeros(len(rows), np.int64)
+    if month is None:
+        raise ValueError("the geometry has classes of months (tree crowns): give each pass's month")
+    return tm[rows, np.asarray(month, np.int64) - 1]
+
+
+def sky_terms(geo: dict, rows, cos_zenith, with_reflectors: bool = True, classes=None,
+              trees: bool = True) -> dict:
     """The per-pass geometry of the Perez sky for :func:`roof_components` (its *sky*
     without ``f1, f2``): the sun's ``cos_zenith``, the roof's ``horizon_view`` and
     ``sin_tilt``, the reflectors' ``reflector_horizon`` (float32, dimensionless).
@@ -363,12 +420,17 @@ def sky_terms(geo: dict, rows, cos_zenith, with_reflectors: bool = True) -> dict
     rows : (n,) int, rows of *geo*
     cos_zenith : (n,) float, up component of the unit vector towards the sun
     with_reflectors : bool, whether the reflectors count (else their horizon weight is 0)
+    classes : (n,) int, optional, each pass's class of months (:func:`pass_classes`; 0)
+    trees : bool, the roof's horizon view through the crowns (else without them)
     """
     f32 = np.float32
+    rows = np.asarray(rows, np.int64)
+    cls = np.zeros(len(rows), np.int64) if classes is None else np.asarray(classes, np.int64)
     nrm = geo["n"][rows]
     sin_tilt = np.sqrt(nrm[:, 0] * nrm[:, 0] + nrm[:, 1] * nrm[:, 1]).astype(f32)
-    return {"cos_zenith": np.asarray(cos_zenith, f32), "horizon_view": geo["hbv"][rows],
-            "reflector_horizon": (geo["refl_hor"][rows] if with_reflectors
+    hbv = geo["hbv"][rows, cls] if trees else geo["hbv_no_trees"][rows]
+    return {"cos_zenith": np.asarray(cos_zenith, f32), "horizon_view": hbv,
+            "reflector_horizon": (geo["refl_hor"][rows, cls] if with_reflectors
                                   else np.zeros(len(rows), f32)),
             "sin_tilt": sin_tilt}
 
@@ -445,8 +507,10 @@ def evaluate_passes(passes: pd.DataFrame, segments: pd.DataFrame, geometry: pd.D
     Returns
     -------
     DataFrame indexed like *passes*: ``direct, diffuse, reflected, total`` and the
-    ``_clear`` variants, ``total_unshaded``, ``total_clear_unshaded``, and the horizontal
-    ``ghi``, ``ghi_clear`` at the pass (float32, W/m2), ``sun_visible`` (bool).
+    ``_clear`` variants, ``total_unshaded``, ``total_clear_unshaded``, ``direct_no_trees``,
+    ``diffuse_no_trees`` (the buildings alone, all-sky), and the horizontal ``ghi``,
+    ``ghi_clear`` at the pass (float32, W/m2), ``sun_visible`` (bool).  The crowns' class
+    of months is the pass's month (UTC calendar, at the time the radiation is taken).
 
     References
     ----------
@@ -506,15 +570,20 @@ def evaluate_passes(passes: pd.DataFrame, segments: pd.DataFrame, geometry: pd.D
         r = row[idx]
         loc = None if loc_col is None else loc_col[r]
         rad = radiation_table.lookup(t[idx], location=loc, angles=False)
+        month = month_of(t[idx])
         if cfg.diffuse_model == "perez_svf" and geo["sky_x"].shape[1]:
+            cls = pass_classes(geo, r, month)
             for sfx in ("", "_clear"):
                 rad["sky_share" + sfx], rad["sky_open" + sfx] = radiation_table.sky_share(
                     t[idx], geo["sky_x"][r], geo["n"][r], loc, clear=bool(sfx))
+                if geo["tsky"].shape[2]:
+                    rad["sky_tree" + sfx] = radiation_table.sky_tree_share(
+                        t[idx], geo["tsky"][r, cls], geo["n"][r], loc, clear=bool(sfx))
         sun = np.stack([rad["sun_x"], rad["sun_y"], rad["sun_z"]], 1)
         key = pass_sample_key(seg[idx], t_start[idx])
         clock["lookup_s"] += time.perf_counter() - t_look
         out = roof_irradiance(geo, r, sun, rad, scene, cfg, ground_albedo, sample=key,
-                              timings=clock)
+                              timings=clock, month=month)
         t_pack = time.perf_counter()
         for j, k in enumerate(COMPONENTS):
             block[idx, j] = out[k]

@@ -39,9 +39,11 @@ FACE_ATTRIBUTES = {
     "normals": (np.float32, 3, None),       # unit outward normal of the face's *surface* (Newell)
 }
 
-#: version of ``city/meshes/<TILE>.npz``: 2 = written from a Trimesh (``faces``, ``face_<name>``
-#: per face attribute, ``format``); 1 (no ``format`` key) = the arrays of vipvflow before it
-MESH_FORMAT = 2
+#: version of ``city/meshes/<TILE>.npz``: 3 = vegetation no longer in the mesh (trees are
+#: crowns of their own, :mod:`vipvflow.models.trees`); 2 = written from a Trimesh (``faces``,
+#: ``face_<name>`` per face attribute, ``format``); 1 (no ``format`` key) = the arrays of
+#: vipvflow before it
+MESH_FORMAT = 3
 
 
 def _face_values(name: str, value, m: int) -> np.ndarray:

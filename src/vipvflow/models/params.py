@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from typing import Literal
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import BaseModel, ConfigDict, Field, field_validator
 
 
 class _Params(BaseModel):
@@ -20,6 +20,34 @@ class CycleCfg(_Params):
     max_decel_mps2: float = Field(1.3, gt=0)
     speed_limit_kmh: float = Field(50.0, gt=0)
     dwell_s: float = Field(20.0, ge=0)
+
+
+class TreeCfg(_Params):
+    """How tree crowns shade the roofs (:mod:`vipvflow.models.trees`).
+
+    A crown transmits ``transmittance_leaf_on`` of the light crossing it while in leaf and a
+    deciduous one ``transmittance_leaf_off`` in its leaf-off months (a ray through several
+    crowns: the product).  Defaults from measurements of single urban trees: in leaf 0.088 to
+    0.275 (Konarska et al. 2014), a sugar maple's shade 80 % darker in leaf and nearly 40 %
+    leafless (Heisler 1986).
+    """
+
+    # false: the city's trees are ignored (the buildings alone shade)
+    enabled: bool = True
+    transmittance_leaf_on: float = Field(0.20, ge=0, le=1)
+    transmittance_leaf_off: float = Field(0.60, ge=0, le=1)
+    # months (1..12) deciduous trees stand leafless; null: November to April north of the
+    # equator, May to October south of it (a tree's own leaf_off_months win)
+    leaf_off_months: list[int] | None = None
+    # trees whose data names no leaf type
+    unknown_leaf_type: Literal["deciduous", "evergreen"] = "deciduous"
+
+    @field_validator("leaf_off_months")
+    @classmethod
+    def _months(cls, v):
+        if v is not None and any(not 1 <= m <= 12 for m in v):
+            raise ValueError(f"leaf_off_months are months 1..12, got {v}")
+        return None if v is None else sorted(set(v))
 
 
 class IrradianceCfg(_Params):
@@ -42,6 +70,8 @@ class IrradianceCfg(_Params):
     # bus is the level ground at the road's height, lit and shaded as it is, with the road's
     # albedo; false: rays that leave the model downwards see an open field lit by GHI
     virtual_street: bool = True
+    # the city's trees (CityGML vegetation, inputs.trees): crowns with a transmittance by season
+    trees: TreeCfg = Field(default_factory=TreeCfg)
     seed: int = 7
 
 

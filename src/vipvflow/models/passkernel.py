@@ -41,19 +41,23 @@ from numba import njit
 
 from .irradiance import ROULETTE_WEIGHT
 from .sky import COS_85, SECTOR_COS, SECTOR_SIN, SKY_AZIMUTH_BINS, SKY_LEVELS
+from .trees import _MAX_HITS, month0, transmit_one
 
 #: components of a pass in the order of the kernel's output block (W/m2)
 BLOCK_COLUMNS = ("direct", "diffuse", "reflected", "total", "direct_clear", "diffuse_clear",
                  "reflected_clear", "total_clear", "total_unshaded", "total_clear_unshaded",
-                 "ghi", "ghi_clear")
+                 "direct_no_trees", "diffuse_no_trees", "ghi", "ghi_clear")
+_NB = len(BLOCK_COLUMNS)
 #: rays in one batch (bounds the batch's memory: 24 bytes a ray)
 RAY_BUDGET = 1 << 21
 #: radiation columns the kernel reads, in this order (then the Perez sky's coefficients)
 _RAD = ("dni", "dhi", "ghi", "dni_clear", "dhi_clear", "ghi_clear", "sun_x", "sun_y", "sun_z",
         "f1", "f2", "f1_clear", "f2_clear")
 _N_RAD = len(_RAD)
-#: per pass after the radiation: the Perez sky tables' row nearest in time
-_N_ROW = _N_RAD + 1
+#: per pass after the radiation: the Perez sky tables' row nearest in time, the crowns'
+#: class of the pass's month
+_N_ROW = _N_RAD + 2
+_CLS = _N_RAD + 1
 _COS_85 = np.float32(COS_85)
 _SEC_SIN = SECTOR_SIN.astype(np.float32)
 _SEC_COS = SECTOR_COS.astype(np.float32)
@@ -74,8 +78,8 @@ def _sample_key(segment_id, t_utc):
 
 @njit(cache=True, nogil=True)
 def _setup(lo, hi, seg, t_start, dt, mid, row, loc_of_row, packed, cols, t0, step,
-           nrm, wn, p_local, gp_local, rotate, roulette_w, perez, sky_rows, sky_t0, sky_step,
-           rad, cos_aoi, pass_ray, pair_w, pair_pass, o, d, done):
+           nrm, wn, tree_month, p_local, gp_local, rotate, roulette_w, perez, sky_rows, sky_t0,
+           sky_step, rad, cos_aoi, pass_ray, pair_w, pair_pass, pair_pt, o, d, done):
     """Radiation lookup and ray batch of passes ``lo..hi`` (see the module docstring).
 
     Fills, per pass ``i`` (chunk index ``i - lo``): ``rad`` (:data:`_RAD`, NaN as 0, sun
@@ -84,10 +88,12 @@ def _setup(lo, hi, seg, t_start, dt, mid, row, loc_of_row, packed, cols, t0, ste
     ``pass_ray[i + 1] - pass_ray[i]`` rays: its direct ray first when the sun is in front of
     the roof, then per reflector pair one ray, or P with ``rotate`` False), ``done[i]``
     False for a dark pass (every component 0).  ``pair_w`` / ``pair_pass``: per pair its
-    beam weight and pass (chunk index).  Returns (rays, pairs).
+    beam weight and pass (chunk index), ``pair_pt`` its (first) sample point's flat index
+    (reflector x P + point).  ``rad[c, _CLS]``: the crowns' class of the pass's
+    month (*tree_month*, per geometry row; *wn* per row and class).  Returns (rays, pairs).
     """
     n_t = packed.shape[1]
-    J = wn.shape[1]
+    J = wn.shape[2]
     P = gp_local.shape[1]
     nr = 0
     npair = 0
@@ -121,6 +127,8 @@ def _setup(lo, hi, seg, t_start, dt, mid, row, loc_of_row, packed, cols, t0, ste
         if dark:
             continue
         done[c] = True
+        cls = tree_month[r, month0(t)]
+        rad[c, _CLS] = np.float32(cls)
         if sky_rows.shape[1]:
             # the Perez sky tables' row nearest the pass (RadiationTable.sky_steps)
             js = np.int64(min(max(np.floor((t - sky_t0) / sky_step + 0.5), 0.0),
@@ -141,7 +149,7 @@ def _setup(lo, hi, seg, t_start, dt, mid, row, loc_of_row, packed, cols, t0, ste
             continue
         key = _sample_key(seg[i], t_start[i]) if rotate else np.int64(0)
         for g in range(J):
-            wc = wn[r, g, 0] * sx + wn[r, g, 1] * sy + wn[r, g, 2] * sz
+            wc = wn[r, cls, g, 0] * sx + wn[r, cls, g, 1] * sy + wn[r, cls, g, 2] * sz
             if not wc > 0:
                 continue
             beam = wc
@@ -153,10 +161,12 @@ def _setup(lo, hi, seg, t_start, dt, mid, row, loc_of_row, packed, cols, t0, ste
                 beam = max(wc, roulette_w)
             pair_w[npair] = beam
             pair_pass[npair] = c
-            npair += 1
             base = (r * J + g)
+            pair_pt[npair] = base * P
+            npair += 1
             if rotate:
                 k = (key + g) % P
+                pair_pt[npair - 1] = base * P + k
                 for j in range(3):
                     o[nr, j] = gp_local[base, k, j]
                 d[nr, 0], d[nr, 1], d[nr, 2] = sx, sy, sz
@@ -191,18 +201,34 @@ def _share(tg, th, r, cell, f, t, tilted, nz):
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _components(c, r, rad, cos_aoi, visible, beam_sum, sky, iso, refl_sky, refl_ghi,
-                perez, hbv, refl_hor, sin_tilt, sky_cell, sky_f, sky_t, sky_tilted, tg_all, th_all,
-                to_all, tg_clear, th_clear, to_clear, nrm, out):
-    """The 12 :data:`BLOCK_COLUMNS` of one pass into *out* (float32, as
+def _tree_loss(tg, th, rs, r, cls, nz, t, ts):
+    """The Perez sky's share the crowns take from segment row *r* in class *cls*: its sky
+    cells with a loss, ``sum loss (n_z dG + t_k dH)`` (:func:`vipvflow.models.sky.tree_share`)."""
+    off, cell, sector, w = ts
+    s = np.float32(0.0)
+    for e in range(off[r], off[r + 1]):
+        j = cell[e]
+        s += w[e, cls] * (nz * (tg[rs, j] - tg[rs, j + 1]) + t[sector[e]] * (th[rs, j] - th[rs, j + 1]))
+    return s
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _components(c, r, rad, cos_aoi, vis_t, visible, beam_sum, sky, sky_nt, iso, refl_sky,
+                refl_ghi, perez, hbv, hbv_nt, refl_hor, sin_tilt, sky_cell, sky_f, sky_t,
+                sky_tilted, tg_all, th_all, to_all, tg_clear, th_clear, to_clear, nrm, ts, out):
+    """The :data:`BLOCK_COLUMNS` of one pass into *out* (float32, as
     :func:`vipvflow.models.irradiance.roof_components` sums them, the Perez sky with
-    *perez*)."""
+    *perez*): the sun ray's transmittance *vis_t* (0, or the crowns' where the buildings
+    let it through: *visible*), the sky through the crowns of the pass's class; the
+    ``_no_trees`` columns with the buildings alone."""
     ca = cos_aoi[c]
-    vis = np.float32(1.0) if visible else np.float32(0.0)
+    cls = np.int64(rad[c, _CLS])
+    vis_b = np.float32(1.0) if visible else np.float32(0.0)
     for s in range(2):
         b, dh, gh = rad[c, 3 * s], rad[c, 3 * s + 1], rad[c, 3 * s + 2]
         beam = b * ca
-        direct = beam * vis
+        direct = beam * vis_t
+        direct_nt = beam * vis_b
         if perez:
             f1, f2 = rad[c, 9 + 2 * s], rad[c, 10 + 2 * s]
             cs = dh * f1 / max(rad[c, 8], _COS_85)
@@ -212,100 +238,143 @@ def _components(c, r, rad, cos_aoi, visible, beam_sum, sky, iso, refl_sky, refl_
                 rs = np.int64(rad[c, _N_RAD])
                 share = np.float32(0.0)
                 share_open = np.float32(0.0)
+                loss = np.float32(0.0)
                 if rs >= 0:
                     nx, ny, nz = nrm[r, 0], nrm[r, 1], nrm[r, 2]
                     if s == 0:
                         share = _share(tg_all, th_all, rs, sky_cell[r], sky_f[r], sky_t[r],
                                        sky_tilted[r], nz)
                         share_open = nz + (nx * to_all[rs, 0] + ny * to_all[rs, 1])
+                        loss = _tree_loss(tg_all, th_all, rs, r, cls, nz, sky_t[r], ts)
                     else:
                         share = _share(tg_clear, th_clear, rs, sky_cell[r], sky_f[r], sky_t[r],
                                        sky_tilted[r], nz)
                         share_open = nz + (nx * to_clear[rs, 0] + ny * to_clear[rs, 1])
-                diffuse = max(dh * share, np.float32(0.0))
+                        loss = _tree_loss(tg_clear, th_clear, rs, r, cls, nz, sky_t[r], ts)
+                diffuse = max(dh * (share - loss), np.float32(0.0))
+                diffuse_nt = max(dh * share, np.float32(0.0))
             else:
-                diffuse = max(dh * (iso_w * sky[r] + f2 * hbv[r]) + circ * vis, np.float32(0.0))
-            reflected = ((b + cs) * beam_sum + dh * (iso_w * refl_sky[r] + f2 * refl_hor[r])
-                         + gh * refl_ghi[r])
+                diffuse = max(dh * (iso_w * sky[r, cls] + f2 * hbv[r, cls]) + circ * vis_t,
+                              np.float32(0.0))
+                diffuse_nt = max(dh * (iso_w * sky_nt[r] + f2 * hbv_nt[r]) + circ * vis_b,
+                                 np.float32(0.0))
+            reflected = ((b + cs) * beam_sum + dh * (iso_w * refl_sky[r, cls] + f2 * refl_hor[r, cls])
+                         + gh * refl_ghi[r, cls])
             if sky_cell.shape[1]:
                 unshaded = beam + max(dh * share_open, np.float32(0.0))
             else:
                 unshaded = beam + max(dh * (iso_w * iso[r] + f2 * sin_tilt[r]) + circ, np.float32(0.0))
         else:
-            diffuse = dh * sky[r]
-            reflected = b * beam_sum + dh * refl_sky[r] + gh * refl_ghi[r]
+            diffuse = dh * sky[r, cls]
+            diffuse_nt = dh * sky_nt[r]
+            reflected = b * beam_sum + dh * refl_sky[r, cls] + gh * refl_ghi[r, cls]
             unshaded = beam + dh * iso[r]
         out[4 * s] = direct
         out[4 * s + 1] = diffuse
         out[4 * s + 2] = reflected
         out[4 * s + 3] = direct + diffuse + reflected
         out[8 + s] = unshaded
-    out[10] = rad[c, 2]
-    out[11] = rad[c, 5]
+        if s == 0:
+            out[10] = direct_nt
+            out[11] = diffuse_nt
+    out[12] = rad[c, 2]
+    out[13] = rad[c, 5]
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _visibility(c, pass_ray, pair_w, pair_pass, q, occ, cos_aoi, rotate, P):
-    """Whether the pass's sun ray is free, its reflectors' beam sum ``sum weight x lit``
-    (float64 like the reference's bincount, then float32), and the next pair."""
+def _visibility(c, pass_ray, pair_w, pair_pass, pair_pt, gf, q, occ, cos_aoi, rotate, P, o, d,
+                tmax, cls, tr, hits):
+    """Whether the pass's sun ray misses the buildings, its transmittance (0, else the
+    crowns' along it in class *cls*), its reflectors' beam sum ``sum weight x lit``
+    (float64 like the reference's bincount, then float32; a sample point's ray lit in the
+    crowns' transmittance, times the point's factor through the crowns *gf*), and the next
+    pair."""
+    cx, cy, cz, ia2, ic2, meta, start, items, tau = tr
+    trees = items.shape[0] > 0
     r0, r1 = pass_ray[c], pass_ray[c + 1]
     visible = False
+    vis_t = np.float32(0.0)
     if cos_aoi[c] > 0:
         visible = not occ[r0]
+        if visible:
+            vis_t = np.float32(1.0)
+            if trees:
+                vis_t = transmit_one(o[r0, 0], o[r0, 1], o[r0, 2], d[r0, 0], d[r0, 1], d[r0, 2],
+                                     tmax, cls, cx, cy, cz, ia2, ic2, meta, start, items, tau, hits)
         r0 += 1
     acc = 0.0
     while r0 < r1:
         if rotate:
-            acc += np.float64(pair_w[q] * (np.float32(0.0) if occ[r0] else np.float32(1.0)))
+            t = np.float32(0.0)
+            if not occ[r0]:
+                t = np.float32(1.0)
+                if trees:
+                    t = transmit_one(o[r0, 0], o[r0, 1], o[r0, 2], d[r0, 0], d[r0, 1], d[r0, 2],
+                                     tmax, cls, cx, cy, cz, ia2, ic2, meta, start, items, tau, hits)
+            t = t * gf[pair_pt[q], cls]
+            acc += np.float64(pair_w[q] * t)
             r0 += 1
         else:
-            cnt = 0
+            tsum = 0.0
             for k in range(P):
-                cnt += occ[r0 + k]
-            share = np.float64(np.int32(P - cnt)) * np.float64(np.float32(1.0 / P))
+                if not occ[r0 + k]:
+                    t = np.float32(1.0)
+                    if trees:
+                        i = r0 + k
+                        t = transmit_one(o[i, 0], o[i, 1], o[i, 2], d[i, 0], d[i, 1], d[i, 2],
+                                         tmax, cls, cx, cy, cz, ia2, ic2, meta, start, items,
+                                         tau, hits)
+                    tsum += np.float64(t * gf[pair_pt[q] + k, cls])
+            share = tsum * np.float64(np.float32(1.0 / P))
             acc += np.float64(pair_w[q]) * share
             r0 += P
         q += 1
-    return visible, np.float32(acc), q
+    return visible, vis_t, np.float32(acc), q
 
 
 @njit(cache=True, nogil=True)
-def _finish(lo, hi, row, rad, cos_aoi, pass_ray, pair_w, pair_pass, occ, done,
-            sky, iso, refl_sky, refl_ghi, perez, hbv, refl_hor, sin_tilt, sky_cell, sky_f, sky_t,
-            sky_tilted, tg_all, th_all, to_all, tg_clear, th_clear, to_clear, nrm, rotate, P,
-            to_bins, block, visible_out, dt, seg_hour, run, seg_bins, run_bins):
-    """Components of passes ``lo..hi``: into columns of *block* (12, n) and *visible_out*,
+def _finish(lo, hi, row, rad, cos_aoi, pass_ray, pair_w, pair_pass, pair_pt, gf, occ, done,
+            sky, sky_nt, iso, refl_sky, refl_ghi, perez, hbv, hbv_nt, refl_hor, sin_tilt, sky_cell,
+            sky_f, sky_t, sky_tilted, tg_all, th_all, to_all, tg_clear, th_clear, to_clear, nrm,
+            ts, rotate, P, o, d, tmax, tr, to_bins, block, visible_out, dt, seg_hour, run,
+            seg_bins, run_bins):
+    """Components of passes ``lo..hi``: into columns of *block* (14, n) and *visible_out*,
     or, with *to_bins*, as irradiation (Wh/m2) added into ``seg_bins[seg_hour[i]]`` and
-    ``run_bins[run[i]]`` ((bins, 12) float64, :data:`BLOCK_COLUMNS`); the other side's
-    arrays are not touched (empty ones will do)."""
-    out = np.empty(12, np.float32)
+    ``run_bins[run[i]]`` ((bins, 14) float64, :data:`BLOCK_COLUMNS`); the other side's
+    arrays are not touched (empty ones will do).  *o*, *d*: the chunk's rays (the crowns
+    along those the buildings let through, *tr*: :meth:`vipvflow.models.trees.Crowns.arrays`)."""
+    out = np.empty(_NB, np.float32)
+    hits = np.empty(_MAX_HITS, np.int64)
     q = 0
     for i in range(lo, hi):
         c = i - lo
         if not done[c]:
             continue
-        visible, beam_sum, q = _visibility(c, pass_ray, pair_w, pair_pass, q, occ, cos_aoi,
-                                           rotate, P)
-        _components(c, row[i], rad, cos_aoi, visible, beam_sum, sky, iso, refl_sky, refl_ghi,
-                    perez, hbv, refl_hor, sin_tilt, sky_cell, sky_f, sky_t, sky_tilted, tg_all,
-                    th_all, to_all, tg_clear, th_clear, to_clear, nrm, out)
+        cls = np.int64(rad[c, _CLS])
+        visible, vis_t, beam_sum, q = _visibility(c, pass_ray, pair_w, pair_pass, pair_pt, gf, q,
+                                                  occ, cos_aoi, rotate, P, o, d, tmax, cls, tr,
+                                                  hits)
+        _components(c, row[i], rad, cos_aoi, vis_t, visible, beam_sum, sky, sky_nt, iso,
+                    refl_sky, refl_ghi, perez, hbv, hbv_nt, refl_hor, sin_tilt, sky_cell, sky_f,
+                    sky_t, sky_tilted, tg_all, th_all, to_all, tg_clear, th_clear, to_clear,
+                    nrm, ts, out)
         if to_bins:
             w = dt[i] / 3600.0
             b, k = seg_hour[i], run[i]
-            for j in range(12):
+            for j in range(_NB):
                 h = np.float64(out[j]) * w
                 seg_bins[b, j] += h
                 run_bins[k, j] += h
         else:
-            for j in range(12):
+            for j in range(_NB):
                 block[j, i] = out[j]
             visible_out[i] = visible
 
 
 #: empty stand-ins for the side of :func:`_finish` a call does not fill
 _NO_INT = np.zeros(0, np.int64)
-_NO_BINS = np.zeros((0, 12))
-_NO_BLOCK = np.zeros((12, 0), np.float32)
+_NO_BINS = np.zeros((0, _NB))
+_NO_BLOCK = np.zeros((_NB, 0), np.float32)
 _NO_VISIBLE = np.zeros(0, np.bool_)
 
 
@@ -432,13 +501,14 @@ class _Batch:
         self.done = np.empty(chunk, np.bool_)
         self.pair_w = np.empty(chunk * pairs_per_pass, f32)
         self.pair_pass = np.empty(chunk * pairs_per_pass, np.int64)
+        self.pair_pt = np.empty(chunk * pairs_per_pass, np.int64)
         self.o = np.empty((chunk * rays_per_pass, 3), f32)
         self.d = np.empty((chunk * rays_per_pass, 3), f32)
 
 
 def _plan(geo: dict, cfg):
     """Reflectors J, sample points P, rotate, rays and pairs per pass at most, chunk size."""
-    J = geo["wn"].shape[1] if (cfg.reflection and cfg.max_reflector_groups) else 0
+    J = geo["wn"].shape[2] if (cfg.reflection and cfg.max_reflector_groups) else 0
     P = geo["group_p_local"].shape[1]
     rotate = cfg.reflector_sampling == "rotate" and P > 1
     per_pass = 1 + J * (1 if rotate else P)
@@ -460,31 +530,40 @@ def _writable(a: np.ndarray) -> np.ndarray:
     return a if a.flags.writeable else a.copy()
 
 
-def _inputs(geo: dict, cfg, radiation_table, rows_of_segment_loc):
+def _inputs(geo: dict, cfg, radiation_table, rows_of_segment_loc, scene=None):
     f32 = np.float32
     names, packed = radiation_table._packed()
     cols = np.array([names.index(c) for c in _RAD], np.int64)
     n_seg = len(geo["n"])
     nrm = geo["n"]
+    C = geo["svf"].shape[1]
     iso = ((f32(1) + nrm[:, 2]) * f32(0.5)).astype(f32)
-    sky = geo["svf"] if cfg.diffuse_model != "isotropic" else iso
-    J = geo["wn"].shape[1] if (cfg.reflection and cfg.max_reflector_groups) else 0
-    zero = np.zeros(n_seg, f32)
+    if cfg.diffuse_model != "isotropic":
+        sky, sky_nt = geo["svf"], geo["svf_no_trees"]
+    else:
+        sky, sky_nt = np.repeat(iso[:, None], C, axis=1), iso
+    J = geo["wn"].shape[2] if (cfg.reflection and cfg.max_reflector_groups) else 0
+    zero = np.zeros((n_seg, C), f32)
     r_sky, r_ghi = (geo["refl_sky"], geo["refl_ghi"]) if J else (zero, zero)
     sin_tilt = np.sqrt(nrm[:, 0] * nrm[:, 0] + nrm[:, 1] * nrm[:, 1]).astype(f32)
-    hbv = geo["hbv"] if "hbv" in geo else zero
-    r_hor = geo["refl_hor"] if (J and "refl_hor" in geo) else zero
-    wn = geo["wn"] if J else np.zeros((n_seg, 0, 3), f32)
+    hbv, hbv_nt = geo["hbv"], geo["hbv_no_trees"]
+    r_hor = geo["refl_hor"] if J else zero
+    wn = geo["wn"] if J else np.zeros((n_seg, C, 0, 3), f32)
     loc = (np.zeros(n_seg, np.int64) if rows_of_segment_loc is None
            else np.asarray(rows_of_segment_loc, np.int64))
     x = dict(packed=packed, cols=cols, nrm=nrm, wn=wn.astype(f32, copy=False), p_local=geo["p_local"],
              gp_local=geo["group_p_local"].astype(f32, copy=False), sky=sky.astype(f32, copy=False),
-             iso=iso, refl_sky=r_sky.astype(f32, copy=False), refl_ghi=r_ghi.astype(f32, copy=False),
-             hbv=hbv.astype(f32, copy=False), refl_hor=r_hor.astype(f32, copy=False),
-             sin_tilt=sin_tilt, loc=loc)
+             sky_nt=sky_nt.astype(f32, copy=False), iso=iso, refl_sky=r_sky.astype(f32, copy=False),
+             refl_ghi=r_ghi.astype(f32, copy=False), hbv=hbv.astype(f32, copy=False),
+             hbv_nt=hbv_nt.astype(f32, copy=False), refl_hor=r_hor.astype(f32, copy=False),
+             sin_tilt=sin_tilt, loc=loc, tree_month=geo["tree_month"],
+             gf=geo["group_f"].reshape(-1, C))
     x = {k: _writable(v) for k, v in x.items()}
     perez = cfg.diffuse_model == "perez_svf"
-    x.update(t0=float(radiation_table.t0), step=float(radiation_table.step_s), perez=perez)
+    x.update(t0=float(radiation_table.t0), step=float(radiation_table.step_s), perez=perez,
+             tmax=float(cfg.ray_length_m))
+    crowns = scene.crowns(cfg) if (scene is not None and hasattr(scene, "crowns")) else None
+    x["tr"] = tuple(_writable(a) for a in crowns.arrays()) if crowns is not None else _NO_TREES
     sky_x = geo.get("sky_x")
     if perez and sky_x is not None and sky_x.shape[1]:
         tables = radiation_table.sky()
@@ -494,21 +573,29 @@ def _inputs(geo: dict, cfg, radiation_table, rows_of_segment_loc):
                  sky_rows=_writable(tables["rows"]),
                  sky_tables=(flat(tables["all"]), flat(tables["all_h"]), _writable(tables["all_open"]),
                              flat(tables["clear"]), flat(tables["clear_h"]), _writable(tables["clear_open"])),
-                 sky_t0=tables["t0"], sky_step=tables["step"])
+                 sky_t0=tables["t0"], sky_step=tables["step"],
+                 ts=tuple(_writable(geo[k]) for k in ("tsky_off", "tsky_cell", "tsky_sector", "tsky_w")))
     else:
         e2 = np.zeros((0, 2), f32)
         e = np.zeros((0, SKY_AZIMUTH_BINS * (SKY_LEVELS + 1)), f32)
         x.update(sky_cell=np.zeros((n_seg, 0), np.int64), sky_f=np.zeros((n_seg, 0), f32),
                  sky_t=np.zeros((n_seg, 0), f32), sky_tilted=np.zeros(n_seg, np.bool_),
                  sky_rows=np.zeros((1, 0), np.int32),
-                 sky_tables=(e, e, e2, e, e, e2), sky_t0=0.0, sky_step=1.0)
+                 sky_tables=(e, e, e2, e, e, e2), sky_t0=0.0, sky_step=1.0,
+                 ts=(np.zeros(n_seg + 1, np.int64), _NO_INT, _NO_INT, np.zeros((0, C), f32)))
     return x
+
+
+#: the crowns' arrays of a scene without trees (:meth:`vipvflow.models.trees.Crowns.arrays`)
+_NO_TREES = (np.zeros(0), np.zeros(0), np.zeros(0), np.zeros(0), np.zeros(0),
+             np.array([0.0, 0.0, 1.0, 1.0, 1.0, 0.0, 0.0]), np.zeros(2, np.int64),
+             np.zeros(0, np.int64), np.ones((0, 1), np.float32))
 
 
 def _run(seg, t_start, dt, mid, row, geo, cfg, radiation_table, scene, loc_of_row, clock,
          finish):
-    """Chunks of passes through setup -> Embree -> *finish(lo, hi, batch, occ, P, rotate)*."""
-    x = _inputs(geo, cfg, radiation_table, loc_of_row)
+    """Chunks of passes through setup -> Embree -> *finish(lo, hi, x, batch, occ, P, rotate)*."""
+    x = _inputs(geo, cfg, radiation_table, loc_of_row, scene)
     J, P, rotate, per_pass, chunk = _plan(geo, cfg)
     n = len(row)
     chunk = min(chunk, max(n, 1))
@@ -518,9 +605,10 @@ def _run(seg, t_start, dt, mid, row, geo, cfg, radiation_table, scene, loc_of_ro
         hi = min(n, lo + chunk)
         t_a = time.perf_counter()
         nr, _ = _setup(lo, hi, seg, t_start, dt, mid, row, x["loc"], x["packed"], x["cols"],
-                       x["t0"], x["step"], x["nrm"], x["wn"], x["p_local"], x["gp_local"],
-                       rotate, rw, x["perez"], x["sky_rows"], x["sky_t0"], x["sky_step"], bt.rad, bt.cos_aoi, bt.pass_ray, bt.pair_w, bt.pair_pass,
-                       bt.o, bt.d, bt.done)
+                       x["t0"], x["step"], x["nrm"], x["wn"], x["tree_month"], x["p_local"],
+                       x["gp_local"], rotate, rw, x["perez"], x["sky_rows"], x["sky_t0"],
+                       x["sky_step"], bt.rad, bt.cos_aoi, bt.pass_ray, bt.pair_w, bt.pair_pass,
+                       bt.pair_pt, bt.o, bt.d, bt.done)
         t_b = time.perf_counter()
         occ = (scene.occluded_local(bt.o[:nr], bt.d[:nr], cfg.ray_length_m) if nr
                else np.zeros(0, bool))
@@ -553,7 +641,7 @@ def evaluate_block(seg, t_start, dt, mid, row, geo, cfg, radiation_table, scene,
 
     Returns
     -------
-    block : (n, 12) float32, W/m2, columns :data:`BLOCK_COLUMNS`
+    block : (n, 14) float32, W/m2, columns :data:`BLOCK_COLUMNS`
     visible : (n,) bool, the sun ray from the roof point was free
     """
     seg, t_start, dt, row = (_writable(a) for a in (seg, t_start, dt, row))
@@ -580,8 +668,8 @@ def accumulate(seg, t_start, dt, mid, row, geo, cfg, radiation_table, scene, seg
 
     Returns
     -------
-    seg_bins : (n_seg_hour, 12) float64, Wh/m2 per (segment, local hour), :data:`BLOCK_COLUMNS`
-    run_bins : (n_runs, 12) float64, Wh/m2 per run
+    seg_bins : (n_seg_hour, 14) float64, Wh/m2 per (segment, local hour), :data:`BLOCK_COLUMNS`
+    run_bins : (n_runs, 14) float64, Wh/m2 per run
     """
     seg, t_start, dt, row, seg_hour, run = (_writable(a) for a in (seg, t_start, dt, row, seg_hour, run))
     seg_bins = np.zeros((n_seg_hour, len(BLOCK_COLUMNS)))
@@ -598,9 +686,11 @@ def _finisher(row, dt, to_bins, block, visible, seg_hour, run, seg_bins, run_bin
     *visible*, or (*to_bins*) into *seg_bins* and *run_bins*."""
     def finish(lo, hi, x, bt, occ, P, rotate):
         _finish(lo, hi, row, bt.rad, bt.cos_aoi, bt.pass_ray, bt.pair_w, bt.pair_pass,
-                occ, bt.done, x["sky"], x["iso"], x["refl_sky"], x["refl_ghi"], x["perez"],
-                x["hbv"], x["refl_hor"], x["sin_tilt"], x["sky_cell"], x["sky_f"], x["sky_t"],
-                x["sky_tilted"], *x["sky_tables"], x["nrm"], rotate, P, to_bins, block, visible, dt, seg_hour, run, seg_bins, run_bins)
+                bt.pair_pt, x["gf"], occ, bt.done, x["sky"], x["sky_nt"], x["iso"], x["refl_sky"], x["refl_ghi"],
+                x["perez"], x["hbv"], x["hbv_nt"], x["refl_hor"], x["sin_tilt"], x["sky_cell"],
+                x["sky_f"], x["sky_t"], x["sky_tilted"], *x["sky_tables"], x["nrm"], x["ts"],
+                rotate, P, bt.o, bt.d, x["tmax"], x["tr"], to_bins, block, visible, dt,
+                seg_hour, run, seg_bins, run_bins)
     return finish
 
 
@@ -610,27 +700,30 @@ def warm() -> float:
     t = time.perf_counter()
     f32, i64 = np.float32, np.int64
     one_i, one_f, one_t = np.zeros(1, i64), np.zeros(1, f32), np.zeros(1)
+    one_c = np.zeros((1, 1), f32)
     rad, pr = np.zeros((1, _N_ROW), f32), np.zeros(2, i64)
     o3 = np.zeros((1, 3), f32)
     packed = np.zeros((1, 2, _N_RAD), f32)
     tables = np.zeros((1, SKY_AZIMUTH_BINS * (SKY_LEVELS + 1)), f32)
+    months = np.zeros((1, 12), i64)
+    ts = (np.zeros(2, i64), np.zeros(0, i64), np.zeros(0, i64), np.zeros((0, 1), f32))
     for rotate in (True, False):
         for perez in (True, False):
             for n_sky in (0, SKY_AZIMUTH_BINS):
                 rows = np.zeros((1, 2 if n_sky else 0), np.int32)
                 _setup(0, 1, one_i, one_t, one_t, True, one_i, one_i, packed,
-                       np.arange(_N_RAD, dtype=i64), 0.0, 60.0, o3, np.zeros((1, 1, 3), f32), o3,
-                       np.zeros((1, 1, 3), f32), rotate, f32(0.02), perez, rows, 0.0, 900.0,
-                       rad, one_f, pr, one_f, one_i, o3, o3, np.zeros(1, np.bool_))
+                       np.arange(_N_RAD, dtype=i64), 0.0, 60.0, o3, np.zeros((1, 1, 1, 3), f32),
+                       months, o3, np.zeros((1, 1, 3), f32), rotate, f32(0.02), perez, rows, 0.0,
+                       900.0, rad, one_f, pr, one_f, one_i, one_i, o3, o3, np.zeros(1, np.bool_))
                 for to_bins in (False, True):
-                    _finish(0, 1, one_i, rad, one_f, pr, one_f, one_i, np.zeros(1, bool),
-                            np.zeros(1, np.bool_), one_f, one_f, one_f, one_f, perez, one_f, one_f,
-                            one_f, np.zeros((1, n_sky), np.int64), np.zeros((1, n_sky), f32),
-                            np.zeros((1, n_sky), f32), np.zeros(1, np.bool_), tables, tables,
-                            np.zeros((1, 2), f32), tables, tables, np.zeros((1, 2), f32), o3,
-                            rotate, 1, to_bins,
-                            np.zeros((12, 1), f32), np.zeros(1, bool), one_t, one_i, one_i,
-                            np.zeros((1, 12)), np.zeros((1, 12)))
+                    _finish(0, 1, one_i, rad, one_f, pr, one_f, one_i, one_i, one_c, np.zeros(1, bool),
+                            np.zeros(1, np.bool_), one_c, one_f, one_f, one_c, one_c, perez, one_c,
+                            one_f, one_c, one_f, np.zeros((1, n_sky), np.int64),
+                            np.zeros((1, n_sky), f32), np.zeros((1, n_sky), f32),
+                            np.zeros(1, np.bool_), tables, tables, np.zeros((1, 2), f32), tables,
+                            tables, np.zeros((1, 2), f32), o3, ts, rotate, 1, o3, o3, 300.0,
+                            _NO_TREES, to_bins, np.zeros((_NB, 1), f32), np.zeros(1, bool), one_t,
+                            one_i, one_i, np.zeros((1, _NB)), np.zeros((1, _NB)))
     _groups(one_i, one_i, one_i, one_t, one_t, 0, one_i, 0, one_t, one_i, one_i, one_i, one_i)
     _seconds(one_i, one_i, one_i, one_t, one_t, one_t, one_t, one_i, one_i)
     return time.perf_counter() - t

@@ -56,6 +56,8 @@ class Scene:
     mesh : TileMesh
     n_threads : int, optional
         Threads for large ray batches (default: the cores available to the process).
+    trees : vipvflow.models.trees.TreeTable, optional
+        The trees whose crowns the scene's rays meet (:meth:`crowns`).
 
     Notes
     -----
@@ -63,10 +65,14 @@ class Scene:
     ``self.origin`` (the centre of the mesh's bounding box) in float32.
     """
 
-    def __init__(self, mesh: TileMesh, n_threads: int | None = None):
+    def __init__(self, mesh: TileMesh, n_threads: int | None = None, trees=None):
         self.mesh = mesh
+        self.trees = trees if trees is not None and len(trees) else None
+        self._crowns: dict = {}
         self.n_threads = n_threads or available_cores()
         v = np.asarray(mesh.vertices, np.float64)
+        if not len(v) and self.trees is not None:        # a tile of trees alone: their frame
+            v = np.column_stack([self.trees.x, self.trees.y, self.trees.z])
         self.origin = (v.min(0) + v.max(0)) / 2 if len(v) else np.zeros(3)
         self.n_triangles = int(len(mesh.triangles))
         self._scene = None
@@ -74,6 +80,22 @@ class Scene:
             tris = np.ascontiguousarray((v[mesh.triangles] - self.origin).astype(np.float32))
             self._scene = rtcore_scene.EmbreeScene()
             self._mesh = TriangleMesh(self._scene, tris)
+
+    def crowns(self, cfg):
+        """The scene's tree crowns for the tree parameters *cfg*
+        (:class:`vipvflow.models.params.TreeCfg`, or an ``IrradianceCfg`` holding them) in
+        the scene's frame (:class:`vipvflow.models.trees.Crowns`, built once per *cfg*), or
+        None: no trees, or ``cfg.enabled`` false."""
+        cfg = getattr(cfg, "trees", cfg)
+        if self.trees is None or cfg is None or not cfg.enabled:
+            return None
+        key = cfg.model_dump_json()
+        crowns = self._crowns.get(key)
+        if crowns is None:
+            from .trees import Crowns
+
+            crowns = self._crowns[key] = Crowns(self.trees, cfg, self.origin)
+        return crowns
 
     # ------------------------------------------------------------------ helpers
     def _prepare(self, origins, dirs, tfar):
@@ -204,7 +226,8 @@ def modelled_tiles(data_dir) -> frozenset:
 def get_scene(data_dir, tile: str, cache_size: int = 8, n_threads: int | None = None) -> Scene:
     """The :class:`Scene` of a tile, from a bounded LRU cache of this process.
 
-    Loads ``city/meshes/<tile>.npz`` and builds the BVH on a miss; each build is counted in
+    Loads ``city/meshes/<tile>.npz`` (and the tile's trees, ``city/trees/<tile>.npz``)
+    and builds the BVH on a miss; each build is counted in
     :data:`BVH_BUILDS` under the key ``(data_dir, tile)``.  *n_threads* sets the ray-casting
     threads of a new scene (default: the cores available).  A tile the city model has no
     mesh for (no modelled surface within the buffer: a line that leaves the model) is an
@@ -222,7 +245,10 @@ def get_scene(data_dir, tile: str, cache_size: int = 8, n_threads: int | None = 
         if scene is not None:
             _cache.move_to_end(key)
             return scene
+    from .trees import load_tile_trees
+
     path = DataDir(data_dir).city.mesh(tile)
+    trees = load_tile_trees(data_dir, tile)
     if path.exists():
         mesh = TileMesh.load(path)
     elif tile in modelled_tiles(data_dir):
@@ -232,7 +258,7 @@ def get_scene(data_dir, tile: str, cache_size: int = 8, n_threads: int | None = 
                          f"{tile}; run `vipvflow ingest city` again")
     else:
         mesh = box_mesh([], name=tile)
-    scene = Scene(mesh, n_threads=n_threads)
+    scene = Scene(mesh, n_threads=n_threads, trees=trees)
     with _cache_lock:
         BVH_BUILDS[key] += 1
         _cache[key] = scene

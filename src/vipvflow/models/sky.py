@@ -323,3 +323,28 @@ def open_share(terms, normal) -> np.ndarray:
     nrm = np.asarray(normal, np.float32)
     t = np.asarray(terms, np.float32)
     return nrm[:, 2] + (nrm[:, 0] * t[:, 0] + nrm[:, 1] * t[:, 1])
+
+
+def tree_share(table_g, table_h, loss, normal) -> np.ndarray:
+    """The share of DHI the tree crowns take from a roof point: for rows of the two sky
+    tables (:func:`sky_table`, (n, 36, 10)), the crowns' loss per sky cell (n, 324)
+    (:func:`vipvflow.models.trees.sky_cell_loss`, the cell's light taken as uniform within
+    it) and the roof's unit *normal* (n, 3): ``sum_cells loss (n_z dG + t_k dH)`` with
+    ``dG``, ``dH`` the cell's light (the tables' difference between its two levels) and
+    ``t_k = n_x sin a_k + n_y cos a_k``; float32 (n,), summed cell by cell as the compiled
+    kernel sums them."""
+    from .trees import sky_cells
+
+    cells = sky_cells()
+    n = len(loss)
+    g = np.asarray(table_g, np.float32).reshape(n, -1)
+    h = np.asarray(table_h, np.float32).reshape(n, -1)
+    nrm = np.asarray(normal, np.float32)
+    tilt = (nrm[:, 0:1] * SECTOR_SIN.astype(np.float32) + nrm[:, 1:2] * SECTOR_COS.astype(np.float32))
+    nz = nrm[:, 2]
+    loss = np.asarray(loss, np.float32)
+    out = np.zeros(n, np.float32)
+    for j, cell in enumerate(cells):
+        k = j // SKY_LEVELS
+        out += loss[:, j] * (nz * (g[:, cell] - g[:, cell + 1]) + tilt[:, k] * (h[:, cell] - h[:, cell + 1]))
+    return out

@@ -341,6 +341,26 @@ class RadiationTable:
             open_[ok] = open_share(sky[name + "_open"][r[ok]], nrm)
         return out, open_
 
+    def sky_tree_share(self, t_utc, loss, normal, location=None, clear: bool = False):
+        """The share of DHI the tree crowns take from roof points at times *t_utc* (Unix s),
+        from their loss per sky cell *loss* (n, 324) (:func:`vipvflow.models.trees.sky_cell_loss`,
+        the pass's class of months) and roof unit *normal* (n, 3), with the table row of
+        :meth:`sky` nearest in time (:func:`vipvflow.models.sky.tree_share`); float32 (n,),
+        0 at night."""
+        from .sky import tree_share
+
+        sky = self.sky()
+        j = self.sky_steps(t_utc)
+        loc = np.zeros(len(j), np.int64) if location is None else np.broadcast_to(np.asarray(location, np.int64), j.shape)
+        r = sky["rows"][loc, j]
+        name = "clear" if clear else "all"
+        out = np.zeros(len(j), np.float32)
+        ok = r >= 0
+        if ok.any():
+            out[ok] = tree_share(sky[name][r[ok]], sky[name + "_h"][r[ok]],
+                                 np.asarray(loss, np.float32)[ok], np.asarray(normal, np.float32)[ok])
+        return out
+
     def sky_steps(self, t_utc) -> np.ndarray:
         """The sky tables' step nearest each time (int64, within the tables)."""
         sky = self.sky()

@@ -162,7 +162,7 @@ def _dominant_surface(gkey, surface, w, n_keys: int) -> np.ndarray:
     return out
 
 
-def _group_points(o, hs, gkey, w, hp, hn, w_g, n_g, P: int, lift: float):
+def _group_points(o, hs, gkey, w, hp, hn, w_g, n_g, P: int, lift: float, w_t=None):
     """P sample points per reflector group, each standing for an equal share of the group's
     weight (albedo x view factor), stratified over the group's surface in two dimensions.
 
@@ -189,10 +189,16 @@ def _group_points(o, hs, gkey, w, hp, hn, w_g, n_g, P: int, lift: float):
     P : int, points per group
     lift : float, m, the points are lifted off their surface by this along its normal
 
+    With *w_t* (h, C), each hit's weight seen through the tree crowns per class of months,
+    also each point's factor per class (m, G, P, C): its cell's share of the group's weight
+    through the crowns over its share without (1/P), so that the mean of the points' lit
+    fractions times their factors is the group's lit fraction as the roof sees it through
+    the crowns (a point of an empty cell: the group's mean).
+
     Returns
     -------
     points (m, G, P, 3), m, and their surface normals (m, G, P, 3); groups without hits keep
-    the roof point and the group normal.
+    the roof point and the group normal; the factors (None without *w_t*).
 
     References
     ----------
@@ -259,14 +265,26 @@ def _group_points(o, hs, gkey, w, hp, hn, w_g, n_g, P: int, lift: float):
     pts = np.where(used[..., None], hp[idx] + lift * hn[idx],
                    np.repeat(o, G, axis=0)[:, None, :])
     nrm = np.where(used[..., None], hn[idx], n_flat[:, None, :])
-    return pts.reshape(m, G, P, 3), nrm.reshape(m, G, P, 3)
+    factors = None
+    if w_t is not None:
+        C = w_t.shape[1]
+        cell_w = np.bincount(ckey, w, n_cell).reshape(m * G, P)
+        ratio = np.empty((m * G, P, C))
+        for c in range(C):
+            cell_c = np.bincount(ckey, w_t[:, c], n_cell).reshape(m * G, P)
+            group = np.bincount(gkey, w_t[:, c], m * G) / np.maximum(wflat, 1e-300)
+            ratio[:, :, c] = np.where(cell_w > 0, cell_c / np.where(cell_w > 0, cell_w, 1.0),
+                                      group[:, None])
+        mean = ratio.mean(1, keepdims=True)
+        factors = np.where(mean > 0, ratio / np.where(mean > 0, mean, 1.0), 1.0).reshape(m, G, P, C)
+    return pts.reshape(m, G, P, 3), nrm.reshape(m, G, P, 3), factors
 
 
 #: the surface index of the street where the city model has none (the virtual ground)
 VIRTUAL_GROUND = -2
 
 
-def _hits(scene, o, d, ray_length_m: float, ground_z, road_albedo: float) -> dict:
+def _hits(scene, o, d, ray_length_m: float, ground_z, road_albedo: float, crowns=None) -> dict:
     """What rays from *o* (n, 3) along *d* (n, 3) hit first: a triangle of the mesh, else the
     street where the city model has none.
 
@@ -277,12 +295,16 @@ def _hits(scene, o, d, ray_length_m: float, ground_z, road_albedo: float) -> dic
     the street, with the road's albedo, lit and shaded as the buildings shade it (its
     sample points cast their own sun rays).  A mesh hit always wins (terrain, roads).
 
+    With *crowns* (:class:`vipvflow.models.trees.Crowns` of the scene) also ``T`` (n, C):
+    the crowns' transmittance per class of months along each ray up to what it hits (its
+    whole length where it hits nothing); None without.
+
     Returns
     -------
     dict of (n,) arrays: ``tri`` (mesh triangle, :data:`VIRTUAL_GROUND` for the virtual
     street, -1 for nothing), ``dist`` (m, inf for nothing), ``albedo``, ``ground`` (bool:
     ground, terrain, road or the virtual street), ``normal`` (n, 3) the surface's normal as
-    stored (up for the virtual street)
+    stored (up for the virtual street), ``T``
     """
     tri, dist = scene.first_hit(o, d, ray_length_m)
     tri = tri.astype(np.int64)
@@ -307,7 +329,20 @@ def _hits(scene, o, d, ray_length_m: float, ground_z, road_albedo: float) -> dic
         virtual = down & (t_g > 0) & (t_g <= ray_length_m)
         tri[virtual], dist[virtual] = VIRTUAL_GROUND, t_g[virtual]
         albedo[virtual], ground[virtual] = road_albedo, True
-    return {"tri": tri, "dist": dist, "albedo": albedo, "ground": ground, "normal": normal}
+    T = None
+    if crowns is not None:
+        T = crowns.transmittance(np.asarray(o, np.float64) - scene.origin, d,
+                                 np.where(np.isfinite(dist), dist, ray_length_m))
+    return {"tri": tri, "dist": dist, "albedo": albedo, "ground": ground, "normal": normal, "T": T}
+
+
+def _class_mean(values: np.ndarray, T, n: int) -> np.ndarray | None:
+    """Per class: the mean of *values* x the crowns' transmittance *T* (rays, C) over each
+    row's *n* consecutive rays, (rows, C); None without crowns."""
+    if T is None:
+        return None
+    v = np.asarray(values, np.float64)[:, None] * T
+    return v.reshape(-1, n, T.shape[1]).mean(1)
 
 
 def _group_cumsum(values: np.ndarray, groups: np.ndarray) -> np.ndarray:
@@ -319,7 +354,7 @@ def _group_cumsum(values: np.ndarray, groups: np.ndarray) -> np.ndarray:
 
 
 def _reflector_surroundings(scene, keys, pts, nrm, used, cfg: IrradianceCfg, stream: int = 2,
-                            ground_z=None, road_albedo: float = 0.10):
+                            ground_z=None, road_albedo: float = 0.10, crowns=None):
     """What the sample points of each reflector group see over their own hemisphere (m, G).
 
     ``cfg.reflector_sky_rays`` cosine-weighted rays from every sample point: a ray that
@@ -336,11 +371,15 @@ def _reflector_surroundings(scene, keys, pts, nrm, used, cfg: IrradianceCfg, str
     (albedo-weighted facades and roofs), ``hor`` (view of the band of sky near the horizon,
     :func:`horizon_band_view`, mean over the points), and the street hits ``hits``: ``pair`` (segment x
     G + group), ``p`` (hit points, m), ``n`` (upward normals), ``w`` (albedo / rays, the
-    hit's share of the group's ``gnd``).
+    hit's share of the group's ``gnd``).  With *crowns*, ``sky_t``, ``gnd_t``, ``open_t``,
+    ``wall_t``, ``hor_t`` (m, G, C): the same seen through the crowns, per class of months.
     """
     m, G, P, _ = pts.shape
     R = cfg.reflector_sky_rays
     out = {k: np.zeros((m, G)) for k in ("sky", "gnd", "open", "wall", "hor")}
+    C = crowns.n_classes if crowns is not None else 0
+    if C:
+        out.update({f"{k}_t": np.zeros((m, G, C)) for k in ("sky", "gnd", "open", "wall", "hor")})
     sel = np.flatnonzero(used.reshape(-1))                     # active (segment, group)
     out["hits"] = {"pair": np.zeros(0, np.int64), "p": np.zeros((0, 3)), "n": np.zeros((0, 3)),
                    "w": np.zeros(0)}
@@ -352,32 +391,37 @@ def _reflector_surroundings(scene, keys, pts, nrm, used, cfg: IrradianceCfg, str
     oo = np.repeat(pts.reshape(m * G, P, 3)[sel].reshape(-1, 3), R, axis=0)
     n = P * R
     gz = None if ground_z is None else np.repeat(np.repeat(np.asarray(ground_z, np.float64), G)[sel], n)
-    h = _hits(scene, oo, d, cfg.ray_length_m, gz, road_albedo)
+    h = _hits(scene, oo, d, cfg.ray_length_m, gz, road_albedo, crowns)
     tri, dist, a = h["tri"], h["dist"], h["albedo"]
     hit = tri != -1
     on_ground = h["ground"]
-    rays = {"sky": ~hit & (d[:, 2] > 0), "open": ~hit & (d[:, 2] <= 0)}
-    for k, v in rays.items():
+    seen = {"sky": ~hit & (d[:, 2] > 0), "open": ~hit & (d[:, 2] <= 0),
+            "gnd": np.where(on_ground, a, 0.0), "wall": np.where(hit & ~on_ground, a, 0.0)}
+    for k, v in seen.items():
         out[k].reshape(-1)[sel] = v.astype(np.float64).reshape(-1, n).mean(1)
-    out["gnd"].reshape(-1)[sel] = np.where(on_ground, a, 0.0).reshape(-1, n).mean(1)
-    out["wall"].reshape(-1)[sel] = np.where(hit & ~on_ground, a, 0.0).reshape(-1, n).mean(1)
+        if C:
+            out[f"{k}_t"].reshape(-1, C)[sel] = _class_mean(v, h["T"], n)
     # the view of the band of sky near the horizon (the Perez horizon term), R rays a point
     pn = nrm.reshape(m * G, P, 3)[sel].reshape(-1, 3)
     band_uni = segment_uniforms(cfg.seed, stream + 3, keys, G * P * 2 * R).reshape(m * G, P, 2 * R)
-    band = horizon_band_view(scene, pts.reshape(m * G, P, 3)[sel].reshape(-1, 3), pn,
-                             band_uni[sel].reshape(-1, 2 * R), R, cfg.ray_length_m)
+    band, band_t = _horizon_band(scene, pts.reshape(m * G, P, 3)[sel].reshape(-1, 3), pn,
+                                 band_uni[sel].reshape(-1, 2 * R), R, cfg.ray_length_m, crowns)
     out["hor"].reshape(-1)[sel] = band.reshape(-1, P).mean(1)
+    if C:
+        out["hor_t"].reshape(-1, C)[sel] = band_t.reshape(-1, P, C).mean(1)
     g = np.flatnonzero(on_ground & (a > 0))
     if len(g):
         tn = h["normal"][g]
         tn = np.where((tn[:, 2:3] < 0), -tn, tn)
         out["hits"] = {"pair": sel[g // n], "p": oo[g] + dist[g, None].astype(np.float64) * d[g],
                        "n": tn, "w": a[g] / n}
+        if C:
+            out["hits"]["T"] = h["T"][g]
     return out
 
 
 def _street(o, gw, surround, keys, cfg: IrradianceCfg, scene, lift: float, ground_z=None,
-            road_albedo: float = 0.10):
+            road_albedo: float = 0.10, crowns=None, gw_t=None):
     """The street the reflector groups see, as one more reflector of each segment.
 
     Its P sample points are taken from the street hits of the groups' own rays, each hit
@@ -387,7 +431,10 @@ def _street(o, gw, surround, keys, cfg: IrradianceCfg, scene, lift: float, groun
     Returns
     -------
     dict of arrays: ``n`` (m, 3) weighted mean normal, ``pts`` (m, P, 3), ``used`` (m,),
-    and the street's own ``sky``, ``wall`` (m,) (see :func:`_reflector_surroundings`).
+    and the street's own ``sky``, ``wall`` (m,) (see :func:`_reflector_surroundings`); with
+    *crowns* ``sky_t``, ``wall_t`` (m, C) through them and the points' factors ``f`` (m, P,
+    C) (the street seen through the crowns from the groups the roof sees through them,
+    *gw_t* (m, G, C): :func:`_group_points`).
     """
     m, G = gw.shape
     P = cfg.reflector_points
@@ -399,15 +446,25 @@ def _street(o, gw, surround, keys, cfg: IrradianceCfg, scene, lift: float, groun
     used = w_s[:, 0] > 0
     n_s = np.where(used[:, None, None], n_s / np.maximum(np.linalg.norm(n_s, axis=2, keepdims=True),
                                                          1e-12), [0.0, 0.0, 1.0])
+    C = crowns.n_classes if crowns is not None else 0
     if not used.any():
         pts = np.repeat(o[:, None], P, axis=1)
         z = np.zeros(m)
-        return {"n": n_s[:, 0], "pts": pts, "used": used, "sky": z, "wall": z.copy()}
-    pts, pn = _group_points(o, seg, seg, w, h["p"], h["n"], w_s, n_s, P, lift)
+        out = {"n": n_s[:, 0], "pts": pts, "used": used, "sky": z, "wall": z.copy()}
+        if C:
+            out.update(sky_t=np.zeros((m, C)), wall_t=np.zeros((m, C)), f=np.ones((m, P, C)))
+        return out
+    w_t = None
+    if C:
+        w_t = (h["w"][:, None] * h["T"]) * gw_t.reshape(-1, C)[h["pair"]]
+    pts, pn, f = _group_points(o, seg, seg, w, h["p"], h["n"], w_s, n_s, P, lift, w_t)
     own = _reflector_surroundings(scene, keys, pts, pn, used[:, None], cfg, stream=3,
-                                  ground_z=ground_z, road_albedo=road_albedo)
-    return {"n": n_s[:, 0], "pts": pts[:, 0], "used": used, "sky": own["sky"][:, 0],
-            "wall": own["wall"][:, 0]}
+                                  ground_z=ground_z, road_albedo=road_albedo, crowns=crowns)
+    out = {"n": n_s[:, 0], "pts": pts[:, 0], "used": used, "sky": own["sky"][:, 0],
+           "wall": own["wall"][:, 0]}
+    if C:
+        out.update(sky_t=own["sky_t"][:, 0], wall_t=own["wall_t"][:, 0], f=f[:, 0])
+    return out
 
 
 def segment_geometry(scene, segments: pd.DataFrame, cfg: IrradianceCfg | None = None,
@@ -492,19 +549,26 @@ def segment_geometry(scene, segments: pd.DataFrame, cfg: IrradianceCfg | None = 
         ground_z = roof[:, 2] - float(roof_height_m)
     else:
         ground_z = None
+    crowns = scene.crowns(cfg) if hasattr(scene, "crowns") else None
+    C = crowns.n_classes if crowns is not None else 0
     G, P = cfg.max_reflector_groups, cfg.reflector_points
     svf = np.ones(n_seg, np.float64)
     hbv = np.zeros(n_seg, np.float64)
-    acc = _no_reflectors(origin, G, P)
+    trees = {"svf": np.ones((n_seg, C)), "hbv": np.zeros((n_seg, C))} if C else None
+    acc = _no_reflectors(origin, G, P, C)
     H = cfg.horizon_band_rays
     for a in range(0, n_seg, chunk):
         sl = slice(a, min(n_seg, a + chunk))
-        svf[sl] = _sky_view_factor(scene, origin[sl], normal[sl], seg_ids[sl], cfg)
+        svf[sl], svf_t = _sky_view_factor(scene, origin[sl], normal[sl], seg_ids[sl], cfg, crowns)
+        if C:
+            trees["svf"][sl] = svf_t
         tilted = np.flatnonzero(np.hypot(normal[sl, 0], normal[sl, 1]) > 1e-6)
         if len(tilted):
             uni = segment_uniforms(cfg.seed, 4, seg_ids[sl][tilted], 2 * H)
-            hbv[a + tilted] = horizon_band_view(scene, origin[sl][tilted], normal[sl][tilted],
-                                                uni, H, cfg.ray_length_m)
+            hbv[a + tilted], hbv_t = _horizon_band(scene, origin[sl][tilted], normal[sl][tilted],
+                                                   uni, H, cfg.ray_length_m, crowns)
+            if C:
+                trees["hbv"][a + tilted] = hbv_t
         if not (cfg.reflection and cfg.reflection_rays > 0 and G > 0):
             continue
         # more rays where the sky view is small: reflections matter most there
@@ -513,8 +577,9 @@ def segment_geometry(scene, segments: pd.DataFrame, cfg: IrradianceCfg | None = 
             idx = np.arange(sl.start, sl.stop)[part]
             if len(idx):
                 _reflectors(scene, origin[idx], normal[idx], seg_ids[idx], N, cfg, acc, idx,
-                            None if ground_z is None else ground_z[idx], road_albedo)
+                            None if ground_z is None else ground_z[idx], road_albedo, crowns)
     frame = _geometry_frame(seg_ids, origin, tilt, azim, normal, svf, acc, G, P, hbv)
+    profile = None
     if cfg.diffuse_model == "perez_svf":
         # the Perez sky's luminance is integrated over the sky the roof point sees: its
         # horizon per 10 deg sector as a level index (models.sky.sky_levels)
@@ -524,18 +589,81 @@ def segment_geometry(scene, segments: pd.DataFrame, cfg: IrradianceCfg | None = 
         profile = np.concatenate([horizon_profile(scene, origin[a:a + chunk], max_distance_m=cfg.ray_length_m)
                                   for a in range(0, n_seg, chunk)]) if n_seg else np.zeros((0, 72), np.float32)
         frame = pd.concat([frame, pd.DataFrame(sky_levels(profile), columns=SKY_COLUMNS)], axis=1)
+    if C:
+        frame = pd.concat([frame, _tree_frame(crowns, scene, origin, trees, acc, G, cfg,
+                                              None if profile is None else frame[SKY_COLUMNS])], axis=1)
+    if profile is not None:
         frame.attrs["horizon_profile"] = profile        # the run stores it for the app, once
     return frame
+
+
+def tree_columns(C: int, G: int) -> list[str]:
+    """The geometry table's per-class columns of a tile with tree crowns (C classes of
+    months, G reflector groups): the quantity of the column without ``_t{c}`` seen through
+    the crowns in class ``c`` (:func:`segment_geometry`)."""
+    names = ["svf", "hbv"] + [f"r{g}_{k}" for g in range(G)
+                              for k in ("w", "sky", "gnd", "open", "wall", "hor")]
+    if G:
+        names += ["st_sky", "st_wall"]
+    return [f"{n}_t{c}" for c in range(C) for n in names]
+
+
+#: the geometry table's columns of each segment's class of months (crowns), January first
+TREE_MONTH_COLUMNS = [f"tree_month_{m:02d}" for m in range(1, 13)]
+#: the prefix of the crowns' loss per sky cell (``tsky_t{c}_{cell:03d}``, perez_svf)
+_TSKY = re.compile(r"tsky_t(\d+)_(\d{3})")
+#: a reflector's sample point's factor through the crowns (``r{g}_q{k}_t{c}``, ``st_q{k}_t{c}``)
+_POINT_FACTOR = re.compile(r"(r\d+|st)_q(\d+)_t(\d+)")
+
+
+def _tree_frame(crowns, scene, origin, trees: dict, acc: dict, G: int, cfg: IrradianceCfg,
+                sky_x) -> pd.DataFrame:
+    """The columns a tile with crowns adds to its geometry table: the class of each month
+    (:data:`TREE_MONTH_COLUMNS`), :func:`tree_columns`, and with the Perez sky the crowns'
+    loss per sky cell of each class (``tsky_t{c}_{cell:03d}``,
+    :func:`vipvflow.models.trees.sky_cell_loss`)."""
+    f32 = np.float32
+    C, n = crowns.n_classes, len(origin)
+    out = {m: np.full(n, k, np.int8) for m, k in zip(TREE_MONTH_COLUMNS, crowns.class_of_month)}
+    for c in range(C):
+        out[f"svf_t{c}"] = np.minimum(trees["svf"][:, c], 1.0).astype(f32)
+        out[f"hbv_t{c}"] = trees["hbv"][:, c].astype(f32)
+        for g in range(G):
+            out[f"r{g}_w_t{c}"] = acc["w_t"][:, g, c].astype(f32)
+            for k in ("sky", "gnd", "open", "wall", "hor"):
+                out[f"r{g}_{k}_t{c}"] = acc[f"{k}_t"][:, g, c].astype(f32)
+        if G:
+            out[f"st_sky_t{c}"] = acc["street"]["sky_t"][:, c].astype(f32)
+            out[f"st_wall_t{c}"] = acc["street"]["wall_t"][:, c].astype(f32)
+    # each sample point's factor through the crowns (its cell's share of the reflector's
+    # weight through them over its share without; _group_points), per class
+    P = acc["f"].shape[2] if G else 0
+    for c in range(C):
+        for g in range(G):
+            for k in range(P):
+                out[f"r{g}_q{k}_t{c}"] = acc["f"][:, g, k, c].astype(f32)
+        if G:
+            for k in range(P):
+                out[f"st_q{k}_t{c}"] = acc["street"]["f"][:, k, c].astype(f32)
+    if sky_x is not None:
+        from .trees import sky_cell_loss
+
+        loss = sky_cell_loss(crowns, origin - scene.origin, np.asarray(sky_x, f32), cfg.ray_length_m)
+        for c in range(C):
+            for j in range(loss.shape[2]):
+                out[f"tsky_t{c}_{j:03d}"] = loss[:, c, j]
+    return _frame_by_dtype(out)
 
 
 #: the geometry table's columns of the roof point's horizon per sky sector (perez_svf)
 SKY_COLUMNS = [f"sky_x{k:02d}" for k in range(_SKY_SECTORS)]
 
 
-def _no_reflectors(origin, G: int, P: int) -> dict:
-    """Per-segment reflector arrays of segments that see nothing (filled by :func:`_reflectors`)."""
+def _no_reflectors(origin, G: int, P: int, C: int = 0) -> dict:
+    """Per-segment reflector arrays of segments that see nothing (filled by :func:`_reflectors`);
+    with C classes of months (crowns) also their ``w_t``, ``sky_t``.. (n, G, C)."""
     n = len(origin)
-    return {"refl_vf": np.zeros(n), "refl_se": np.zeros(n), "w": np.zeros((n, G)),
+    out = {"refl_vf": np.zeros(n), "refl_se": np.zeros(n), "w": np.zeros((n, G)),
             "n": np.tile(np.array([0.0, 0.0, 1.0]), (n, G, 1)) if G else np.zeros((n, 0, 3)),
             "rep": np.repeat(origin[:, None], G, axis=1),
             "pts": np.repeat(np.repeat(origin[:, None, None], G, axis=1), P, axis=2),
@@ -544,11 +672,18 @@ def _no_reflectors(origin, G: int, P: int) -> dict:
             "street": {"n": np.tile([0.0, 0.0, 1.0], (n, 1)),
                        "pts": np.repeat(origin[:, None], P, axis=1),
                        "sky": np.zeros(n), "wall": np.zeros(n)}}
+    if C:
+        out.update({f"{k}_t": np.zeros((n, G, C)) for k in ("w", "sky", "gnd", "open", "wall", "hor")})
+        out["f"] = np.ones((n, G, P, C))
+        out["street"].update(sky_t=np.zeros((n, C)), wall_t=np.zeros((n, C)), f=np.ones((n, P, C)))
+    return out
 
 
-def _sky_view_factor(scene, o, nrm, keys, cfg: IrradianceCfg) -> np.ndarray:
+def _sky_view_factor(scene, o, nrm, keys, cfg: IrradianceCfg, crowns=None):
     """Cosine-weighted sky view factor of roof points (m,): the share of ``cfg.svf_rays``
-    stratified cosine-weighted rays that escape upwards, at most ``(1 + cos tilt) / 2``.
+    stratified cosine-weighted rays that escape upwards, at most ``(1 + cos tilt) / 2``;
+    and with *crowns* the same with each escaping ray weighted by the crowns' transmittance
+    along it, per class of months (m, C) (None without).
 
     References
     ----------
@@ -557,10 +692,17 @@ def _sky_view_factor(scene, o, nrm, keys, cfg: IrradianceCfg) -> np.ndarray:
     """
     R = cfg.svf_rays
     d = cosine_directions(nrm, R, segment_uniforms(cfg.seed, 0, keys, R + 1)).reshape(-1, 3)
-    blocked = scene.occluded(np.repeat(o, R, axis=0), d, cfg.ray_length_m)
-    free = ((~blocked) & (d[:, 2] > 0)).reshape(len(o), R).mean(axis=1)
+    oo = np.repeat(o, R, axis=0)
+    blocked = scene.occluded(oo, d, cfg.ray_length_m)
+    escape = (~blocked) & (d[:, 2] > 0)
+    free = escape.reshape(len(o), R).mean(axis=1)
     # never above the open field's (1 + cos tilt) / 2, which the rays only estimate
-    return np.minimum(free, isotropic_sky_view(np.asarray(nrm, np.float64)[:, 2]))
+    cap = isotropic_sky_view(np.asarray(nrm, np.float64)[:, 2])
+    if crowns is None:
+        return np.minimum(free, cap), None
+    T = np.zeros((len(oo), crowns.n_classes), np.float32)
+    T[escape] = crowns.transmittance(oo[escape] - scene.origin, d[escape], cfg.ray_length_m)
+    return np.minimum(free, cap), np.minimum(T.reshape(len(o), R, -1).mean(1), cap[:, None])
 
 
 def horizon_band_directions(normals: np.ndarray, n_rays: int, uni: np.ndarray) -> np.ndarray:
@@ -620,17 +762,28 @@ def horizon_band_view(scene, o, nrm, uni, n_rays: int, ray_length_m: float) -> n
     R. Perez et al. (1990), Solar Energy 44(5), 271-289 (the horizon term ``F2 sin beta``);
     pvlib ``irradiance.perez``.
     """
+    return _horizon_band(scene, o, nrm, uni, n_rays, ray_length_m)[0]
+
+
+def _horizon_band(scene, o, nrm, uni, n_rays: int, ray_length_m: float, crowns=None):
+    """:func:`horizon_band_view` (m,), and with *crowns* the same with each free ray
+    weighted by the crowns' transmittance along it, per class of months (m, C) (else None)."""
     nrm = np.asarray(nrm, np.float64)
     s = np.hypot(nrm[:, 0], nrm[:, 1])
     out = np.zeros(len(nrm))
+    out_t = np.zeros((len(nrm), crowns.n_classes)) if crowns is not None else None
     tilted = np.flatnonzero(s > 1e-6)
     if not len(tilted):
-        return out
+        return out, out_t
     d = horizon_band_directions(nrm[tilted], n_rays, np.asarray(uni)[tilted]).reshape(-1, 3)
-    blocked = scene.occluded(np.repeat(np.asarray(o, np.float64)[tilted], n_rays, axis=0), d,
-                             ray_length_m)
+    oo = np.repeat(np.asarray(o, np.float64)[tilted], n_rays, axis=0)
+    blocked = scene.occluded(oo, d, ray_length_m)
     out[tilted] = s[tilted] * (~blocked).reshape(-1, n_rays).mean(1)
-    return out
+    if crowns is not None:
+        T = np.zeros((len(oo), crowns.n_classes), np.float32)
+        T[~blocked] = crowns.transmittance(oo[~blocked] - scene.origin, d[~blocked], ray_length_m)
+        out_t[tilted] = s[tilted, None] * T.reshape(-1, n_rays, crowns.n_classes).mean(1)
+    return out, out_t
 
 
 def _merge_groups(hs, hn, w, m: int, G: int) -> np.ndarray:
@@ -655,18 +808,21 @@ def _merge_groups(hs, hn, w, m: int, G: int) -> np.ndarray:
 
 
 def _reflectors(scene, o, nrm, keys, N: int, cfg: IrradianceCfg, acc: dict, idx,
-                ground_z=None, road_albedo: float = 0.10) -> None:
+                ground_z=None, road_albedo: float = 0.10, crowns=None) -> None:
     """Reflector groups of the roof points *o* (m, 3) with normals *nrm*, from *N*
     cosine-weighted rays each; written into the rows *idx* of *acc* (see
     :func:`segment_geometry` for what each array holds).  *ground_z* (m,): the level of the
-    street under each roof point where the model has none (:func:`_hits`)."""
+    street under each roof point where the model has none (:func:`_hits`).  With *crowns*
+    the groups' weights and surroundings are also found through them, per class of months
+    (``acc["w_t"]``...: the groups, their points and normals stay those without crowns)."""
     mesh = scene.mesh
     G, P = cfg.max_reflector_groups, cfg.reflector_points
     m = len(o)
     d = cosine_directions(nrm, N, segment_uniforms(cfg.seed, 1, keys, N + 1)).reshape(-1, 3)
     oo = np.repeat(o, N, axis=0)
     h = _hits(scene, oo, d, cfg.ray_length_m,
-              None if ground_z is None else np.repeat(np.asarray(ground_z, np.float64), N), road_albedo)
+              None if ground_z is None else np.repeat(np.asarray(ground_z, np.float64), N), road_albedo,
+              crowns)
     tri, dist = h["tri"], h["dist"]
     hit = tri != -1
     x = h["albedo"]
@@ -683,6 +839,11 @@ def _reflectors(scene, o, nrm, keys, N: int, cfg: IrradianceCfg, acc: dict, idx,
     w = x[hit] / N
     gkey = hs * G + _merge_groups(hs, hn, w, m, G)
     w_g = np.bincount(gkey, w, m * G).reshape(m, G)
+    w_t = None
+    if crowns is not None:
+        w_t = w[:, None] * h["T"][hit]
+        acc["w_t"][idx] = np.stack([np.bincount(gkey, w_t[:, c], m * G).reshape(m, G)
+                                    for c in range(w_t.shape[1])], -1)
     n_g = np.stack([np.bincount(gkey, w * hn[:, j], m * G) for j in range(3)], -1).reshape(m, G, 3)
     p_g = np.stack([np.bincount(gkey, w * hp[:, j], m * G) for j in range(3)], -1).reshape(m, G, 3)
     nz = w_g > 0
@@ -703,13 +864,18 @@ def _reflectors(scene, o, nrm, keys, N: int, cfg: IrradianceCfg, acc: dict, idx,
     acc["surface"][idx] = _dominant_surface(gkey, surf, w, m * G).reshape(m, G)
     # sample points (lit fraction) and the groups' own surroundings (sky, street, facades)
     lift = max(cfg.ray_offset_m, _MIN_REFLECTOR_LIFT)
-    pts, pn = _group_points(o, hs, gkey, w, hp, hn, w_g, n_g, P, lift)
+    pts, pn, f = _group_points(o, hs, gkey, w, hp, hn, w_g, n_g, P, lift, w_t)
+    if f is not None:
+        acc["f"][idx] = f
     around = _reflector_surroundings(scene, keys, pts, pn, nz, cfg, ground_z=ground_z,
-                                     road_albedo=road_albedo)
+                                     road_albedo=road_albedo, crowns=crowns)
     for k in ("sky", "gnd", "open", "wall", "hor"):
         acc[k][idx] = around[k]
+        if crowns is not None:
+            acc[f"{k}_t"][idx] = around[f"{k}_t"]
     acc["w"][idx], acc["n"][idx], acc["rep"][idx], acc["pts"][idx] = w_g, n_g, rep.reshape(m, G, 3), pts
-    st = _street(o, w_g, around, keys, cfg, scene, lift, ground_z, road_albedo)
+    st = _street(o, w_g, around, keys, cfg, scene, lift, ground_z, road_albedo, crowns,
+                 acc["w_t"][idx] if crowns is not None else None)
     for k in acc["street"]:
         acc["street"][k][idx] = st[k]
 
@@ -794,6 +960,30 @@ def geometry_table(geometry: pd.DataFrame):
             raise ValueError(f"geometry columns of {prefix} not in point order")
         flat = np.ascontiguousarray(block[idx[0]][:, [where[i] for i in idx]], np.float64).ravel()
         first[idx[0]] = (f"{prefix}_points", pa.FixedSizeListArray.from_arrays(pa.array(flat), 3 * P))
+    # the crowns' loss per sky cell of each class: one list column ``tsky_t{c}`` (float32)
+    cells: dict[str, list[int]] = {}
+    for i, name in enumerate(names):
+        m = _TSKY.fullmatch(name)
+        if m:
+            cells.setdefault(f"tsky_t{m.group(1)}", []).append(i)
+    for prefix, idx in cells.items():
+        if [names[i] for i in idx] != [f"{prefix}_{j:03d}" for j in range(len(idx))]:
+            raise ValueError(f"geometry columns of {prefix} not in cell order")
+        flat = np.ascontiguousarray(block[idx[0]][:, [where[i] for i in idx]], np.float32).ravel()
+        first[idx[0]] = (prefix, pa.FixedSizeListArray.from_arrays(pa.array(flat), len(idx)))
+        points[prefix] = idx
+    # the sample points' factors through the crowns: one list column ``<prefix>_q_t{c}``
+    factors: dict[tuple, list[int]] = {}
+    for i, name in enumerate(names):
+        m = _POINT_FACTOR.fullmatch(name)
+        if m:
+            factors.setdefault((m.group(1), m.group(3)), []).append(i)
+    for (prefix, c), idx in factors.items():
+        if [names[i] for i in idx] != [f"{prefix}_q{k}_t{c}" for k in range(len(idx))]:
+            raise ValueError(f"geometry columns of {prefix}'s point factors not in point order")
+        flat = np.ascontiguousarray(block[idx[0]][:, [where[i] for i in idx]], np.float32).ravel()
+        first[idx[0]] = (f"{prefix}_q_t{c}", pa.FixedSizeListArray.from_arrays(pa.array(flat), len(idx)))
+        points[f"{prefix}_q_t{c}"] = idx
     in_points = {i for idx in points.values() for i in idx}
     out_names, out_arrays = [], []
     for i, name in enumerate(names):
@@ -822,13 +1012,23 @@ def read_geometry(path, columns: list[str] | None = None) -> pd.DataFrame:
             for k in range(size // 3):
                 for j, c in enumerate("xyz"):
                     out[f"{prefix}_p{k}_{c}"] = flat[:, 3 * k + j]
+        elif pa.types.is_fixed_size_list(col.type) and name.startswith("tsky_t"):
+            flat = col.combine_chunks().flatten().to_numpy().reshape(-1, col.type.list_size)
+            for j in range(col.type.list_size):
+                out[f"{name}_{j:03d}"] = flat[:, j]
+        elif pa.types.is_fixed_size_list(col.type) and "_q_t" in name:
+            prefix, c = name.split("_q_t")
+            flat = col.combine_chunks().flatten().to_numpy().reshape(-1, col.type.list_size)
+            for k in range(col.type.list_size):
+                out[f"{prefix}_q{k}_t{c}"] = flat[:, k]
         else:
             out[name] = col.to_numpy()
     return _frame_by_dtype(out) if out else table.to_pandas()
 
 
 COMPONENTS = ("direct", "diffuse", "reflected", "total", "direct_clear", "diffuse_clear",
-              "reflected_clear", "total_clear", "total_unshaded", "total_clear_unshaded")
+              "reflected_clear", "total_clear", "total_unshaded", "total_clear_unshaded",
+              "direct_no_trees", "diffuse_no_trees")
 
 
 def _exchange_weights(w, f_street, f_wall, street_wall, has_street):
@@ -933,10 +1133,25 @@ def pack_geometry(geometry: pd.DataFrame, cfg: IrradianceCfg, ground_albedo: flo
     street = bool(G and P and "st_sky" in cols)
     J = G + street
     col = lambda c, dt=np.float64: geometry[c].to_numpy(dt)         # noqa: E731
-    w = np.stack([col(f"r{g}_w") for g in range(G)], 1) if G else np.zeros((s, 0))
+    # the classes of months of a tile with crowns (1 without): the quantities the crowns
+    # change are taken per class from their ``_t{c}`` columns (a row of a tile without
+    # crowns, joined with others in the app, has them missing: its own values serve)
+    months = _tree_months(geometry, cols)
+    C = int(months.max()) + 1 if s else 1
+
+    def per_class(name, default=None):
+        base = col(name) if name in cols else (np.zeros(s) if default is None else default)
+        out = np.repeat(base[:, None], C, axis=1)
+        for c in range(C):
+            if f"{name}_t{c}" in cols:
+                v = col(f"{name}_t{c}")
+                out[:, c] = np.where(np.isfinite(v), v, base)
+        return out
+
+    w = np.stack([per_class(f"r{g}_w") for g in range(G)], 1) if G else np.zeros((s, 0, C))
     nrm = np.zeros((s, J, 3))
     pts = np.zeros((s, J, max(P, 1), 3), np.float64)
-    f_s, f_g, f_o, f_w, f_h = (np.zeros((s, G)) for _ in range(5))
+    f_s, f_g, f_o, f_w, f_h = (np.zeros((s, G, C)) for _ in range(5))
     beam_len = np.ones((s, J))
     # the sample points: one (s, P x 3) block per reflector (a thousand columns read one
     # by one cost more than the rest of the packing)
@@ -950,41 +1165,118 @@ def pack_geometry(geometry: pd.DataFrame, cfg: IrradianceCfg, ground_albedo: flo
         if P:
             pts[:, g] = points(f"r{g}")
         if f"r{g}_sky" in cols:
-            f_s[:, g], f_g[:, g], f_o[:, g] = col(f"r{g}_sky"), col(f"r{g}_gnd"), col(f"r{g}_open")
+            f_s[:, g], f_g[:, g], f_o[:, g] = (per_class(f"r{g}_{k}") for k in ("sky", "gnd", "open"))
         else:
-            f_s[:, g], f_o[:, g] = (1 + nrm[:, g, 2]) / 2, (1 - nrm[:, g, 2]) / 2
-        if f"r{g}_wall" in cols:
-            f_w[:, g] = col(f"r{g}_wall")
-        if f"r{g}_hor" in cols:
-            f_h[:, g] = col(f"r{g}_hor")
+            f_s[:, g] = ((1 + nrm[:, g, 2]) / 2)[:, None]
+            f_o[:, g] = ((1 - nrm[:, g, 2]) / 2)[:, None]
+        f_w[:, g], f_h[:, g] = per_class(f"r{g}_wall"), per_class(f"r{g}_hor")
         if f"r{g}_nlen" in cols:
             beam_len[:, g] = col(f"r{g}_nlen")
-    src_sky, src_ghi = f_s, ground_albedo * f_o
+    # one set of reflectors per (segment, class): the classes as more rows
+    flat = lambda a: np.moveaxis(a, 2, 1).reshape(s * C, a.shape[1])       # noqa: E731
+    w2, f_s2, f_g2, f_o2, f_w2, f_h2 = (flat(a) for a in (w, f_s, f_g, f_o, f_w, f_h))
+    src_sky, src_ghi = f_s2, ground_albedo * f_o2
     if street:
         for j, c in enumerate("xyz"):
             nrm[:, G, j] = col(f"st_n{c}")
         pts[:, G] = points("st")
-        has = (f_g * w).sum(1) > 0
-        m = _exchange_weights(w, f_g, f_w, col("st_wall"), has)
-        src_sky = np.concatenate([f_s, col("st_sky")[:, None]], 1)
-        src_ghi = np.concatenate([src_ghi, np.zeros((s, 1))], 1)
-        f_h = np.concatenate([f_h, np.zeros((s, 1))], 1)     # a level street: no horizon term
+        # the street is a reflector of the segment where its groups see it without crowns
+        has = np.repeat(((f_g * w).sum(1) > 0).any(1), C)
+        m = _exchange_weights(w2, f_g2, f_w2, per_class("st_wall").reshape(-1), has)
+        src_sky = np.concatenate([f_s2, per_class("st_sky").reshape(-1)[:, None]], 1)
+        src_ghi = np.concatenate([src_ghi, np.zeros((s * C, 1))], 1)
+        f_h2 = np.concatenate([f_h2, np.zeros((s * C, 1))], 1)   # a level street: no horizon term
     else:                     # the street lit as an open field, by GHI
-        m = w
-        src_ghi = src_ghi + f_g
+        m = w2
+        src_ghi = src_ghi + f_g2
+    blen = np.repeat(beam_len, C, axis=0)
+    nrm_c = np.repeat(nrm, C, axis=0)
     geo = {"p": np.ascontiguousarray(geometry[["px", "py", "pz"]].to_numpy(np.float64)),
            "n": np.ascontiguousarray(geometry[["nx", "ny", "nz"]].to_numpy(f32)),
-           "svf": geometry["svf"].to_numpy(f32),
-           "hbv": (geometry["hbv"].to_numpy(f32) if "hbv" in cols else np.zeros(s, f32)),
+           "svf": np.ascontiguousarray(per_class("svf").astype(f32)),
+           "svf_no_trees": geometry["svf"].to_numpy(f32),
+           "hbv": np.ascontiguousarray(per_class("hbv").astype(f32)),
+           "hbv_no_trees": (geometry["hbv"].to_numpy(f32) if "hbv" in cols else np.zeros(s, f32)),
            **_sky_terms(geometry, cols),
-           "refl_sky": (m * src_sky).sum(1).astype(f32), "refl_ghi": (m * src_ghi).sum(1).astype(f32),
-           "refl_hor": (m * f_h).sum(1).astype(f32),
-           "wn": ((m * beam_len)[..., None] * nrm).astype(f32), "group_p": pts.reshape(s * J, -1, 3)}
+           "tree_month": months,
+           **_tree_sky(geometry, cols, C),
+           "refl_sky": (m * src_sky).sum(1).astype(f32).reshape(s, C),
+           "refl_ghi": (m * src_ghi).sum(1).astype(f32).reshape(s, C),
+           "refl_hor": (m * f_h2).sum(1).astype(f32).reshape(s, C),
+           "wn": np.ascontiguousarray(((m * blen)[..., None] * nrm_c).astype(f32).reshape(s, C, J, 3)),
+           "group_p": pts.reshape(s * J, max(P, 1), 3),
+           "group_f": _point_factors(geometry, cols, G, street, max(P, 1), C)}
     if scene is not None:
         geo["scene_origin"] = np.asarray(scene.origin, np.float64).copy()
         geo["p_local"] = scene.to_local(geo["p"])
         geo["group_p_local"] = scene.to_local(geo["group_p"])
+        _check_tree_classes(geo, scene, cfg)
     return geo
+
+
+def _point_factors(geometry: pd.DataFrame, cols: set, G: int, street: bool, P: int,
+                   C: int) -> np.ndarray:
+    """Each reflector sample point's factor through the crowns per class, (s J, P, C)
+    float32 (:func:`_group_points`; 1 without crowns, or for a row without them)."""
+    s = len(geometry)
+    out = np.ones((s, G + street, P, C), np.float32)
+    for j, prefix in enumerate([f"r{g}" for g in range(G)] + (["st"] if street else [])):
+        for c in range(C):
+            names = [f"{prefix}_q{k}_t{c}" for k in range(P)]
+            if names[0] in cols:
+                v = geometry[names].to_numpy(np.float32)
+                out[:, j, :, c] = np.where(np.isfinite(v), v, np.float32(1))
+    return np.ascontiguousarray(out.reshape(s * (G + street), P, C))
+
+
+def _tree_months(geometry: pd.DataFrame, cols: set) -> np.ndarray:
+    """Each segment's class of each month (s, 12) int64: the ``tree_month_..`` columns, 0
+    where there are none (no crowns)."""
+    s = len(geometry)
+    if not set(TREE_MONTH_COLUMNS) <= cols:
+        return np.zeros((s, 12), np.int64)
+    v = geometry[TREE_MONTH_COLUMNS].to_numpy(np.float64)
+    return np.ascontiguousarray(np.where(np.isfinite(v), v, 0).astype(np.int64))
+
+
+def _tree_sky(geometry: pd.DataFrame, cols: set, C: int) -> dict:
+    """The crowns' loss per sky cell (perez_svf), dense ``tsky`` (s, C, 324) float32 (s, C, 0
+    without), and its nonzero entries for the compiled kernel: ``tsky_off`` (s + 1,) the
+    first entry of each segment, ``tsky_cell`` (e,) the cell's flat index in a sky table row
+    (:func:`vipvflow.models.trees.sky_cells`), ``tsky_sector`` (e,), ``tsky_w`` (e, C)."""
+    from .trees import sky_cells
+
+    s = len(geometry)
+    names = [[f"tsky_t{c}_{j:03d}" for j in range(len(sky_cells()))] for c in range(C)]
+    if not (f"tsky_t0_000" in cols):
+        return {"tsky": np.zeros((s, C, 0), np.float32), "tsky_off": np.zeros(s + 1, np.int64),
+                "tsky_cell": np.zeros(0, np.int64), "tsky_sector": np.zeros(0, np.int64),
+                "tsky_w": np.zeros((0, C), np.float32)}
+    dense = np.zeros((s, C, len(sky_cells())), np.float32)
+    for c in range(C):
+        if names[c][0] in cols:
+            dense[:, c] = np.nan_to_num(geometry[names[c]].to_numpy(np.float32))
+    any_c = (dense > 0).any(1)                                      # (s, cells)
+    seg, cell = np.nonzero(any_c)
+    off = np.zeros(s + 1, np.int64)
+    np.cumsum(np.bincount(seg, minlength=s), out=off[1:])
+    flat_cell = sky_cells()[cell]
+    return {"tsky": dense, "tsky_off": off, "tsky_cell": np.ascontiguousarray(flat_cell.astype(np.int64)),
+            "tsky_sector": np.ascontiguousarray((cell // 9).astype(np.int64)),
+            "tsky_w": np.ascontiguousarray(dense[seg, :, cell])}
+
+
+def _check_tree_classes(geo: dict, scene, cfg) -> None:
+    """The geometry's classes of months must be those of the scene's crowns (the rays of a
+    pass are traced through them): a geometry computed with other trees is refused."""
+    crowns = scene.crowns(cfg) if hasattr(scene, "crowns") else None
+    want = crowns.class_of_month if crowns is not None else np.zeros(12, np.int64)
+    got = geo["tree_month"]
+    if len(got) and not (got == want[None, :]).all():
+        from ..errors import InputError
+
+        raise InputError("the segment geometry was computed with other trees than the city "
+                         "model's now (classes of months differ): compute the geometry again")
 
 
 def _sky_terms(geometry: pd.DataFrame, cols: set) -> dict:

@@ -376,6 +376,9 @@ _SECTIONS = {
     "Buildings": {
         "shading_loss_allsky": "shading loss, all-sky",
         "shading_loss_clearsky": "shading loss, clear-sky",
+        "shading_loss_allsky_without_trees": "shading loss by the buildings alone, all-sky",
+        "tree_shading_loss_allsky": "of which the tree crowns add, all-sky",
+        "trees_in_city_model": "trees in the city model",
         "reflection_gain_allsky": "gain from reflections, all-sky",
         "net_building_effect_allsky": "net effect of the buildings, all-sky",
         "route_km_in_city_model_share": "route-km inside the city model",

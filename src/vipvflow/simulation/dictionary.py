@@ -36,8 +36,12 @@ INSTANT = "timestamp (UTC)"
 
 #: the light a roof receives, by component and sky (``h_<c>`` sums, ``g_<c>`` means, ``pv_kwh_<c>``)
 _LIGHT = {
-    "direct": "beam (direct) light on the roof, after the buildings' shadow",
-    "diffuse": "sky diffuse light on the roof, from the part of the sky the buildings leave open",
+    "direct": "beam (direct) light on the roof, after the shadow of the buildings and the tree crowns",
+    "diffuse": "sky diffuse light on the roof, from the part of the sky the buildings leave open, "
+               "through the tree crowns",
+    "direct_no_trees": "beam (direct) light on the roof with the buildings alone (no tree crowns; "
+                       "the reference of the trees' shading loss)",
+    "diffuse_no_trees": "sky diffuse light on the roof with the buildings alone (no tree crowns)",
     "reflected": "light reflected onto the roof by the buildings and the ground",
     "total": "all light on the roof: direct + diffuse + reflected, with the buildings",
     "total_unshaded": "all light on the roof without any building (the reference of the shading loss)",
@@ -73,7 +77,7 @@ _PV = {
 
 _COMPONENTS = ["direct", "diffuse", "reflected", "total", "total_unshaded",
                "direct_clear", "diffuse_clear", "reflected_clear", "total_clear",
-               "total_clear_unshaded", "ghi", "ghi_clear"]
+               "total_clear_unshaded", "ghi", "ghi_clear", "direct_no_trees", "diffuse_no_trees"]
 
 #: columns shared by the output files (a file's own entry overrides)
 COLUMNS: dict[str, Column] = {
@@ -351,6 +355,15 @@ SUMMARY: dict[str, Column] = {
     "shading_loss_allsky": Column("fraction", "1 - (direct + diffuse) / unshaded light on the roofs, all-sky "
                                               "(segments inside building footprints left out)"),
     "shading_loss_clearsky": Column("fraction", "the same, clear-sky"),
+    "shading_loss_allsky_without_trees": Column("fraction", "shading_loss_allsky with the buildings "
+                                                            "alone (no tree crowns), all-sky"),
+    "tree_shading_loss_allsky": Column("fraction", "what the tree crowns add to the shading loss: "
+                                                   "shading_loss_allsky - "
+                                                   "shading_loss_allsky_without_trees"),
+    "trees_in_city_model": Column("count", "trees (crowns) the city ingest kept from the CityGML "
+                                           "vegetation and the tree tables (0 when "
+                                           "irradiance.trees.enabled is false; null when the "
+                                           "ingest's report cannot be read)"),
     "reflection_gain_allsky": Column("fraction", "reflected / unshaded light, all-sky"),
     "net_building_effect_allsky": Column("fraction", "light with buildings / without - 1 (shading and "
                                                      "reflections together), all-sky"),

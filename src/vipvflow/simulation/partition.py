@@ -28,7 +28,7 @@ VARIANTS = {
 }
 COMPONENTS = ["direct", "diffuse", "reflected", "total", "total_unshaded",
               "direct_clear", "diffuse_clear", "reflected_clear", "total_clear",
-              "total_clear_unshaded", "ghi", "ghi_clear"]
+              "total_clear_unshaded", "ghi", "ghi_clear", "direct_no_trees", "diffuse_no_trees"]
 
 
 @dataclass(frozen=True)

@@ -23,8 +23,8 @@ def _cached(stamp: Path, fp: dict) -> bool:
 #: written beside the demo inputs: the year, seed and size they were generated for
 DEMO_MARKER = "demo_generated.json"
 #: the demo generator's version: inputs of an older generator are made again (2: termini
-#: among buildings)
-DEMO_VERSION = 2
+#: among buildings; 3: street trees)
+DEMO_VERSION = 3
 
 
 def mark_demo(folder, year: int, seed: int, size: str) -> None:
@@ -75,13 +75,15 @@ def ensure_demo(cfg: Config, year: int, say=print) -> None:
 
 def input_digests(cfg: Config) -> "InputDigests":
     """The content digests (SHA-256) of the scenario's input files, which must exist; the
-    timetable and the radiation are required."""
+    timetable and the radiation are required (tree tables, ``inputs.trees``, are optional)."""
     from .manifest import InputDigests
 
     city_files = [Path(p) for p in cfg.inputs.citygml]
+    tree_files = [Path(p) for p in cfg.inputs.trees]
     cams_files = [Path(p) for p in cfg.inputs.cams]
     gtfs = Path(cfg.inputs.gtfs) if cfg.inputs.gtfs else None
-    missing = [str(p) for p in [*city_files, *cams_files, *([gtfs] if gtfs else [])] if not p.exists()]
+    missing = [str(p) for p in [*city_files, *tree_files, *cams_files, *([gtfs] if gtfs else [])]
+               if not p.exists()]
     if missing:
         raise InputError("input file(s) not found: " + ", ".join(missing)
                          + " (see data_manifest.yaml and `make data`)")
@@ -90,9 +92,15 @@ def input_digests(cfg: Config) -> "InputDigests":
     not_files = [str(p) for p in [*city_files, *cams_files] if not p.is_file()]
     if not_files:
         raise InputError(f"{cfg._source}: inputs name folders, not files: {', '.join(not_files)}")
-    return InputDigests({"inputs.citygml": {str(p): sha256(p) for p in city_files},
-                         "inputs.gtfs": {str(gtfs): sha256(gtfs)},
-                         "inputs.cams": {str(p): sha256(p) for p in cams_files}})
+    not_files = [str(p) for p in tree_files if not p.is_file()]
+    if not_files:
+        raise InputError(f"{cfg._source}: inputs.trees names folders, not files: {', '.join(not_files)}")
+    files = {"inputs.citygml": {str(p): sha256(p) for p in city_files},
+             "inputs.gtfs": {str(gtfs): sha256(gtfs)},
+             "inputs.cams": {str(p): sha256(p) for p in cams_files}}
+    if tree_files:
+        files["inputs.trees"] = {str(p): sha256(p) for p in tree_files}
+    return InputDigests(files)
 
 
 #: the ingests' format versions: a data dir ingested before (city: no meshes for the tiles
@@ -110,10 +118,14 @@ def _fingerprints(cfg: Config, inputs) -> dict:
         return sorted(inputs.files[role].values())
 
     from ..models.mesh import MESH_FORMAT
+    from ..models.tree_table import TREES_FORMAT
 
-    city = {"files": shas("inputs.citygml"), "config": {
-        "city": cfg.city.model_dump(mode="json"), "crs": cfg.inputs.citygml_crs,
-        "format": _FORMATS["city"], "mesh_format": MESH_FORMAT}}
+    # the trees (vegetation as crowns, never mesh surfaces, and the tree tables) shape the city
+    city = {"files": shas("inputs.citygml") + (shas("inputs.trees") if "inputs.trees" in inputs.files
+                                              else []),
+            "config": {"city": cfg.city.model_dump(mode="json"), "crs": cfg.inputs.citygml_crs,
+                       "format": _FORMATS["city"], "mesh_format": MESH_FORMAT,
+                       "trees_format": TREES_FORMAT, "trees_crs": cfg.inputs.trees_crs}}
     radiation = {"files": shas("inputs.cams"), "config": {"checks": _FORMATS["radiation"]}}
     gtfs = {"files": shas("inputs.gtfs"), "config": {
         "trajectory": cfg.trajectory.model_dump(mode="json"), "city": city,
@@ -145,15 +157,18 @@ def ensure_ingested(cfg: Config, say=print, inputs=None):
         inputs = input_digests(cfg)
     data_dir = Path(cfg.data_dir)
     city_files = [Path(p) for p in cfg.inputs.citygml]
+    tree_files = [Path(p) for p in cfg.inputs.trees]
     cams_files = [Path(p) for p in cfg.inputs.cams]
     gtfs = Path(cfg.inputs.gtfs)
     fps = _fingerprints(cfg, inputs)
     data = DataDir(data_dir)
     stamp = data.city.stamp
     if city_files and not _cached(stamp, fps["city"]):
-        say(f"ingesting {len(city_files)} CityGML file(s)")
+        say(f"ingesting {len(city_files)} CityGML file(s)"
+            + (f" and {len(tree_files)} tree table(s)" if tree_files else ""))
         report = ingest_city(city_files, data_dir, cfg.city, crs=cfg.inputs.citygml_crs,
-                             accept=cfg.checks.accept)
+                             accept=cfg.checks.accept, trees=tree_files,
+                             trees_crs=cfg.inputs.trees_crs)
         say("  " + report.summary())
         _stamp(stamp, fps["city"])
     # the radiation before the timetable: its header's altitude is the ground where the

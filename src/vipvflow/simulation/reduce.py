@@ -1052,6 +1052,26 @@ def _study_area(sm: pd.DataFrame, flags: pd.DataFrame, kwh_per_kwp_driving: floa
     }
 
 
+def _tree_figures(cfg: Config, tot: pd.Series) -> dict:
+    """The trees' part of the shading loss on the road (all-sky): the loss with the
+    buildings alone (the ``_no_trees`` light) and what the crowns add to it, and how many
+    trees the city model holds (the city ingest's count; 0 with ``irradiance.trees.enabled``
+    false; None when the ingest's report cannot be read: unknown, not 0)."""
+    import json
+
+    report = DataDir(cfg.data_dir).city.report
+    try:
+        kept = int(json.loads(report.read_text()).get("trees", {}).get("kept", 0))
+    except (OSError, ValueError, AttributeError, TypeError):
+        kept = None
+    without = float(shading_loss(tot["h_direct_no_trees"], tot["h_diffuse_no_trees"],
+                                 tot["h_total_unshaded"]))
+    with_trees = float(shading_loss(tot["h_direct"], tot["h_diffuse"], tot["h_total_unshaded"]))
+    return {"trees_in_city_model": kept if cfg.irradiance.trees.enabled else 0,
+            "shading_loss_allsky_without_trees": without,
+            "tree_shading_loss_allsky": with_trees - without}
+
+
 def _fleet_year(cfg: Config, year: int, run_dir: Path, trip, bd, idle, sm, segments,
                 n_buses: int) -> tuple[pd.DataFrame, dict]:
     """The fleet per month and the fleet-year summary (checked: :func:`_check_totals`)."""
@@ -1083,6 +1103,7 @@ def _fleet_year(cfg: Config, year: int, run_dir: Path, trip, bd, idle, sm, segme
         "kwh_per_kwp_driving_clearsky": float(trip["pv_kwh_clear"].sum() * annualise / (pv.kwp * n_buses)),
         "irradiation_kwh_m2": {k[2:]: float(v) / 1000.0 for k, v in tot_all.items()},
         "shading_loss_allsky": float(shading_loss(tot["h_direct"], tot["h_diffuse"], tot["h_total_unshaded"])),
+        **_tree_figures(cfg, tot),
         "shading_loss_clearsky": float(shading_loss(tot["h_direct_clear"], tot["h_diffuse_clear"],
                                                     tot["h_total_clear_unshaded"])),
         "reflection_gain_allsky": float(tot["h_reflected"] / tot["h_total_unshaded"]),

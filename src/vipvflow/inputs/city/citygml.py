@@ -16,7 +16,13 @@ What is read
   from the normal. ``xlink:href`` surface members are resolved within the feature.
 - ``ReliefFeature`` / ``TINRelief``: triangles and polygons (``gml:Triangle`` in
   ``trianglePatches`` / ``patches``) as terrain.
-- ``SolitaryVegetationObject`` / ``PlantCover``: explicit polygons as vegetation.
+- ``SolitaryVegetationObject`` / ``PlantCover``: trees and plant covers, never surfaces of
+  the mesh (:mod:`vipvflow.inputs.city.trees` makes crowns of them): their attributes
+  (``height``, ``crownDiameter``, ``averageHeight``, ``class``, ``species``, generic attributes
+  naming a crown base or leaf type), explicit geometry (any LoD: its vertices), and implicit
+  geometry (``ImplicitGeometry``: the transformation matrix and reference point, the relative
+  geometry inline, by xlink within the feature or to a template an earlier feature of the
+  file defined; an external ``libraryObject`` is not read, its attributes serve).
 """
 from __future__ import annotations
 
@@ -85,8 +91,36 @@ class RawSurface:
 
 
 @dataclass
+class Vegetation:
+    """What a vegetation object says about its shape (file CRS; None where it says nothing).
+
+    ``cls``: ``SolitaryVegetationObject`` or ``PlantCover``; ``attributes``: name -> value
+    (``height``, ``crownDiameter``, ``trunkDiameter``, ``averageHeight`` in m, ``class``,
+    ``species``, ``function``, and generic attributes by name); ``vertices`` (n, 3) of its
+    explicit geometry; ``ref`` (3,) the implicit geometry's reference point, ``offsets``
+    (k, 3) its relative geometry through the transformation matrix (m, added to ``ref``),
+    ``matrix`` the 4 x 4 matrix; ``polygons`` the explicit polygons' exterior rings (plant
+    covers: their footprint)."""
+
+    cls: str
+    attributes: dict = field(default_factory=dict)
+    vertices: np.ndarray | None = None
+    ref: np.ndarray | None = None
+    offsets: np.ndarray | None = None
+    matrix: np.ndarray | None = None
+    polygons: list = field(default_factory=list)
+    implicit: str = ""          # "", "inline", "template", "library", "unresolved"
+
+    def sample(self) -> np.ndarray:
+        """Some of its coordinates (file CRS), for settling the file's axis order."""
+        parts = [a for a in (self.vertices, None if self.ref is None else self.ref[None]) if a is not None]
+        return np.concatenate(parts) if parts else np.zeros((0, 3))
+
+
+@dataclass
 class Feature:
-    """A city object: its id, kind (building, terrain, vegetation) and polygons."""
+    """A city object: its id, kind (building, terrain, vegetation) and polygons (a
+    vegetation object's shape in ``vegetation``)."""
 
     kind: str
     feature_id: str
@@ -96,6 +130,7 @@ class Feature:
     problems: Counter = field(default_factory=Counter)   # unreadable bits, per reason
     skips: list = field(default_factory=list)            # (surface type or None, reason) per unreadable polygon
     lods: set = field(default_factory=set)               # LoDs the geometry was taken from
+    vegetation: Vegetation | None = None
 
     @property
     def lod_used(self) -> str:
@@ -128,6 +163,8 @@ class CityGMLReader:
         self.ignored: Counter = Counter()
         self._anon = 0
         self._seen_ns: set = set()
+        #: implicit geometries' relative geometries by gml:id, for later features' xlinks
+        self.templates: dict = {}
 
     def __iter__(self) -> Iterator[Feature]:
         ctx = etree.iterparse(self.source, events=("end",), tag=_MEMBERS, huge_tree=True,
@@ -194,7 +231,7 @@ class CityGMLReader:
         if name == "ReliefFeature":
             return self._generic(el, "terrain", "terrain", "ReliefFeature")
         if name in ("SolitaryVegetationObject", "PlantCover"):
-            return self._generic(el, "vegetation", "vegetation", name)
+            return self._vegetation(el, name)
         self.ignored[name] += 1
         return None
 
@@ -261,6 +298,124 @@ class CityGMLReader:
             else:
                 feature.surfaces.append(RawSurface(rings, stype, cls, None, rev))
         return feature
+
+
+    def _vegetation(self, el, cls: str) -> Feature:
+        """A tree or plant cover: attributes, explicit vertices, implicit geometry."""
+        fid = gml_id(el) or self._new_id("vegetation")
+        feature = Feature("vegetation", fid)
+        veg = feature.vegetation = Vegetation(cls)
+        index = _LazyIndex(el)
+        for child in el:
+            if not isinstance(child.tag, str):
+                continue
+            name = local(child)
+            if name in _VEG_NUMBERS:
+                try:
+                    veg.attributes[name] = float(child.text)
+                except (TypeError, ValueError):
+                    feature.problems[f"unreadable_{name}"] += 1
+            elif name in ("class", "species", "function", "usage"):
+                veg.attributes[name] = (child.text or "").strip()
+            elif name.endswith("Attribute") and child.get("name"):      # CityGML 1.0 / 2.0
+                value = next((v.text for v in child if local(v) == "value"), None)
+                if value is not None:
+                    veg.attributes[child.get("name")] = value.strip()
+            elif name == "genericAttribute":                              # CityGML 3.0
+                for att in child:
+                    parts = {local(v): (v.text or "").strip() for v in att if isinstance(v.tag, str)}
+                    if parts.get("name") and "value" in parts:
+                        veg.attributes[parts["name"]] = parts["value"]
+            elif "ImplicitRepresentation" in name and veg.ref is None:
+                self._implicit(child, veg, index, feature.problems)
+            elif _LOD_SURF.match(name):
+                rings = []
+                for poly, _ in _polygons(child, index, feature.problems, skip_implicit=True):
+                    r, why = _rings(poly)
+                    if r is None:
+                        feature.skips.append(("vegetation", why))
+                    else:
+                        rings.append(r[0])
+                if rings:
+                    feature.lods.add(_lod_of(child))
+                    veg.polygons += rings
+        if veg.polygons:
+            veg.vertices = np.concatenate(veg.polygons)
+        return feature
+
+    def _implicit(self, holder, veg: "Vegetation", index, problems: Counter) -> None:
+        """An ``ImplicitGeometry``: matrix, reference point, relative geometry's vertices."""
+        ig = next((c for c in holder.iter() if local(c) == "ImplicitGeometry"), None)
+        if ig is None:
+            return
+        matrix, ref, rel = np.eye(4), None, None
+        for child in ig:
+            name = local(child)
+            if name == "transformationMatrix":
+                try:
+                    matrix = np.array((child.text or "").split(), np.float64).reshape(4, 4)
+                except ValueError:
+                    problems["unreadable_transformation_matrix"] += 1
+            elif name == "referencePoint":
+                pos = next((p for p in child.iter() if local(p) in ("pos", "coordinates")), None)
+                if pos is not None:
+                    try:
+                        v = np.array((pos.text or "").replace(",", " ").split(), np.float64)
+                        ref = np.r_[v, np.zeros(3)][:3] if len(v) in (2, 3) else None
+                    except ValueError:
+                        ref = None
+            elif name in ("relativeGMLGeometry", "relativeGeometry"):
+                rel = child
+            elif name == "libraryObject":
+                veg.implicit = "library"
+        if ref is None:
+            problems["implicit_geometry_without_reference_point"] += 1
+            return
+        veg.ref, veg.matrix = ref, matrix
+        if rel is None:
+            veg.implicit = veg.implicit or "unresolved"
+            return
+        href = rel.get(XLINK_HREF)
+        if href is not None and len(rel) == 0:
+            target = index.get(href)
+            verts = _vertices(target, index, problems) if target is not None else \
+                self.templates.get(href.lstrip("#"))
+            veg.implicit = "template"
+        else:
+            verts = _vertices(rel, index, problems)
+            veg.implicit = "inline"
+            for g in rel:
+                if isinstance(g.tag, str) and gml_id(g) is not None and verts is not None:
+                    self.templates[gml_id(g)] = verts
+        if verts is None or not len(verts):
+            problems["unresolved_implicit_geometry"] += 1
+            veg.implicit = "unresolved"
+            return
+        local_xyz = np.column_stack([verts, np.ones(len(verts))]) @ matrix.T
+        if np.linalg.norm(ref) > 0 and np.allclose(matrix[:3, 3], ref, rtol=0, atol=1e-3):
+            # a writer that put the position both in the matrix and in the reference point:
+            # placed once (the standard adds the reference point to the transformed geometry)
+            local_xyz[:, :3] -= ref
+            problems["implicit_position_in_matrix_and_reference_point"] += 1
+        veg.offsets = local_xyz[:, :3]
+
+
+#: vegetation attributes read as numbers (m)
+_VEG_NUMBERS = ("height", "crownDiameter", "trunkDiameter", "averageHeight")
+
+
+def _vertices(el, index, problems: Counter) -> np.ndarray | None:
+    """Every polygon vertex under *el* (xlinks within the feature followed), (n, 3)."""
+    out = []
+    if local(el) in _POLYGONAL:
+        polys = [(el, False)]
+    else:
+        polys = list(_polygons(el, index, problems))
+    for poly, _ in polys:
+        rings, _ = _rings(poly)
+        if rings is not None:
+            out += rings
+    return np.concatenate(out) if out else None
 
 
 class _LazyIndex:

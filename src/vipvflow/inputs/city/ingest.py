@@ -73,6 +73,7 @@ class IngestReport:
     building_parts: int = 0
     terrain_features: int = 0
     vegetation_features: int = 0
+    trees: dict = field(default_factory=dict)              # the crowns kept (inputs/city/trees.py)
     surfaces: dict = field(default_factory=dict)          # polygons written, per type
     thematic_surfaces: dict = field(default_factory=dict)  # thematic elements read, per type
     area_m2: dict = field(default_factory=dict)            # per type
@@ -108,9 +109,17 @@ class IngestReport:
         if self.problems:
             problems = ", other problems " + ", ".join(
                 f"{k} {v}" for k, v in sorted(self.problems.items()))
+        trees = ""
+        if self.trees.get("kept") or self.trees.get("skipped"):
+            from dataclasses import fields as _fields
+
+            from .trees import TreeReport
+
+            names = {f.name for f in _fields(TreeReport)}
+            trees = ", " + TreeReport(**{k: v for k, v in self.trees.items() if k in names}).line()
         return (f"{len(self.files)} file(s) in {crs}: {self.buildings} buildings ({lods or 'none'}), "
-                f"{self.n_surfaces} surfaces ({types}), skipped {self.n_skipped} ({skips}){problems}, "
-                f"{self.tiles} tiles, {self.triangles} mesh triangles, "
+                f"{self.n_surfaces} surfaces ({types}), skipped {self.n_skipped} ({skips}){problems}"
+                f"{trees}, {self.tiles} tiles, {self.triangles} mesh triangles, "
                 f"{self.elapsed_s:.1f} s ({rate:,.0f} surfaces/s)")
 
     def to_json(self) -> str:
@@ -326,7 +335,7 @@ def _surface_mesh(chunk: _Chunk, name: str, bounds: np.ndarray, buffer_m: float)
 
 def ingest_city(paths, data_dir, city_cfg: CityCfg | None = None, crs: str | None = None,
                 chunk_surfaces: int = CHUNK_SURFACES, axis_order: str = "auto",
-                accept=()) -> IngestReport:
+                accept=(), trees=(), trees_crs: str | None = None) -> IngestReport:
     """Read CityGML files into tiled surfaces, tile meshes and a terrain model.
 
     Parameters
@@ -351,6 +360,12 @@ def ingest_city(paths, data_dir, city_cfg: CityCfg | None = None, crs: str | Non
     accept : iterable of str
         Plausibility findings accepted (``checks.accept``): with ``crs_area``, a *crs* whose
         area of use does not hold the city model is used anyway instead of refused.
+    trees : path or list of paths
+        Tree tables (CSV or GeoParquet points, :mod:`vipvflow.inputs.city.trees`); their trees
+        join the CityGML vegetation objects as crowns (``city/trees/<T>.npz``,
+        ``city/trees.parquet``), never as mesh surfaces.
+    trees_crs : str, optional
+        CRS of the x/y columns of the CSV tree tables (default: the city's).
 
     Returns
     -------
@@ -383,7 +398,9 @@ def ingest_city(paths, data_dir, city_cfg: CityCfg | None = None, crs: str | Non
         read.files(paths)
         acc.flush()
         target = report.crs = read.target
-        _check_not_empty(report, counts, read.ignored, final_dir)
+        for table in _paths(trees):
+            read.trees.add_table(table, target, trees_crs)
+        _check_not_empty(report, counts, read.ignored, final_dir, len(read.trees.rows["x"]))
         tiles, grown = {}, []
         # every tile a surface can shade has a mesh: its own surfaces' tiles and the tiles
         # within the buffer around them (a road there is shaded by the model's buildings)
@@ -392,6 +409,7 @@ def ingest_city(paths, data_dir, city_cfg: CityCfg | None = None, crs: str | Non
             if g is not None:
                 grown.append(g)
         terrain_tris = _write_terrain(city_dir, acc, target)
+        report.trees = _write_trees(city_dir, read.trees, cfg, target, set(tiles))
         shutil.rmtree(spool)
         report.coverage = write_coverage(CityDir(city_dir), target, grown)
         write_json({
@@ -432,13 +450,17 @@ def _input_paths(paths, crs: str | None) -> tuple[list[Path], str | None]:
 
 
 class _CityRead:
-    """One pass over the CityGML files: their city objects into the accumulator, counted."""
+    """One pass over the CityGML files: their city objects into the accumulator (vegetation
+    into the trees), counted."""
 
     def __init__(self, acc: _Accumulator, cfg: CityCfg, target: str | None,
                  report: IngestReport, counts: _Counts, bar: Progress, axis_order: str,
                  accept=()):
+        from .trees import TreeCollector
+
         self.acc, self.cfg, self.target, self.axis_order = acc, cfg, target, axis_order
         self.accept = tuple(accept)
+        self.trees = TreeCollector(cfg.trees.crown_base_fraction)
         self.report, self.counts, self.bar = report, counts, bar
         self.albedo = cfg.albedo.model_dump()
         self.ignored = Counter()               # city objects not read, per class
@@ -464,7 +486,14 @@ class _CityRead:
             if src is None and _has_coordinates(feature):
                 src, self.target = _resolve_crs(reader, label, feature, self.target,
                                                 self.report, self.axis_order, self.accept)
-            _add_feature(feature, self.acc, src, self.target, self.cfg, self.albedo, self.counts)
+            if feature.vegetation is not None:
+                # trees are crowns of their own (models/trees.py), never opaque mesh surfaces
+                for stype, reason in feature.skips:
+                    self.counts.skip(reason, stype)
+                if src is not None or not _has_coordinates(feature):
+                    self.trees.add_vegetation(feature, src, self.target, label)
+            else:
+                _add_feature(feature, self.acc, src, self.target, self.cfg, self.albedo, self.counts)
             self._count(feature)
         self.ignored.update(reader.ignored)
         if src is None:
@@ -519,8 +548,16 @@ class _Counts:
             self.skipped_by_type[stype] += 1
 
 
+def _coordinates(feature) -> np.ndarray:
+    """Some coordinates of a feature as written (its polygons', a vegetation object's)."""
+    if feature.vegetation is not None:
+        return feature.vegetation.sample()
+    rings = [r for s in feature.surfaces for r in s.rings if len(r)]
+    return np.concatenate(rings) if rings else np.zeros((0, 3))
+
+
 def _has_coordinates(feature) -> bool:
-    return any(len(r) for s in feature.surfaces for r in s.rings)
+    return len(_coordinates(feature)) > 0
 
 
 def _resolve_crs(reader: CityGMLReader, label: str, feature, target: str | None,
@@ -537,7 +574,7 @@ def _resolve_crs(reader: CityGMLReader, label: str, feature, target: str | None,
         name = target
     else:
         raise InputError(f"{label}: the file names no CRS (no srsName); pass --crs EPSG:xxxx")
-    sample = np.concatenate([r for s in feature.surfaces for r in s.rings])[:, :2]
+    sample = _coordinates(feature)[:, :2]
     src = SourceCRS.decide(name, sample, axis_order)
     report.file_crs[label] = src.crs
     report.axis_order[label] = src.axis_order
@@ -648,7 +685,7 @@ def _add_feature(feature, acc: _Accumulator, src: SourceCRS | None, target: str,
 
 
 def _check_not_empty(report: IngestReport, counts: _Counts, ignored: Counter,
-                     final_dir: Path) -> None:
+                     final_dir: Path, n_trees: int = 0) -> None:
     """Refuse an ingest that would replace the city with nothing."""
     files = ", ".join(report.files)
     kept = f"{final_dir} left as it was"
@@ -656,10 +693,82 @@ def _check_not_empty(report: IngestReport, counts: _Counts, ignored: Counter,
         other = ", ".join(f"{v} {k}" for k, v in ignored.most_common(5))
         found = f" (found only: {other})" if other else ""
         raise InputError(f"{files}: no CityGML building, terrain or vegetation object{found}; {kept}")
-    if not counts.written:
+    if not counts.written and not n_trees:
         why = ", ".join(f"{k} {v}" for k, v in counts.skipped.most_common()) or "no geometry"
         raise InputError(f"{files}: {report.buildings} buildings but no usable polygon "
                          f"(skipped: {why}); {kept}")
+
+
+def _paths(p) -> list[Path]:
+    if p is None:
+        return []
+    if isinstance(p, (str, os.PathLike)):
+        return [Path(p)]
+    return [Path(x) for x in p]
+
+
+def _write_trees(city_dir: Path, collector, cfg: CityCfg, crs: str | None, mesh_tiles: set) -> dict:
+    """The trees' crowns: ``trees.parquet`` (every tree, GeoParquet points) and per tile the
+    trees whose crowns come within ``cfg.buffer_m`` of it (``trees/<T>.npz``); returns the
+    trees' report (:class:`vipvflow.inputs.city.trees.TreeReport`)."""
+    import geopandas as gpd
+
+    from ...models.tree_table import LEAF_TYPES, TREE_SOURCES
+    from .terrain import TerrainModel
+
+    city = CityDir(city_dir)
+    terrain = None
+    if city.terrain.exists():
+        with np.load(city.terrain, allow_pickle=False) as z:
+            terrain = TerrainModel(z["tin_vertices"], z["tin_triangles"], z["ground_points"], str(z["crs"]))
+    lat = 0.0
+    rows = collector.rows
+    if rows["x"] and crs:
+        x, y = float(np.nanmedian(rows["x"])), float(np.nanmedian(rows["y"]))
+        lat = float(transform_xyz(np.array([[x, y, 0.0]]), crs, "EPSG:4326")[0, 1])
+    table = collector.finish(terrain, lat)
+    report = asdict(collector.report)
+    if not len(table):
+        return report
+    leaf = np.array(list(LEAF_TYPES) + ["unknown"])[table.leaf_type]
+    gdf = gpd.GeoDataFrame({
+        "tree_id": table.tree_id.astype(object), "source": np.array(TREE_SOURCES)[table.source].astype(object),
+        "height_m": table.height.astype(np.float64), "crown_diameter_m": table.crown_diameter.astype(np.float64),
+        "crown_base_m": table.crown_base.astype(np.float64), "leaf_type": leaf.astype(object),
+        "leaf_off_months": [_months_text(m) for m in table.leaf_off]},
+        geometry=gpd.points_from_xy(table.x, table.y, table.z), crs=crs)
+    with atomic_path(city.tree_points) as tmp:
+        gdf.to_parquet(tmp, index=False)
+    # the tiles each crown can shade: those whose extent widened by the buffer it meets
+    s, b = float(cfg.tile_size_m), float(cfg.buffer_m)
+    r = 0.5 * table.crown_diameter.astype(np.float64)
+    lx = np.floor((table.x - r - b) / s).astype(np.int64)
+    hx = np.floor((table.x + r + b) / s).astype(np.int64)
+    ly = np.floor((table.y - r - b) / s).astype(np.int64)
+    hy = np.floor((table.y + r + b) / s).astype(np.int64)
+    nx, ny = hx - lx + 1, hy - ly + 1
+    rep = nx * ny
+    tree = np.repeat(np.arange(len(table)), rep)
+    k = np.arange(int(rep.sum())) - np.repeat(np.cumsum(rep) - rep, rep)
+    px, py = lx[tree] + k // ny[tree], ly[tree] + k % ny[tree]
+    keys, inverse = np.unique(np.stack([px, py], 1), axis=0, return_inverse=True)
+    inverse = inverse.ravel()
+    order = np.argsort(inverse, kind="stable")
+    bounds = np.r_[0, np.cumsum(np.bincount(inverse, minlength=len(keys)))]
+    city.trees.mkdir(parents=True, exist_ok=True)
+    n_files = 0
+    for g, (ix, iy) in enumerate(keys):
+        table.take(np.sort(tree[order[bounds[g]:bounds[g + 1]]])).save(city.trees_file(tile_name(ix, iy, s)))
+        n_files += 1
+    report["tiles"] = n_files
+    report["tiles_without_mesh"] = int(sum(tile_name(ix, iy, s) not in mesh_tiles for ix, iy in keys))
+    report["latitude"] = round(lat, 4)
+    return report
+
+
+def _months_text(mask: int) -> str:
+    """A 12-bit month mask as ``1,2,11,12``; empty for the default (-1)."""
+    return "" if mask < 0 else ",".join(str(m + 1) for m in range(12) if (int(mask) >> m) & 1)
 
 
 def remove_stale_ingests(data_dir: Path) -> list[Path]:
