@@ -119,6 +119,19 @@ def _tile_mesh(spec) -> TileMesh:
     return mesh
 
 
+def _canyon_surfaces(spec, black: bool) -> list[str]:
+    """The canyon's materials (grey plastic of its albedos; *black*: all 0) and its quads, as
+    Radiance scene lines."""
+    lines = []
+    for kind, rho in (("wall", spec["rho"]), ("roof", spec["rho"]), ("ground", spec["rho_road"])):
+        r = 0.0 if black else rho
+        lines.append(f"void plastic m_{kind} 0 0 5 {r:.6g} {r:.6g} {r:.6g} 0 0")
+    for i, (kind, _, c) in enumerate(_quads(spec)):
+        coords = " ".join(f"{v:.9g}" for v in c.ravel())
+        lines.append(f"m_{kind} polygon {kind}_{i} 0 0 12 {coords}")
+    return lines
+
+
 def _radiance_scene(spec, sun: np.ndarray, dni: float, dhi: float, black: bool) -> str:
     """Radiance description of a scene, its sun and its uniform sky."""
     omega = 2 * math.pi * (1 - math.cos(math.radians(SUN_DEG / 2)))
@@ -127,12 +140,7 @@ def _radiance_scene(spec, sun: np.ndarray, dni: float, dhi: float, black: bool) 
              "solar source sun 0 0 4 {:.12f} {:.12f} {:.12f} {}".format(*sun, SUN_DEG),
              f"void glow sky_glow 0 0 4 {l_sky:.9g} {l_sky:.9g} {l_sky:.9g} 0",
              "sky_glow source sky 0 0 4 0 0 1 180"]
-    for kind, rho in (("wall", spec["rho"]), ("roof", spec["rho"]), ("ground", spec["rho_road"])):
-        r = 0.0 if black else rho
-        lines.append(f"void plastic m_{kind} 0 0 5 {r:.6g} {r:.6g} {r:.6g} 0 0")
-    for i, (kind, _, c) in enumerate(_quads(spec)):
-        coords = " ".join(f"{v:.9g}" for v in c.ravel())
-        lines.append(f"m_{kind} polygon {kind}_{i} 0 0 12 {coords}")
+    lines += _canyon_surfaces(spec, black)
     return "\n".join(lines) + "\n"
 
 
@@ -331,12 +339,7 @@ def gendaylit_sky(sun: np.ndarray, dni: float, dhi: float, ground_albedo: float)
 
 def _perez_scene(spec, sun, dni, dhi, black: bool) -> str:
     lines = [gendaylit_sky(sun, dni, dhi, spec["rho_road"])]
-    for kind, rho in (("wall", spec["rho"]), ("roof", spec["rho"]), ("ground", spec["rho_road"])):
-        r = 0.0 if black else rho
-        lines.append(f"void plastic m_{kind} 0 0 5 {r:.6g} {r:.6g} {r:.6g} 0 0")
-    for i, (kind, _, c) in enumerate(_quads(spec)):
-        coords = " ".join(f"{v:.9g}" for v in c.ravel())
-        lines.append(f"m_{kind} polygon {kind}_{i} 0 0 12 {coords}")
+    lines += _canyon_surfaces(spec, black)
     return "\n".join(lines) + "\n"
 
 

@@ -47,8 +47,8 @@ from vipvflow.config import IrradianceCfg  # noqa: E402
 from vipvflow.models.params import TreeCfg  # noqa: E402
 from vipvflow.models.trees import TreeTable  # noqa: E402
 
-from test_radiance import (LAT, LON, ALT, ROOF_Z, SCENES, _quads, _rtrace_irradiance,  # noqa: E402
-                           _tile_mesh, gendaylit_sky, json_line)
+from test_radiance import (LAT, LON, ALT, ROOF_Z, SCENES, _canyon_surfaces,  # noqa: E402
+                           _rtrace_irradiance, _tile_mesh, gendaylit_sky, json_line)
 
 CROWN_D, CROWN_BASE, HEIGHT, ROW_X = 7.0, 4.5, 11.5, 5.0
 ROW_Y = np.arange(-60.0, 61.0, 12.0)
@@ -80,12 +80,7 @@ def tree_row() -> TreeTable:
 def _radiance_scene(spec, sky_text: str, tau: float | None, black: bool) -> str:
     """The canyon and its crowns (transmittance *tau*; None: no crowns) under *sky_text*."""
     lines = [sky_text]
-    for kind, rho in (("wall", spec["rho"]), ("roof", spec["rho"]), ("ground", spec["rho_road"])):
-        r = 0.0 if black else rho
-        lines.append(f"void plastic m_{kind} 0 0 5 {r:.6g} {r:.6g} {r:.6g} 0 0")
-    for i, (kind, _, c) in enumerate(_quads(spec)):
-        coords = " ".join(f"{v:.9g}" for v in c.ravel())
-        lines.append(f"m_{kind} polygon {kind}_{i} 0 0 12 {coords}")
+    lines += _canyon_surfaces(spec, black)
     if tau is not None:
         t = math.sqrt(tau)
         lines.append(f"void trans m_crown 0 0 7 {t:.9g} {t:.9g} {t:.9g} 0 0 1 1")

@@ -89,12 +89,9 @@ def input_digests(cfg: Config) -> "InputDigests":
                          + " (see data_manifest.yaml and `make data`)")
     if gtfs is None or not cams_files:
         raise InputError(f"{cfg._source}: inputs.gtfs and inputs.cams are required")
-    not_files = [str(p) for p in [*city_files, *cams_files] if not p.is_file()]
+    not_files = [str(p) for p in [*city_files, *tree_files, *cams_files] if not p.is_file()]
     if not_files:
         raise InputError(f"{cfg._source}: inputs name folders, not files: {', '.join(not_files)}")
-    not_files = [str(p) for p in tree_files if not p.is_file()]
-    if not_files:
-        raise InputError(f"{cfg._source}: inputs.trees names folders, not files: {', '.join(not_files)}")
     files = {"inputs.citygml": {str(p): sha256(p) for p in city_files},
              "inputs.gtfs": {str(gtfs): sha256(gtfs)},
              "inputs.cams": {str(p): sha256(p) for p in cams_files}}
