@@ -40,8 +40,8 @@ import numpy as np
 from numba import njit
 
 from .irradiance import ROULETTE_WEIGHT
-from .sky import COS_85, SECTOR_COS, SECTOR_SIN, SKY_AZIMUTH_BINS, SKY_LEVELS
-from .trees import _MAX_HITS, month0, transmit_one
+from .sky import COS_85, SECTOR_COS, SECTOR_SIN, SKY_AZIMUTH_BINS, SKY_LEVELS, SKY_PACK
+from .trees import _MAX_HITS, MASK_SECTORS, mask_sector, month0, transmit_one
 
 #: components of a pass in the order of the kernel's output block (W/m2)
 BLOCK_COLUMNS = ("direct", "diffuse", "reflected", "total", "direct_clear", "diffuse_clear",
@@ -181,46 +181,75 @@ def _setup(lo, hi, seg, t_start, dt, mid, row, loc_of_row, packed, cols, t0, ste
     return nr, npair
 
 
-@njit(cache=True, nogil=True, inline="always")
-def _share(tg, th, r, cell, f, t, tilted, nz):
-    """The Perez (1993) sky's share of DHI on a roof from table row *r*: per sector its
-    cell, interpolation weight and tilt weight (:func:`vipvflow.models.sky.sky_share`; the
-    tables flat, (rows, 36 x 10))."""
-    s = np.float32(0.0)
+#: values per cell of a packed Perez sky table row (:func:`vipvflow.models.sky.pack_sky`)
+_PACK = SKY_PACK
+
+
+@njit(cache=True, nogil=True)
+def _sector(T, r, j, f, t, nz, tilted):
+    """One sector's term of the all-sky and the clear-sky share: ``n_z`` times the G table
+    interpolated at the horizon (cell *j*, weight *f*), plus with *tilted* the tilt weight
+    *t* times the H table's (packed row *r* of :func:`pack_sky`)."""
+    b = _PACK * j
+    ga, gc = T[r, b], T[r, b + 2]
+    a = nz * (ga + f * (T[r, b + _PACK] - ga))
+    c = nz * (gc + f * (T[r, b + _PACK + 2] - gc))
     if tilted:
-        for k in range(cell.shape[0]):
-            j = cell[k]
-            g0, h0 = tg[r, j], th[r, j]
-            s += nz * (g0 + f[k] * (tg[r, j + 1] - g0)) + t[k] * (h0 + f[k] * (th[r, j + 1] - h0))
-    else:
-        for k in range(cell.shape[0]):
-            j = cell[k]
-            g0 = tg[r, j]
-            s += nz * (g0 + f[k] * (tg[r, j + 1] - g0))
-    return s
+        ha, hc = T[r, b + 1], T[r, b + 3]
+        a = a + t * (ha + f * (T[r, b + _PACK + 1] - ha))
+        c = c + t * (hc + f * (T[r, b + _PACK + 3] - hc))
+    return a, c
 
 
-@njit(cache=True, nogil=True, inline="always")
-def _tree_loss(tg, th, rs, r, cls, nz, t, ts):
-    """The Perez sky's share the crowns take from segment row *r* in class *cls*: its sky
-    cells with a loss, ``sum loss (n_z dG + t_k dH)`` (:func:`vipvflow.models.sky.tree_share`)."""
+@njit(cache=True, nogil=True)
+def _shares(T, r, cell, f, t, tilted, nz):
+    """The Perez (1993) sky's share of DHI on a roof from packed table row *r*
+    (:func:`vipvflow.models.sky.pack_sky`), all-sky and clear-sky: per sector its cell, interpolation weight and
+    tilt weight, summed in sector order (:func:`vipvflow.models.sky.sky_share`)."""
+    a = np.float32(0.0)
+    c = np.float32(0.0)
+    for k in range(cell.shape[0]):
+        x, y = _sector(T, r, cell[k], f[k], t[k], nz, tilted)
+        a += x
+        c += y
+    return a, c
+
+
+@njit(cache=True, nogil=True)
+def _cell_loss(T, rs, j, nz, t, w):
+    """One sky cell's loss to the crowns, all-sky and clear-sky: *w* x its light
+    (``n_z dG + t_k dH``, packed row *rs*)."""
+    b = _PACK * j
+    n = b + _PACK
+    a = w * (nz * (T[rs, b] - T[rs, n]) + t * (T[rs, b + 1] - T[rs, n + 1]))
+    c = w * (nz * (T[rs, b + 2] - T[rs, n + 2]) + t * (T[rs, b + 3] - T[rs, n + 3]))
+    return a, c
+
+
+@njit(cache=True, nogil=True)
+def _tree_losses(T, rs, r, cls, nz, t, ts):
+    """The Perez sky's share the crowns take from segment row *r* in class *cls*, all-sky
+    and clear-sky: its sky cells with a loss, ``sum loss (n_z dG + t_k dH)``, cell by cell
+    (:func:`vipvflow.models.sky.tree_share`)."""
     off, cell, sector, w = ts
-    s = np.float32(0.0)
+    a = np.float32(0.0)
+    c = np.float32(0.0)
     for e in range(off[r], off[r + 1]):
-        j = cell[e]
-        s += w[e, cls] * (nz * (tg[rs, j] - tg[rs, j + 1]) + t[sector[e]] * (th[rs, j] - th[rs, j + 1]))
-    return s
+        x, y = _cell_loss(T, rs, cell[e], nz, t[sector[e]], w[e, cls])
+        a += x
+        c += y
+    return a, c
 
 
 @njit(cache=True, nogil=True, inline="always")
 def _components(c, r, rad, cos_aoi, vis_t, visible, beam_sum, sky, sky_nt, iso, refl_sky,
-                refl_ghi, perez, hbv, hbv_nt, refl_hor, sin_tilt, sky_cell, sky_f, sky_t,
-                sky_tilted, tg_all, th_all, to_all, tg_clear, th_clear, to_clear, nrm, ts, out):
+                refl_ghi, perez, hbv, hbv_nt, refl_hor, sin_tilt, has_sky, terms, out):
     """The :data:`BLOCK_COLUMNS` of one pass into *out* (float32, as
     :func:`vipvflow.models.irradiance.roof_components` sums them, the Perez sky with
-    *perez*): the sun ray's transmittance *vis_t* (0, or the crowns' where the buildings
-    let it through: *visible*), the sky through the crowns of the pass's class; the
-    ``_no_trees`` columns with the buildings alone."""
+    *perez*; with *has_sky* the sky the roof point sees from :func:`_sky_terms`' *terms*):
+    the sun ray's transmittance *vis_t* (0, or the crowns' where the buildings let it
+    through: *visible*), the sky through the crowns of the pass's class; the ``_no_trees``
+    columns with the buildings alone."""
     ca = cos_aoi[c]
     cls = np.int64(rad[c, _CLS])
     vis_b = np.float32(1.0) if visible else np.float32(0.0)
@@ -234,23 +263,8 @@ def _components(c, r, rad, cos_aoi, vis_t, visible, beam_sum, sky, sky_nt, iso, 
             cs = dh * f1 / max(rad[c, 8], _COS_85)
             circ = cs * ca
             iso_w = np.float32(1.0) - f1
-            if sky_cell.shape[1]:
-                rs = np.int64(rad[c, _N_RAD])
-                share = np.float32(0.0)
-                share_open = np.float32(0.0)
-                loss = np.float32(0.0)
-                if rs >= 0:
-                    nx, ny, nz = nrm[r, 0], nrm[r, 1], nrm[r, 2]
-                    if s == 0:
-                        share = _share(tg_all, th_all, rs, sky_cell[r], sky_f[r], sky_t[r],
-                                       sky_tilted[r], nz)
-                        share_open = nz + (nx * to_all[rs, 0] + ny * to_all[rs, 1])
-                        loss = _tree_loss(tg_all, th_all, rs, r, cls, nz, sky_t[r], ts)
-                    else:
-                        share = _share(tg_clear, th_clear, rs, sky_cell[r], sky_f[r], sky_t[r],
-                                       sky_tilted[r], nz)
-                        share_open = nz + (nx * to_clear[rs, 0] + ny * to_clear[rs, 1])
-                        loss = _tree_loss(tg_clear, th_clear, rs, r, cls, nz, sky_t[r], ts)
+            if has_sky:
+                share, share_open, loss = terms[c, s], terms[c, 2 + s], terms[c, 4 + s]
                 diffuse = max(dh * (share - loss), np.float32(0.0))
                 diffuse_nt = max(dh * share, np.float32(0.0))
             else:
@@ -260,7 +274,7 @@ def _components(c, r, rad, cos_aoi, vis_t, visible, beam_sum, sky, sky_nt, iso, 
                                  np.float32(0.0))
             reflected = ((b + cs) * beam_sum + dh * (iso_w * refl_sky[r, cls] + f2 * refl_hor[r, cls])
                          + gh * refl_ghi[r, cls])
-            if sky_cell.shape[1]:
+            if has_sky:
                 unshaded = beam + max(dh * share_open, np.float32(0.0))
             else:
                 unshaded = beam + max(dh * (iso_w * iso[r] + f2 * sin_tilt[r]) + circ, np.float32(0.0))
@@ -281,11 +295,50 @@ def _components(c, r, rad, cos_aoi, vis_t, visible, beam_sum, sky, sky_nt, iso, 
     out[13] = rad[c, 5]
 
 
+@njit(cache=True, nogil=True)
+def _sky_terms(lo, hi, row, rad, done, sky_cell, sky_f, sky_t, sky_tilted, T, to_all, to_clear, nrm,
+               ts, terms):
+    """The Perez sky a pass's roof point sees, for passes ``lo..hi`` (chunk index
+    ``i - lo``), into *terms* (chunk, 6) float32: its share of DHI all-sky and clear-sky
+    (:func:`_shares`), the same in the open, and the crowns' loss from it
+    (:func:`_tree_losses`); 0 for a dark pass or where the sun is more than 3 deg down (the
+    tables' row -1).  A loop of its own before the components' loop, which reads them (in
+    that loop the same work ran 1.5x slower)."""
+    for i in range(lo, hi):
+        c = i - lo
+        for k in range(6):
+            terms[c, k] = np.float32(0.0)
+        if not done[c]:
+            continue
+        rs = np.int64(rad[c, _N_RAD])
+        if rs < 0:
+            continue
+        r = row[i]
+        cls = np.int64(rad[c, _CLS])
+        nx, ny, nz = nrm[r, 0], nrm[r, 1], nrm[r, 2]
+        terms[c, 0], terms[c, 1] = _shares(T, rs, sky_cell[r], sky_f[r], sky_t[r], sky_tilted[r], nz)
+        terms[c, 2] = nz + (nx * to_all[rs, 0] + ny * to_all[rs, 1])
+        terms[c, 3] = nz + (nx * to_clear[rs, 0] + ny * to_clear[rs, 1])
+        terms[c, 4], terms[c, 5] = _tree_losses(T, rs, r, cls, nz, sky_t[r], ts)
+
+
 @njit(cache=True, nogil=True, inline="always")
-def _visibility(c, pass_ray, pair_w, pair_pass, pair_pt, gf, q, occ, cos_aoi, rotate, P, o, d,
-                tmax, cls, tr, hits):
+def _may_cross(smask, r, dx, dy, dz):
+    """Whether the sun ray (direction *d*) from segment row *r*'s roof point may cross a
+    crown: its slope not above the row's mask in its sector
+    (:func:`vipvflow.models.trees.sun_masks`)."""
+    h = np.sqrt(np.float64(dx) * dx + np.float64(dy) * dy)
+    if not h > 0.0:
+        return True
+    return not np.float64(dz) / h > smask[r, mask_sector(np.float64(dx), np.float64(dy))]
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _visibility(c, r, pass_ray, pair_w, pair_pass, pair_pt, gf, q, occ, cos_aoi, rotate, P, o, d,
+                tmax, cls, tr, smask, hits):
     """Whether the pass's sun ray misses the buildings, its transmittance (0, else the
-    crowns' along it in class *cls*), its reflectors' beam sum ``sum weight x lit``
+    crowns' along it in class *cls*; 1 without a walk where segment row *r*'s sun mask
+    *smask* rules the crowns out), its reflectors' beam sum ``sum weight x lit``
     (float64 like the reference's bincount, then float32; a sample point's ray lit in the
     crowns' transmittance, times the point's factor through the crowns *gf*), and the next
     pair."""
@@ -298,7 +351,8 @@ def _visibility(c, pass_ray, pair_w, pair_pass, pair_pt, gf, q, occ, cos_aoi, ro
         visible = not occ[r0]
         if visible:
             vis_t = np.float32(1.0)
-            if trees:
+            # the crowns' walk only where the segment's sun mask cannot rule them out
+            if trees and _may_cross(smask, r, d[r0, 0], d[r0, 1], d[r0, 2]):
                 vis_t = transmit_one(o[r0, 0], o[r0, 1], o[r0, 2], d[r0, 0], d[r0, 1], d[r0, 2],
                                      tmax, cls, cx, cy, cz, ia2, ic2, meta, start, items, tau, hits)
         r0 += 1
@@ -334,10 +388,9 @@ def _visibility(c, pass_ray, pair_w, pair_pass, pair_pt, gf, q, occ, cos_aoi, ro
 
 @njit(cache=True, nogil=True)
 def _finish(lo, hi, row, rad, cos_aoi, pass_ray, pair_w, pair_pass, pair_pt, gf, occ, done,
-            sky, sky_nt, iso, refl_sky, refl_ghi, perez, hbv, hbv_nt, refl_hor, sin_tilt, sky_cell,
-            sky_f, sky_t, sky_tilted, tg_all, th_all, to_all, tg_clear, th_clear, to_clear, nrm,
-            ts, rotate, P, o, d, tmax, tr, to_bins, block, visible_out, dt, seg_hour, run,
-            seg_bins, run_bins):
+            sky, sky_nt, iso, refl_sky, refl_ghi, perez, hbv, hbv_nt, refl_hor, sin_tilt, has_sky,
+            terms, rotate, P, o, d, tmax, tr, smask, to_bins, block, visible_out, dt, seg_hour,
+            run, seg_bins, run_bins):
     """Components of passes ``lo..hi``: into columns of *block* (14, n) and *visible_out*,
     or, with *to_bins*, as irradiation (Wh/m2) added into ``seg_bins[seg_hour[i]]`` and
     ``run_bins[run[i]]`` ((bins, 14) float64, :data:`BLOCK_COLUMNS`); the other side's
@@ -351,13 +404,12 @@ def _finish(lo, hi, row, rad, cos_aoi, pass_ray, pair_w, pair_pass, pair_pt, gf,
         if not done[c]:
             continue
         cls = np.int64(rad[c, _CLS])
-        visible, vis_t, beam_sum, q = _visibility(c, pass_ray, pair_w, pair_pass, pair_pt, gf, q,
-                                                  occ, cos_aoi, rotate, P, o, d, tmax, cls, tr,
-                                                  hits)
+        visible, vis_t, beam_sum, q = _visibility(c, row[i], pass_ray, pair_w, pair_pass, pair_pt,
+                                                  gf, q, occ, cos_aoi, rotate, P, o, d, tmax, cls,
+                                                  tr, smask, hits)
         _components(c, row[i], rad, cos_aoi, vis_t, visible, beam_sum, sky, sky_nt, iso,
-                    refl_sky, refl_ghi, perez, hbv, hbv_nt, refl_hor, sin_tilt, sky_cell, sky_f,
-                    sky_t, sky_tilted, tg_all, th_all, to_all, tg_clear, th_clear, to_clear,
-                    nrm, ts, out)
+                    refl_sky, refl_ghi, perez, hbv, hbv_nt, refl_hor, sin_tilt, has_sky, terms,
+                    out)
         if to_bins:
             w = dt[i] / 3600.0
             b, k = seg_hour[i], run[i]
@@ -496,6 +548,7 @@ class _Batch:
     def __init__(self, chunk: int, rays_per_pass: int, pairs_per_pass: int):
         f32 = np.float32
         self.rad = np.empty((chunk, _N_ROW), f32)
+        self.terms = np.empty((chunk, 6), f32)
         self.cos_aoi = np.empty(chunk, f32)
         self.pass_ray = np.empty(chunk + 1, np.int64)
         self.done = np.empty(chunk, np.bool_)
@@ -564,26 +617,41 @@ def _inputs(geo: dict, cfg, radiation_table, rows_of_segment_loc, scene=None):
              tmax=float(cfg.ray_length_m))
     crowns = scene.crowns(cfg) if (scene is not None and hasattr(scene, "crowns")) else None
     x["tr"] = tuple(_writable(a) for a in crowns.arrays()) if crowns is not None else _NO_TREES
+    x["smask"] = _sun_masks(geo, crowns)
     sky_x = geo.get("sky_x")
     if perez and sky_x is not None and sky_x.shape[1]:
         tables = radiation_table.sky()
-        flat = lambda a: _writable(a.reshape(len(a), -1))          # noqa: E731
         x.update(sky_cell=_writable(geo["sky_cell"]), sky_f=_writable(geo["sky_f"]),
                  sky_t=_writable(geo["sky_t"]), sky_tilted=_writable(geo["sky_tilted"]),
-                 sky_rows=_writable(tables["rows"]),
-                 sky_tables=(flat(tables["all"]), flat(tables["all_h"]), _writable(tables["all_open"]),
-                             flat(tables["clear"]), flat(tables["clear_h"]), _writable(tables["clear_open"])),
+                 sky_rows=_writable(tables["rows"]), sky_packed=_writable(tables["packed"]),
+                 sky_open=(_writable(tables["all_open"]), _writable(tables["clear_open"])),
                  sky_t0=tables["t0"], sky_step=tables["step"],
                  ts=tuple(_writable(geo[k]) for k in ("tsky_off", "tsky_cell", "tsky_sector", "tsky_w")))
+        x["has_sky"] = True
     else:
+        x["has_sky"] = False
         e2 = np.zeros((0, 2), f32)
-        e = np.zeros((0, SKY_AZIMUTH_BINS * (SKY_LEVELS + 1)), f32)
         x.update(sky_cell=np.zeros((n_seg, 0), np.int64), sky_f=np.zeros((n_seg, 0), f32),
                  sky_t=np.zeros((n_seg, 0), f32), sky_tilted=np.zeros(n_seg, np.bool_),
                  sky_rows=np.zeros((1, 0), np.int32),
-                 sky_tables=(e, e, e2, e, e, e2), sky_t0=0.0, sky_step=1.0,
+                 sky_packed=np.zeros((0, SKY_AZIMUTH_BINS * (SKY_LEVELS + 1) * SKY_PACK), f32),
+                 sky_open=(e2, e2), sky_t0=0.0, sky_step=1.0,
                  ts=(np.zeros(n_seg + 1, np.int64), _NO_INT, _NO_INT, np.zeros((0, C), f32)))
     return x
+
+
+def _sun_masks(geo: dict, crowns) -> np.ndarray:
+    """The sun masks of the geometry's roof points among *crowns*
+    (:meth:`vipvflow.models.trees.Crowns.sun_masks`), kept in *geo* for the crowns they were
+    made for (a tile's packed geometry lives for many partitions); (0, sectors) without crowns."""
+    if crowns is None:
+        return np.zeros((0, MASK_SECTORS))
+    kept = geo.get("_sun_masks")
+    if kept is not None and kept[0] is crowns:
+        return kept[1]
+    masks = crowns.sun_masks(geo["p_local"])
+    geo["_sun_masks"] = (crowns, masks)
+    return masks
 
 
 #: the crowns' arrays of a scene without trees (:meth:`vipvflow.models.trees.Crowns.arrays`)
@@ -613,6 +681,12 @@ def _run(seg, t_start, dt, mid, row, geo, cfg, radiation_table, scene, loc_of_ro
         occ = (scene.occluded_local(bt.o[:nr], bt.d[:nr], cfg.ray_length_m) if nr
                else np.zeros(0, bool))
         t_c = time.perf_counter()
+        t_s = time.perf_counter()
+        if x["has_sky"]:
+            _sky_terms(lo, hi, row, bt.rad, bt.done, x["sky_cell"], x["sky_f"], x["sky_t"],
+                       x["sky_tilted"], x["sky_packed"], x["sky_open"][0], x["sky_open"][1],
+                       x["nrm"], x["ts"], bt.terms)
+        clock["sky_s"] = clock.get("sky_s", 0.0) + time.perf_counter() - t_s
         finish(lo, hi, x, bt, occ, P, rotate)
         t_d = time.perf_counter()
         clock["ray_setup_s"] = clock.get("ray_setup_s", 0.0) + t_b - t_a
@@ -687,9 +761,8 @@ def _finisher(row, dt, to_bins, block, visible, seg_hour, run, seg_bins, run_bin
     def finish(lo, hi, x, bt, occ, P, rotate):
         _finish(lo, hi, row, bt.rad, bt.cos_aoi, bt.pass_ray, bt.pair_w, bt.pair_pass,
                 bt.pair_pt, x["gf"], occ, bt.done, x["sky"], x["sky_nt"], x["iso"], x["refl_sky"], x["refl_ghi"],
-                x["perez"], x["hbv"], x["hbv_nt"], x["refl_hor"], x["sin_tilt"], x["sky_cell"],
-                x["sky_f"], x["sky_t"], x["sky_tilted"], *x["sky_tables"], x["nrm"], x["ts"],
-                rotate, P, bt.o, bt.d, x["tmax"], x["tr"], to_bins, block, visible, dt,
+                x["perez"], x["hbv"], x["hbv_nt"], x["refl_hor"], x["sin_tilt"], x["has_sky"],
+                bt.terms, rotate, P, bt.o, bt.d, x["tmax"], x["tr"], x["smask"], to_bins, block, visible, dt,
                 seg_hour, run, seg_bins, run_bins)
     return finish
 
@@ -718,12 +791,15 @@ def warm() -> float:
                 for to_bins in (False, True):
                     _finish(0, 1, one_i, rad, one_f, pr, one_f, one_i, one_i, one_c, np.zeros(1, bool),
                             np.zeros(1, np.bool_), one_c, one_f, one_f, one_c, one_c, perez, one_c,
-                            one_f, one_c, one_f, np.zeros((1, n_sky), np.int64),
-                            np.zeros((1, n_sky), f32), np.zeros((1, n_sky), f32),
-                            np.zeros(1, np.bool_), tables, tables, np.zeros((1, 2), f32), tables,
-                            tables, np.zeros((1, 2), f32), o3, ts, rotate, 1, o3, o3, 300.0,
-                            _NO_TREES, to_bins, np.zeros((_NB, 1), f32), np.zeros(1, bool), one_t,
-                            one_i, one_i, np.zeros((1, _NB)), np.zeros((1, _NB)))
+                            one_f, one_c, one_f, bool(n_sky), np.zeros((1, 6), f32), rotate, 1, o3,
+                            o3, 300.0, _NO_TREES, np.zeros((1, MASK_SECTORS)), to_bins,
+                            np.zeros((_NB, 1), f32),
+                            np.zeros(1, bool), one_t, one_i, one_i, np.zeros((1, _NB)),
+                            np.zeros((1, _NB)))
+    _sky_terms(0, 1, one_i, rad, np.zeros(1, np.bool_), np.zeros((1, SKY_AZIMUTH_BINS), np.int64),
+               np.zeros((1, SKY_AZIMUTH_BINS), f32), np.zeros((1, SKY_AZIMUTH_BINS), f32),
+               np.zeros(1, np.bool_), np.zeros((1, tables.shape[1] * SKY_PACK), f32),
+               np.zeros((1, 2), f32), np.zeros((1, 2), f32), o3, ts, np.zeros((1, 6), f32))
     _groups(one_i, one_i, one_i, one_t, one_t, 0, one_i, 0, one_t, one_i, one_i, one_i, one_i)
     _seconds(one_i, one_i, one_i, one_t, one_t, one_t, one_t, one_i, one_i)
     return time.perf_counter() - t

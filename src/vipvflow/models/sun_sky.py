@@ -17,7 +17,7 @@ import pandas as pd
 from ..errors import InputError
 from ..inputs.cams import _GRID_S, COLUMNS, ingest_cams
 from ..store import DataDir, RadiationDir, write_npz
-from .sky import SKY_STEP_S, open_terms, perez_table, sky_table
+from .sky import SKY_STEP_S, open_terms, pack_sky, perez_table, sky_table, unpack_sky
 
 log = logging.getLogger(__name__)
 
@@ -315,7 +315,10 @@ class RadiationTable:
                     write_npz(file, key=np.array(key), **cache)
                 except OSError:
                     pass
-        cache = {**cache, "t0": float(self.t0), "step": float(SKY_STEP_S)}
+        # the four tables interleaved for the compiled kernel, and kept only as views into that
+        packed = pack_sky(cache)
+        cache = {**cache, **unpack_sky(packed, cache["all"].shape), "packed": packed,
+                 "t0": float(self.t0), "step": float(SKY_STEP_S)}
         self.__dict__["_sky"] = cache
         return cache
 

@@ -213,6 +213,54 @@ def transmit_one(ox, oy, oz, dx, dy, dz, tmax, cls, cx, cy, cz, ia2, ic2, meta, 
     return t
 
 
+#: azimuth sectors of :func:`sun_masks` (10 deg)
+MASK_SECTORS = 36
+
+
+@njit(cache=True, nogil=True, inline="always")
+def mask_sector(dx, dy):
+    """The sector of :func:`sun_masks` a direction's azimuth (from +y, clockwise) falls in."""
+    k = np.int64(np.floor(np.arctan2(dx, dy) * (MASK_SECTORS / (2.0 * np.pi))))
+    return k % MASK_SECTORS
+
+
+@njit(cache=True, nogil=True)
+def sun_masks(o, cx, cy, cz, ia2, ic2, out):
+    """For each origin ``o[i]`` and azimuth sector ``k``, into ``out[i, k]``: a bound on
+    the slope (tan of the elevation) above which a ray from the origin towards the sky in
+    that sector passes over every crown (-inf: none lies there; inf: the origin is under a
+    crown).  A crown (centre, semi-axes ``a`` across, ``c`` up) lies within the upright
+    cylinder of radius ``a`` up to its top; from horizontal distance ``d > a`` it covers the
+    azimuths within ``asin(a / d)`` of its centre's, and a ray rising at slope ``s`` is
+    above its top beyond ``d - a`` if ``s > (top - o_z) / (d - a)``.  The margins make the
+    bound safe in float32 rays: where a ray's slope exceeds it, :func:`_walk` finds no crown."""
+    w = 2.0 * np.pi / MASK_SECTORS
+    for i in range(o.shape[0]):
+        for k in range(MASK_SECTORS):
+            out[i, k] = -np.inf
+        ox, oy, oz = np.float64(o[i, 0]), np.float64(o[i, 1]), np.float64(o[i, 2])
+        for j in range(cx.shape[0]):
+            a = 1.0 / np.sqrt(ia2[j])
+            top = cz[j] + 1.0 / np.sqrt(ic2[j]) - oz
+            if top <= 0.0:
+                continue                        # wholly below the origin: no rising ray meets it
+            dx, dy = cx[j] - ox, cy[j] - oy
+            d = np.sqrt(dx * dx + dy * dy)
+            if d <= a * 1.001 + 0.01:
+                for k in range(MASK_SECTORS):
+                    out[i, k] = np.inf
+                break
+            bound = top / (d - a) * 1.001 + 1e-4
+            half = np.arcsin(min(a / d, 1.0)) + 1e-3
+            phi = np.arctan2(dx, dy)
+            k0 = np.int64(np.floor((phi - half) / w))
+            k1 = np.int64(np.floor((phi + half) / w))
+            for k in range(k0, k1 + 1):
+                kk = k % MASK_SECTORS
+                if bound > out[i, kk]:
+                    out[i, kk] = bound
+
+
 @njit(cache=True, nogil=True)
 def _transmit_many(o, d, tmax, cls, cx, cy, cz, ia2, ic2, meta, start, items, tau, out):
     """Rays ``o[i] + t d[i]``, ``0 < t < tmax[i]``: ``out[i, c]`` the product of the crossed
@@ -308,6 +356,14 @@ class Crowns:
         start, items, tau``."""
         return (self.cx, self.cy, self.cz, self.ia2, self.ic2, self.meta, self.start, self.items,
                 self.tau)
+
+    def sun_masks(self, origins_local) -> np.ndarray:
+        """:func:`sun_masks` of *origins_local* (n, 3), m, in the scene's local frame:
+        (n, :data:`MASK_SECTORS`) float64."""
+        o = np.ascontiguousarray(np.asarray(origins_local, np.float64).reshape(-1, 3))
+        out = np.empty((len(o), MASK_SECTORS))
+        sun_masks(o, self.cx, self.cy, self.cz, self.ia2, self.ic2, out)
+        return out
 
     def transmittance(self, origins, dirs, tmax, classes=None) -> np.ndarray:
         """The crowns' transmittance along rays (float32).
