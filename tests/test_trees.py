@@ -148,18 +148,55 @@ def test_sky_view_under_a_crown_is_its_solid_angle_darkened():
     assert (loss * w).sum() == pytest.approx((1 - 0.2) * sin2, rel=0.08)
 
 
-def test_fused_kernel_equals_the_numpy_reference_with_crowns():
+def test_sun_masks_rule_out_only_rays_that_miss_every_crown():
+    """Crowns of every size scattered around roof points above, among and below them, sun
+    rays in every direction: where the compiled kernel skips the grid walk (the ray rises
+    above its origin's mask in its azimuth sector) the walk finds no crown, and the masks
+    rule out most rays."""
+    from vipvflow.models.passkernel import _may_cross
+    from vipvflow.models.trees import _MAX_HITS, MASK_SECTORS, transmit_one
+
+    rng = np.random.default_rng(11)
+    n = 300
+    t = TreeTable(x=rng.uniform(-150, 150, n), y=rng.uniform(-150, 150, n), z=rng.uniform(0, 3, n),
+                  height=rng.uniform(5, 25, n), crown_diameter=rng.uniform(2, 14, n),
+                  crown_base=rng.uniform(1, 4, n), leaf_type=rng.integers(-1, 2, n),
+                  leaf_off=np.full(n, -1), source=np.zeros(n), tree_id=[str(i) for i in range(n)],
+                  latitude=50.0)
+    crowns = Crowns(t, TreeCfg(), origin=(3.0, -2.0, 0.5))
+    k, m = 300, 100
+    origins = np.column_stack([rng.uniform(-160, 160, k), rng.uniform(-160, 160, k),
+                               rng.uniform(0, 30, k)]).astype(np.float32)
+    masks = crowns.sun_masks(origins)
+    assert masks.shape == (k, MASK_SECTORS) and np.isinf(masks).any()
+    d = rng.normal(size=(k * m, 3)).astype(np.float32)
+    d[:, 2] = np.abs(d[:, 2]) + np.float32(1e-3)                  # towards the sky
+    d[:50] = [0.0, 0.0, 1.0]                                      # straight up
+    row = np.repeat(np.arange(k), m)
+    o = origins[row]
+    hits = np.empty(_MAX_HITS, np.int64)
+    tr = crowns.arrays()
+    walk = np.array([transmit_one(o[i, 0], o[i, 1], o[i, 2], d[i, 0], d[i, 1], d[i, 2], 400.0, 0,
+                                  *tr, hits) for i in range(len(o))], np.float32)
+    may = np.array([_may_cross(masks, row[i], d[i, 0], d[i, 1], d[i, 2]) for i in range(len(o))])
+    assert (walk[~may] == 1.0).all()
+    assert (~may).mean() > 0.5 and (walk[may] < 1).any()
+
+
+def test_fused_kernel_equals_the_numpy_reference_with_crowns(monkeypatch):
     """A canyon with rows of crowns (deciduous and evergreen, some with their own leaf-off
     months: three classes of months) over two days, one in leaf and one not: every
     component of the fused kernel equals the numpy reference's, in both reflector samplings
-    and both skies; the crowns darken the direct and diffuse light they shade, and the
-    ``_no_trees`` components are the buildings' alone."""
+    and both skies (the Perez sky's per-segment sums also in blocks of one segment); the
+    crowns darken the direct and diffuse light they shade, and the ``_no_trees``
+    components are the buildings' alone."""
     import sys
     from pathlib import Path
 
     sys.path.insert(0, str(Path(__file__).parent))
     from test_passkernel import _assert_same, _canyon_scene, _clear_day_table
 
+    from vipvflow.models import passkernel
     from vipvflow.models.irradiance import evaluate_passes
     from vipvflow.models.shading import Scene
     from vipvflow.models.view_factors import pack_geometry, segment_geometry
@@ -190,6 +227,10 @@ def test_fused_kernel_equals_the_numpy_reference_with_crowns():
             assert geo["svf"].shape[1] == 3
             ref = evaluate_passes(passes, None, geometry, table_, scene, cfg, packed=geo, kernel="numpy")
             _assert_same(ref, evaluate_passes(passes, None, geometry, table_, scene, cfg, packed=geo))
+            if diffuse == "perez_svf":
+                with monkeypatch.context() as mp:
+                    mp.setattr(passkernel, "SKY_GRID_BUDGET", 1)
+                    _assert_same(ref, evaluate_passes(passes, None, geometry, table_, scene, cfg, packed=geo))
             assert (ref["direct"] <= ref["direct_no_trees"] + 1e-4).all()
             assert (ref["direct"] < 0.9 * ref["direct_no_trees"]).any()
             assert (ref["diffuse"] < 0.9 * ref["diffuse_no_trees"]).any()

@@ -295,29 +295,31 @@ def _interp(table, levels):
     return lo + f * (table[r, k, i + 1] - lo)
 
 
-#: values per cell of a packed sky table row (:func:`pack_sky`)
+#: values per cell of the packed sky tables (:func:`pack_sky`)
 SKY_PACK = 4
 
 
 def pack_sky(tables: dict) -> np.ndarray:
     """The four tables of :meth:`vipvflow.models.sun_sky.RadiationTable.sky` (``all``,
-    ``all_h``, ``clear``, ``clear_h``, (rows, 36, 10) float32) interleaved per cell, (rows,
-    360 x 4) float32 in that order: the values the compiled kernel reads for a sector (two
-    cells, G and H, all-sky and clear-sky) in 32 bytes side by side, not on eight cache
-    lines of four tables (its Perez sky ran 1.5x faster)."""
+    ``all_h``, ``clear``, ``clear_h``, (rows, 36, 10) float32) as one array of cells x time:
+    (360 x 4, rows) float32, row ``4 cell + q`` the values of table ``q`` (in that order) at
+    every time step.  The compiled kernel sums a segment's sky over many time steps at once,
+    each sum a run over contiguous memory (:func:`vipvflow.models.passkernel._sky_grid`)."""
     names = ("all", "all_h", "clear", "clear_h")
     n = len(tables["all"])
-    out = np.empty((n, tables["all"][0].size, SKY_PACK), np.float32)
+    cells = tables["all"][0].size
+    out = np.empty((cells, SKY_PACK, n), np.float32)
     for q, name in enumerate(names):
-        out[:, :, q] = np.asarray(tables[name], np.float32).reshape(n, -1)
-    return out.reshape(n, -1)
+        out[:, q, :] = np.asarray(tables[name], np.float32).reshape(n, cells).T
+    return out.reshape(cells * SKY_PACK, n)
 
 
 def unpack_sky(packed: np.ndarray, shape) -> dict:
     """The four tables of :func:`pack_sky`'s *packed* as views into it (no copy), each of
     *shape* (rows, 36, 10)."""
-    p = packed.reshape(*shape, SKY_PACK)
-    return {name: p[..., q] for q, name in enumerate(("all", "all_h", "clear", "clear_h"))}
+    n = packed.shape[1]
+    p = packed.reshape(-1, SKY_PACK, n)
+    return {name: p[:, q, :].T.reshape(shape) for q, name in enumerate(("all", "all_h", "clear", "clear_h"))}
 
 
 def sky_share(table_g, table_h, levels, normal) -> np.ndarray:
