@@ -148,7 +148,7 @@ def test_sky_view_under_a_crown_is_its_solid_angle_darkened():
     assert (loss * w).sum() == pytest.approx((1 - 0.2) * sin2, rel=0.08)
 
 
-def test_sun_masks_rule_out_only_rays_that_miss_every_crown():
+def test_sun_masks_rule_out_only_rays_that_miss_every_crown(monkeypatch):
     """Crowns of every size scattered around roof points above, among and below them, sun
     rays in every direction: where the compiled kernel skips the grid walk (the ray rises
     above its origin's mask in its azimuth sector) the walk finds no crown, and the masks
@@ -181,6 +181,15 @@ def test_sun_masks_rule_out_only_rays_that_miss_every_crown():
     may = np.array([_may_cross(masks, row[i], d[i, 0], d[i, 1], d[i, 2]) for i in range(len(o))])
     assert (walk[~may] == 1.0).all()
     assert (~may).mean() > 0.5 and (walk[may] < 1).any()
+    # the crowns' share of each sky cell skips the rays of its cells the same way
+    from vipvflow.models.sky import SKY_AZIMUTH_BINS
+    from vipvflow.models.trees import sky_cell_loss
+
+    pts, levels = origins[:40].astype(np.float64), np.zeros((40, SKY_AZIMUTH_BINS))
+    got = sky_cell_loss(crowns, pts, levels, 400.0)
+    monkeypatch.setattr(Crowns, "sun_masks", lambda self, o: np.full((len(o), MASK_SECTORS), np.inf))
+    want = sky_cell_loss(crowns, pts, levels, 400.0)             # every ray walked
+    assert (got == want).all() and (want > 0).any()
 
 
 def test_fused_kernel_equals_the_numpy_reference_with_crowns(monkeypatch):

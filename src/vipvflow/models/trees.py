@@ -441,7 +441,7 @@ def sky_cell_loss(crowns: Crowns, origins_local, sky_x, tmax: float) -> np.ndarr
     ``1 - T`` (the crowns' transmittance, per class) over the directions above the point's
     horizon in that sector (``sky_x``: 10 x its level), over the cell's whole weight.  The
     roof then receives ``sum_cells loss x (n_z dG + t_k dH)`` less (the cell's light of the
-    Perez sky, :func:`vipvflow.models.passkernel._share`), the sky taken as uniform within a
+    Perez sky, :func:`vipvflow.models.passkernel._sky_grid`), the sky taken as uniform within a
     cell.
 
     Parameters
@@ -472,10 +472,15 @@ def sky_cell_loss(crowns: Crowns, origins_local, sky_x, tmax: float) -> np.ndarr
     sector = np.repeat(np.arange(K), L)
     horizon = np.asarray(sky_x, np.float64).reshape(m, K) * SKY_LEVEL_DEG
     loss = np.zeros((K * L * S * S, C))
+    # a direction rising above every crown of its sector (the point's sun mask, the same 10 deg
+    # sectors) crosses none: no walk for it
+    masks = crowns.sun_masks(o)
+    slope = np.broadcast_to(np.tan(EL), (K, L, S, S)).reshape(K * L, S * S)
     for i in range(m):
-        keep = np.flatnonzero((el_deg > horizon[i, sector][:, None]).reshape(-1))
+        above = (el_deg > horizon[i, sector][:, None]).reshape(-1)
+        keep = np.flatnonzero(above & ~(slope > masks[i, sector][:, None]).reshape(-1))
         if not len(keep):
-            continue
+            continue                       # no direction the crowns could take: no loss
         loss[:] = 0.0
         loss[keep] = 1.0 - crowns.transmittance(np.broadcast_to(o[i], (len(keep), 3)), d[keep], tmax)
         out[i] = ((loss.reshape(K * L, S * S, C) * w[:, :, None]).sum(1) / w_cell[:, None]).T
