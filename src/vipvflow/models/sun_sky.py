@@ -17,7 +17,8 @@ import pandas as pd
 from ..errors import InputError
 from ..inputs.cams import _GRID_S, COLUMNS, ingest_cams
 from ..store import DataDir, RadiationDir, write_npz
-from .sky import SKY_STEP_S, open_terms, pack_sky, perez_table, sky_table, unpack_sky
+from .sky import (SKY_AZIMUTH_BINS, SKY_PACK, SKY_STEP_S, open_terms, pack_sky, perez_table,
+                  sky_table, unpack_sky)
 
 log = logging.getLogger(__name__)
 
@@ -98,7 +99,10 @@ def _sky_tables(grid_t0: float, n_steps: int, table: "RadiationTable", k: int) -
     return out
 
 
-_SKY_KEYS = ("rows", "all", "all_h", "all_open", "clear", "clear_h", "clear_open")
+#: what the sky tables' file holds (the four tables packed: :func:`vipvflow.models.sky.pack_sky`)
+_SKY_KEYS = ("rows", "packed", "all_open", "clear_open")
+_SKY_TABLES = ("all", "all_h", "clear", "clear_h")
+_SKY_OPEN = ("all_open", "clear_open")
 
 
 # --------------------------------------------------------------------------- lookup
@@ -295,7 +299,7 @@ class RadiationTable:
         key = None
         if path is not None:
             st = Path(path).stat()
-            key = json.dumps(["sky-4", st.st_size, st.st_mtime_ns, self.t0, self.n, SKY_STEP_S,
+            key = json.dumps(["sky-5", st.st_size, st.st_mtime_ns, self.t0, self.n, SKY_STEP_S,
                               np.round(self.lat, 8).tolist(), np.round(self.lon, 8).tolist()])
             file = RadiationDir(Path(path).parent).sky_cache(int(self.t0), self.n)
             try:
@@ -309,16 +313,17 @@ class RadiationTable:
             offset = np.cumsum([0] + [len(p["all"]) for p in parts])
             cache = {"rows": np.stack([np.where(p["rows"] >= 0, p["rows"] + offset[i], -1)
                                        for i, p in enumerate(parts)]).astype(np.int32),
-                     **{k: np.concatenate([p[k] for p in parts]) for k in _SKY_KEYS[1:]}}
+                     **{k: np.concatenate([p[k] for p in parts]) for k in _SKY_OPEN},
+                     "packed": pack_sky({k: np.concatenate([p[k] for p in parts]) for k in _SKY_TABLES})}
             if key is not None:
                 try:
                     write_npz(file, key=np.array(key), **cache)
                 except OSError:
                     pass
-        # the four tables interleaved for the compiled kernel, and kept only as views into that
-        packed = pack_sky(cache)
-        cache = {**cache, **unpack_sky(packed, cache["all"].shape), "packed": packed,
-                 "t0": float(self.t0), "step": float(SKY_STEP_S)}
+        # the four tables are kept once, interleaved for the compiled kernel, and read as views
+        packed = cache["packed"]
+        shape = (packed.shape[1], SKY_AZIMUTH_BINS, packed.shape[0] // SKY_PACK // SKY_AZIMUTH_BINS)
+        cache = {**cache, **unpack_sky(packed, shape), "t0": float(self.t0), "step": float(SKY_STEP_S)}
         self.__dict__["_sky"] = cache
         return cache
 
