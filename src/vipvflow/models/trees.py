@@ -232,8 +232,11 @@ def sun_masks(o, cx, cy, cz, ia2, ic2, out):
     crown).  A crown (centre, semi-axes ``a`` across, ``c`` up) lies within the upright
     cylinder of radius ``a`` up to its top; from horizontal distance ``d > a`` it covers the
     azimuths within ``asin(a / d)`` of its centre's, and a ray rising at slope ``s`` is
-    above its top beyond ``d - a`` if ``s > (top - o_z) / (d - a)``.  The margins make the
-    bound safe in float32 rays: where a ray's slope exceeds it, :func:`_walk` finds no crown."""
+    above its top beyond ``d - a`` if ``s > (top - o_z) / (d - a)``; with heights scaled by
+    ``a / c`` it is a ball that rises nowhere above its centre's elevation plus
+    ``asin(a / D)`` (``D`` the scaled distance): the lower bound counts.  The margins make
+    the bound safe in float32 rays: where a ray's slope exceeds it, :func:`_walk` finds no
+    crown."""
     w = 2.0 * np.pi / MASK_SECTORS
     for i in range(o.shape[0]):
         for k in range(MASK_SECTORS):
@@ -250,7 +253,15 @@ def sun_masks(o, cx, cy, cz, ia2, ic2, out):
                 for k in range(MASK_SECTORS):
                     out[i, k] = np.inf
                 break
-            bound = top / (d - a) * 1.001 + 1e-4
+            # the lower of two bounds: over the cylinder's near edge; over the crown's
+            # silhouette (heights scaled by a / c make it a ball of radius a, no point of
+            # which rises above its centre's elevation plus asin(a / D))
+            k = a * np.sqrt(ic2[j])
+            hz = (cz[j] - oz) * k
+            D = np.sqrt(d * d + hz * hz)
+            el = np.arctan2(hz, d) + np.arcsin(min(a / D, 1.0))
+            silhouette = np.tan(el) / k if el < 0.5 * np.pi - 1e-6 else np.inf
+            bound = min(top / (d - a), silhouette) * 1.001 + 1e-4
             half = np.arcsin(min(a / d, 1.0)) + 1e-3
             phi = np.arctan2(dx, dy)
             k0 = np.int64(np.floor((phi - half) / w))
