@@ -2,7 +2,7 @@
 
 The same physics as :func:`vipvflow.models.irradiance.roof_irradiance` (eqs. 1-3 of the paper, the
 street reflectors, the rotating reflector sample point and its Russian roulette), compiled
-with numba into two loops over the passes around the one Embree occlusion query numba cannot
+with numba into loops over the passes around the one Embree occlusion query numba cannot
 call:
 
 1. :func:`_setup` looks up the radiation and the sun at each pass's time (linear in time,
@@ -10,13 +10,15 @@ call:
    writes the pass's rays (the roof point towards the sun, one per reflector facing it)
    straight into the ray batch;
 2. Embree answers the batch (:meth:`vipvflow.models.shading.Scene.occluded_local`);
-3. :func:`_finish` sums the components per pass into the output block of
+3. with the Perez sky, :func:`_sky_terms` sums each segment's sky (and what the crowns take
+   from it) over every sky step the chunk spans (:func:`_sky_grid`) and gives each pass its own;
+4. :func:`_finish` sums the components per pass into the output block of
    :func:`vipvflow.models.irradiance.evaluate_passes`, or adds their
    irradiation (Wh/m2) straight into the (segment, local hour) and (trip, date) bins of a
    partition (:func:`vipvflow.simulation.partition.aggregate_partition`).
 
-No per-pass array is made beyond the ray batch, the radiation values of the chunk and the
-pass's place in the batch.  Every float32 operation is the numpy reference's, in the same
+No per-pass array is made beyond the ray batch, the radiation values and sky terms of the
+chunk and the pass's place in the batch.  Every float32 operation is the numpy reference's, in the same
 order, so the components are equal to float32 precision (the tests check it); the sums are
 float64, like the reference's ``bincount``.
 
