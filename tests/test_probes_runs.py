@@ -316,9 +316,12 @@ def test_raw_websocket_request_is_one_log_line(small_run):
         s.bind(("127.0.0.1", 0))
         port = s.getsockname()[1]
     env = dict(os.environ, PYTHONUNBUFFERED="1")
+    # Ctrl-C handled by default, as from a terminal (a suite started in the background of a
+    # shell without job control ignores SIGINT, and its children would inherit that)
     proc = subprocess.Popen([sys.executable, "-m", "vipvflow.cli", "app", small_run, "--port",
                              str(port)], env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                            text=True, start_new_session=True)
+                            text=True, start_new_session=True,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     try:
         deadline = time.time() + 300
         while True:
