@@ -18,8 +18,8 @@ call:
    partition (:func:`vipvflow.simulation.partition.aggregate_partition`).
 
 No per-pass array is made beyond the ray batch, the radiation values and sky terms of the
-chunk and the pass's place in the batch.  Every float32 operation is the numpy reference's, in the same
-order, so the components are equal to float32 precision (the tests check it); the sums are
+chunk and the pass's place in the batch.  Every float32 operation is the numpy reference's,
+in the same order, so the components are equal to float32 precision (the tests check it); the sums are
 float64, like the reference's ``bincount``.
 
 The kernels compile once per process on first use and are cached on disk
@@ -183,8 +183,6 @@ def _setup(lo, hi, seg, t_start, dt, mid, row, loc_of_row, packed, cols, t0, ste
     return nr, npair
 
 
-#: values per cell of the packed Perez sky tables (:func:`vipvflow.models.sky.pack_sky`)
-_PACK = SKY_PACK
 #: float32 values of the sky grids :func:`_sky_terms` holds at once (32 MB)
 SKY_GRID_BUDGET = 8 << 20
 
@@ -207,13 +205,13 @@ def _sky_grid(TT, s0, r, sky_cell, sky_f, sky_t, sky_tilted, nrm, ts, cls_used, 
     a, c = g[0], g[1]
     e1 = s0 + m
     for k in range(sky_cell.shape[1]):
-        b = _PACK * sky_cell[r, k]
+        b = SKY_PACK * sky_cell[r, k]
         f, t = sky_f[r, k], sky_t[r, k]
-        ga0, ga1 = TT[b, s0:e1], TT[b + _PACK, s0:e1]
-        gc0, gc1 = TT[b + 2, s0:e1], TT[b + _PACK + 2, s0:e1]
+        ga0, ga1 = TT[b, s0:e1], TT[b + SKY_PACK, s0:e1]
+        gc0, gc1 = TT[b + 2, s0:e1], TT[b + SKY_PACK + 2, s0:e1]
         if sky_tilted[r]:
-            ha0, ha1 = TT[b + 1, s0:e1], TT[b + _PACK + 1, s0:e1]
-            hc0, hc1 = TT[b + 3, s0:e1], TT[b + _PACK + 3, s0:e1]
+            ha0, ha1 = TT[b + 1, s0:e1], TT[b + SKY_PACK + 1, s0:e1]
+            hc0, hc1 = TT[b + 3, s0:e1], TT[b + SKY_PACK + 3, s0:e1]
             for i in range(m):
                 a[i] += nz * (ga0[i] + f * (ga1[i] - ga0[i])) + t * (ha0[i] + f * (ha1[i] - ha0[i]))
                 c[i] += nz * (gc0[i] + f * (gc1[i] - gc0[i])) + t * (hc0[i] + f * (hc1[i] - hc0[i]))
@@ -227,12 +225,12 @@ def _sky_grid(TT, s0, r, sky_cell, sky_f, sky_t, sky_tilted, nrm, ts, cls_used, 
             continue
         la, lc = g[2 + 2 * q], g[3 + 2 * q]
         for e in range(off[r], off[r + 1]):
-            b = _PACK * cell[e]
+            b = SKY_PACK * cell[e]
             tk, we = sky_t[r, sector[e]], w[e, q]
-            ga0, ga1 = TT[b, s0:e1], TT[b + _PACK, s0:e1]
-            ha0, ha1 = TT[b + 1, s0:e1], TT[b + _PACK + 1, s0:e1]
-            gc0, gc1 = TT[b + 2, s0:e1], TT[b + _PACK + 2, s0:e1]
-            hc0, hc1 = TT[b + 3, s0:e1], TT[b + _PACK + 3, s0:e1]
+            ga0, ga1 = TT[b, s0:e1], TT[b + SKY_PACK, s0:e1]
+            ha0, ha1 = TT[b + 1, s0:e1], TT[b + SKY_PACK + 1, s0:e1]
+            gc0, gc1 = TT[b + 2, s0:e1], TT[b + SKY_PACK + 2, s0:e1]
+            hc0, hc1 = TT[b + 3, s0:e1], TT[b + SKY_PACK + 3, s0:e1]
             for i in range(m):
                 la[i] += we * (nz * (ga0[i] - ga1[i]) + tk * (ha0[i] - ha1[i]))
                 lc[i] += we * (nz * (gc0[i] - gc1[i]) + tk * (hc0[i] - hc1[i]))
@@ -721,12 +719,10 @@ def _run(seg, t_start, dt, mid, row, geo, cfg, radiation_table, scene, loc_of_ro
         occ = (scene.occluded_local(bt.o[:nr], bt.d[:nr], cfg.ray_length_m) if nr
                else np.zeros(0, bool))
         t_c = time.perf_counter()
-        t_s = time.perf_counter()
         if x["has_sky"]:
             _sky_terms(lo, hi, row, bt.rad, bt.done, x["sky_cell"], x["sky_f"], x["sky_t"],
                        x["sky_tilted"], x["sky_packed"], x["sky_open"][0], x["sky_open"][1],
                        x["nrm"], x["ts"], SKY_GRID_BUDGET, bt.terms)
-        clock["sky_s"] = clock.get("sky_s", 0.0) + time.perf_counter() - t_s
         finish(lo, hi, x, bt, occ, P, rotate)
         t_d = time.perf_counter()
         clock["ray_setup_s"] = clock.get("ray_setup_s", 0.0) + t_b - t_a

@@ -256,11 +256,11 @@ def sun_masks(o, cx, cy, cz, ia2, ic2, out):
             # the lower of two bounds: over the cylinder's near edge; over the crown's
             # silhouette (heights scaled by a / c make it a ball of radius a, no point of
             # which rises above its centre's elevation plus asin(a / D))
-            k = a * np.sqrt(ic2[j])
-            hz = (cz[j] - oz) * k
+            scale = a * np.sqrt(ic2[j])
+            hz = (cz[j] - oz) * scale
             D = np.sqrt(d * d + hz * hz)
             el = np.arctan2(hz, d) + np.arcsin(min(a / D, 1.0))
-            silhouette = np.tan(el) / k if el < 0.5 * np.pi - 1e-6 else np.inf
+            silhouette = np.tan(el) / scale if el < 0.5 * np.pi - 1e-6 else np.inf
             bound = min(top / (d - a), silhouette) * 1.001 + 1e-4
             half = np.arcsin(min(a / d, 1.0)) + 1e-3
             phi = np.arctan2(dx, dy)
