@@ -227,12 +227,13 @@ def stage_split(manifest: dict) -> dict:
         "ray_setup": t.get("irradiance_ray_setup_s", 0.0),
         "rays": t.get("irradiance_rays_s", 0.0),
         "components": t.get("irradiance_components_s", 0.0),
+        "sun_masks": t.get("irradiance_sun_masks_s", 0.0),
         "pack": t.get("irradiance_pack_s", 0.0),
         "aggregate": t.get("reduce_s", 0.0),
         "write": t.get("write_s", 0.0),
     }
-    untracked = t.get("irradiance_s", 0.0) - sum(stages[k] for k in
-                                                  ("lookup", "ray_setup", "rays", "components", "pack"))
+    untracked = t.get("irradiance_s", 0.0) - sum(stages[k] for k in ("lookup", "ray_setup", "rays",
+                                                                     "components", "sun_masks", "pack"))
     # the rest of irradiance_s: the worker's first load of the radiation table (sun positions)
     # and of the tile's BVH, both cached afterwards, and the segment index of evaluate_passes
     stages["load_and_other"] = max(untracked, 0.0)

@@ -60,6 +60,9 @@ class IrradianceCfg(_Params):
     reflection_rays: int = Field(256, ge=0, le=65_536)
     svf_rays: int = Field(512, gt=0, le=65_536)
     ray_length_m: float = Field(300.0, gt=0, le=100_000)
+    # per roof point and 1 deg of azimuth, a bound on how high the buildings rise: a sun
+    # ray above it is clear without Embree (exact: the same answer; false casts every ray)
+    sun_masks: bool = True
     ray_offset_m: float = Field(0.05, ge=0)
     max_reflector_groups: int = Field(4, ge=0)
     reflector_points: int = Field(64, ge=1)

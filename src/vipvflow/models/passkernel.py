@@ -41,6 +41,7 @@ from functools import lru_cache
 import numpy as np
 from numba import njit
 
+from .horizon import BUILDING_SECTORS, building_sector
 from .irradiance import ROULETTE_WEIGHT
 from .sky import COS_85, SECTOR_COS, SECTOR_SIN, SKY_AZIMUTH_BINS, SKY_LEVELS, SKY_PACK
 from .trees import _MAX_HITS, MASK_SECTORS, mask_sector, month0, transmit_one
@@ -78,18 +79,33 @@ def _sample_key(segment_id, t_utc):
     return np.int64(x >> np.uint64(33))
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _clear_of_buildings(bmask, r, sx, sy, sz):
+    """Whether segment row *r*'s sun mask among the buildings *bmask*
+    (:meth:`vipvflow.models.shading.Scene.sun_masks`; no rows: no masks) tells the sun ray
+    (*s*) clear: its slope above the mask in its sector."""
+    if bmask.shape[0] == 0:
+        return False
+    h = np.sqrt(np.float64(sx) * sx + np.float64(sy) * sy)
+    if not h > 0.0:
+        return False
+    k = building_sector(np.float64(sx), np.float64(sy), BUILDING_SECTORS)
+    return np.float64(sz) / h > bmask[r, k]
+
+
 @njit(cache=True, nogil=True)
 def _setup(lo, hi, seg, t_start, dt, mid, row, loc_of_row, packed, cols, t0, step,
            nrm, wn, tree_month, p_local, gp_local, rotate, roulette_w, perez, sky_rows, sky_t0,
-           sky_step, rad, cos_aoi, pass_ray, pair_w, pair_pass, pair_pt, o, d, done):
+           sky_step, bmask, rad, cos_aoi, pass_ray, pair_w, pair_pass, pair_pt, o, d, done, free):
     """Radiation lookup and ray batch of passes ``lo..hi`` (see the module docstring).
 
     Fills, per pass ``i`` (chunk index ``i - lo``): ``rad`` (:data:`_RAD`, NaN as 0, sun
     components as looked up; the Perez coefficients 0 unless *perez*), ``cos_aoi``,
     ``pass_ray`` (the pass's first ray in the batch;
     ``pass_ray[i + 1] - pass_ray[i]`` rays: its direct ray first when the sun is in front of
-    the roof, then per reflector pair one ray, or P with ``rotate`` False), ``done[i]``
-    False for a dark pass (every component 0).  ``pair_w`` / ``pair_pass``: per pair its
+    the roof and the segment's sun mask among the buildings *bmask* cannot tell it clear
+    (``free[i]`` True where it can: no ray), then per reflector pair one ray, or P with
+    ``rotate`` False), ``done[i]`` False for a dark pass (every component 0).  ``pair_w`` / ``pair_pass``: per pair its
     beam weight and pass (chunk index), ``pair_pt`` its (first) sample point's flat index
     (reflector x P + point).  ``rad[c, _CLS]``: the crowns' class of the pass's
     month (*tree_month*, per geometry row; *wn* per row and class).  Returns (rays, pairs).
@@ -104,6 +120,7 @@ def _setup(lo, hi, seg, t_start, dt, mid, row, loc_of_row, packed, cols, t0, ste
         pass_ray[c] = nr
         cos_aoi[c] = np.float32(0.0)
         done[c] = False
+        free[c] = False
         t = t_start[i] + 0.5 * dt[i] if mid else t_start[i]
         f = (t - t0) / step
         if not (f >= 0.0 and f <= n_t - 1):
@@ -144,9 +161,12 @@ def _setup(lo, hi, seg, t_start, dt, mid, row, loc_of_row, packed, cols, t0, ste
         ca = max(ca, np.float32(0.0))
         cos_aoi[c] = ca
         if ca > 0:
-            o[nr, 0], o[nr, 1], o[nr, 2] = p_local[r, 0], p_local[r, 1], p_local[r, 2]
-            d[nr, 0], d[nr, 1], d[nr, 2] = sx, sy, sz
-            nr += 1
+            if _clear_of_buildings(bmask, r, sx, sy, sz):
+                free[c] = True
+            else:
+                o[nr, 0], o[nr, 1], o[nr, 2] = p_local[r, 0], p_local[r, 1], p_local[r, 2]
+                d[nr, 0], d[nr, 1], d[nr, 2] = sx, sy, sz
+                nr += 1
         if J == 0:
             continue
         key = _sample_key(seg[i], t_start[i]) if rotate else np.int64(0)
@@ -372,28 +392,36 @@ def _may_cross(smask, r, dx, dy, dz):
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _visibility(c, r, pass_ray, pair_w, pair_pass, pair_pt, gf, q, occ, cos_aoi, rotate, P, o, d,
-                tmax, cls, tr, smask, hits):
+def _visibility(c, r, pass_ray, pair_w, pair_pass, pair_pt, gf, q, occ, cos_aoi, free, rad,
+                p_local, rotate, P, o, d, tmax, cls, tr, smask, hits):
     """Whether the pass's sun ray misses the buildings, its transmittance (0, else the
     crowns' along it in class *cls*; 1 without a walk where segment row *r*'s sun mask
     *smask* rules the crowns out), its reflectors' beam sum ``sum weight x lit``
     (float64 like the reference's bincount, then float32; a sample point's ray lit in the
     crowns' transmittance, times the point's factor through the crowns *gf*), and the next
-    pair."""
+    pair.  A pass whose sun mask among the buildings told its sun ray clear (*free*) has no
+    ray of its own: it starts at the roof point (*p_local*) towards the sun (*rad*)."""
     cx, cy, cz, ia2, ic2, meta, start, items, tau = tr
     trees = items.shape[0] > 0
     r0, r1 = pass_ray[c], pass_ray[c + 1]
     visible = False
     vis_t = np.float32(0.0)
     if cos_aoi[c] > 0:
-        visible = not occ[r0]
+        if free[c]:
+            visible = True
+            ox, oy, oz = p_local[r, 0], p_local[r, 1], p_local[r, 2]
+            dx, dy, dz = rad[c, 6], rad[c, 7], rad[c, 8]
+        else:
+            visible = not occ[r0]
+            ox, oy, oz = o[r0, 0], o[r0, 1], o[r0, 2]
+            dx, dy, dz = d[r0, 0], d[r0, 1], d[r0, 2]
+            r0 += 1
         if visible:
             vis_t = np.float32(1.0)
             # the crowns' walk only where the segment's sun mask cannot rule them out
-            if trees and _may_cross(smask, r, d[r0, 0], d[r0, 1], d[r0, 2]):
-                vis_t = transmit_one(o[r0, 0], o[r0, 1], o[r0, 2], d[r0, 0], d[r0, 1], d[r0, 2],
-                                     tmax, cls, cx, cy, cz, ia2, ic2, meta, start, items, tau, hits)
-        r0 += 1
+            if trees and _may_cross(smask, r, dx, dy, dz):
+                vis_t = transmit_one(ox, oy, oz, dx, dy, dz, tmax, cls, cx, cy, cz, ia2, ic2,
+                                     meta, start, items, tau, hits)
     acc = 0.0
     while r0 < r1:
         if rotate:
@@ -426,7 +454,7 @@ def _visibility(c, r, pass_ray, pair_w, pair_pass, pair_pt, gf, q, occ, cos_aoi,
 
 @njit(cache=True, nogil=True)
 def _finish(lo, hi, row, rad, cos_aoi, pass_ray, pair_w, pair_pass, pair_pt, gf, occ, done,
-            sky, sky_nt, iso, refl_sky, refl_ghi, perez, hbv, hbv_nt, refl_hor, sin_tilt, has_sky,
+            free, p_local, sky, sky_nt, iso, refl_sky, refl_ghi, perez, hbv, hbv_nt, refl_hor, sin_tilt, has_sky,
             terms, rotate, P, o, d, tmax, tr, smask, to_bins, block, visible_out, dt, seg_hour,
             run, seg_bins, run_bins):
     """Components of passes ``lo..hi``: into columns of *block* (14, n) and *visible_out*,
@@ -443,8 +471,8 @@ def _finish(lo, hi, row, rad, cos_aoi, pass_ray, pair_w, pair_pass, pair_pt, gf,
             continue
         cls = np.int64(rad[c, _CLS])
         visible, vis_t, beam_sum, q = _visibility(c, row[i], pass_ray, pair_w, pair_pass, pair_pt,
-                                                  gf, q, occ, cos_aoi, rotate, P, o, d, tmax, cls,
-                                                  tr, smask, hits)
+                                                  gf, q, occ, cos_aoi, free, rad, p_local, rotate,
+                                                  P, o, d, tmax, cls, tr, smask, hits)
         _components(c, row[i], rad, cos_aoi, vis_t, visible, beam_sum, sky, sky_nt, iso,
                     refl_sky, refl_ghi, perez, hbv, hbv_nt, refl_hor, sin_tilt, has_sky, terms,
                     out)
@@ -590,6 +618,7 @@ class _Batch:
         self.cos_aoi = np.empty(chunk, f32)
         self.pass_ray = np.empty(chunk + 1, np.int64)
         self.done = np.empty(chunk, np.bool_)
+        self.free = np.empty(chunk, np.bool_)
         self.pair_w = np.empty(chunk * pairs_per_pass, f32)
         self.pair_pass = np.empty(chunk * pairs_per_pass, np.int64)
         self.pair_pt = np.empty(chunk * pairs_per_pass, np.int64)
@@ -621,7 +650,7 @@ def _writable(a: np.ndarray) -> np.ndarray:
     return a if a.flags.writeable else a.copy()
 
 
-def _inputs(geo: dict, cfg, radiation_table, rows_of_segment_loc, scene=None):
+def _inputs(geo: dict, cfg, radiation_table, rows_of_segment_loc, scene=None, clock=None):
     f32 = np.float32
     names, packed = radiation_table._packed()
     cols = np.array([names.index(c) for c in _RAD], np.int64)
@@ -656,6 +685,7 @@ def _inputs(geo: dict, cfg, radiation_table, rows_of_segment_loc, scene=None):
     crowns = scene.crowns(cfg) if (scene is not None and hasattr(scene, "crowns")) else None
     x["tr"] = tuple(_writable(a) for a in crowns.arrays()) if crowns is not None else _NO_TREES
     x["smask"] = _sun_masks(geo, crowns)
+    x["bmask"] = _building_masks(geo, scene, cfg, clock) if cfg.sun_masks else _NO_BMASK
     sky_x = geo.get("sky_x")
     if perez and sky_x is not None and sky_x.shape[1]:
         tables = radiation_table.sky()
@@ -692,6 +722,28 @@ def _sun_masks(geo: dict, crowns) -> np.ndarray:
     return masks
 
 
+#: no sun masks among the buildings: every sun ray is cast
+_NO_BMASK = np.zeros((0, BUILDING_SECTORS))
+
+
+def _building_masks(geo: dict, scene, cfg, clock: dict | None = None) -> np.ndarray:
+    """The sun masks of the geometry's roof points among *scene*'s buildings for rays of
+    ``cfg.ray_length_m`` (:meth:`vipvflow.models.shading.Scene.sun_masks`), kept in *geo*
+    for the scene and length they were made for; none without a scene.  The seconds of a
+    build are added to ``clock["sun_masks_s"]``."""
+    if scene is None or not hasattr(scene, "sun_masks"):
+        return _NO_BMASK
+    kept = geo.get("_building_masks")
+    if kept is not None and kept[0] is scene and kept[1] == cfg.ray_length_m:
+        return kept[2]
+    t = time.perf_counter()
+    masks = scene.sun_masks(geo["p_local"], cfg.ray_length_m)
+    if clock is not None:
+        clock["sun_masks_s"] = clock.get("sun_masks_s", 0.0) + time.perf_counter() - t
+    geo["_building_masks"] = (scene, cfg.ray_length_m, masks)
+    return masks
+
+
 #: the crowns' arrays of a scene without trees (:meth:`vipvflow.models.trees.Crowns.arrays`)
 _NO_TREES = (np.zeros(0), np.zeros(0), np.zeros(0), np.zeros(0), np.zeros(0),
              np.array([0.0, 0.0, 1.0, 1.0, 1.0, 0.0, 0.0]), np.zeros(2, np.int64),
@@ -701,7 +753,7 @@ _NO_TREES = (np.zeros(0), np.zeros(0), np.zeros(0), np.zeros(0), np.zeros(0),
 def _run(seg, t_start, dt, mid, row, geo, cfg, radiation_table, scene, loc_of_row, clock,
          finish):
     """Chunks of passes through setup -> Embree -> *finish(lo, hi, x, batch, occ, P, rotate)*."""
-    x = _inputs(geo, cfg, radiation_table, loc_of_row, scene)
+    x = _inputs(geo, cfg, radiation_table, loc_of_row, scene, clock)
     J, P, rotate, per_pass, chunk = _plan(geo, cfg)
     n = len(row)
     chunk = min(chunk, max(n, 1))
@@ -713,8 +765,8 @@ def _run(seg, t_start, dt, mid, row, geo, cfg, radiation_table, scene, loc_of_ro
         nr, _ = _setup(lo, hi, seg, t_start, dt, mid, row, x["loc"], x["packed"], x["cols"],
                        x["t0"], x["step"], x["nrm"], x["wn"], x["tree_month"], x["p_local"],
                        x["gp_local"], rotate, rw, x["perez"], x["sky_rows"], x["sky_t0"],
-                       x["sky_step"], bt.rad, bt.cos_aoi, bt.pass_ray, bt.pair_w, bt.pair_pass,
-                       bt.pair_pt, bt.o, bt.d, bt.done)
+                       x["sky_step"], x["bmask"], bt.rad, bt.cos_aoi, bt.pass_ray, bt.pair_w,
+                       bt.pair_pass, bt.pair_pt, bt.o, bt.d, bt.done, bt.free)
         t_b = time.perf_counter()
         occ = (scene.occluded_local(bt.o[:nr], bt.d[:nr], cfg.ray_length_m) if nr
                else np.zeros(0, bool))
@@ -728,6 +780,12 @@ def _run(seg, t_start, dt, mid, row, geo, cfg, radiation_table, scene, loc_of_ro
         clock["ray_setup_s"] = clock.get("ray_setup_s", 0.0) + t_b - t_a
         clock["rays_s"] = clock.get("rays_s", 0.0) + t_c - t_b
         clock["components_s"] = clock.get("components_s", 0.0) + t_d - t_c
+        # sun rays in front of the roof: cast, or told clear by the masks (counts, not s)
+        m = hi - lo
+        masked = int(np.count_nonzero(bt.free[:m]))
+        clock["sun_rays_masked_n"] = clock.get("sun_rays_masked_n", 0) + masked
+        clock["sun_rays_cast_n"] = (clock.get("sun_rays_cast_n", 0)
+                                    + int(np.count_nonzero(bt.cos_aoi[:m] > 0)) - masked)
 
 
 def evaluate_block(seg, t_start, dt, mid, row, geo, cfg, radiation_table, scene,
@@ -747,7 +805,9 @@ def evaluate_block(seg, t_start, dt, mid, row, geo, cfg, radiation_table, scene,
     scene : vipvflow.models.shading.Scene
     loc_of_row : (segments,) int64, optional, radiation location of each geometry row
     timings : dict, optional, seconds added to ``ray_setup_s`` (includes the radiation
-        lookup), ``rays_s`` and ``components_s``
+        lookup), ``rays_s``, ``components_s`` and ``sun_masks_s`` (a tile's masks, once),
+        and the counts ``sun_rays_cast_n`` and ``sun_rays_masked_n`` (sun rays in front of
+        the roof told clear by the masks, with no ray)
 
     Returns
     -------
@@ -796,7 +856,7 @@ def _finisher(row, dt, to_bins, block, visible, seg_hour, run, seg_bins, run_bin
     *visible*, or (*to_bins*) into *seg_bins* and *run_bins*."""
     def finish(lo, hi, x, bt, occ, P, rotate):
         _finish(lo, hi, row, bt.rad, bt.cos_aoi, bt.pass_ray, bt.pair_w, bt.pair_pass,
-                bt.pair_pt, x["gf"], occ, bt.done, x["sky"], x["sky_nt"], x["iso"], x["refl_sky"], x["refl_ghi"],
+                bt.pair_pt, x["gf"], occ, bt.done, bt.free, x["p_local"], x["sky"], x["sky_nt"], x["iso"], x["refl_sky"], x["refl_ghi"],
                 x["perez"], x["hbv"], x["hbv_nt"], x["refl_hor"], x["sin_tilt"], x["has_sky"],
                 bt.terms, rotate, P, bt.o, bt.d, x["tmax"], x["tr"], x["smask"], to_bins, block, visible, dt,
                 seg_hour, run, seg_bins, run_bins)
@@ -823,10 +883,11 @@ def warm() -> float:
                 _setup(0, 1, one_i, one_t, one_t, True, one_i, one_i, packed,
                        np.arange(_N_RAD, dtype=i64), 0.0, 60.0, o3, np.zeros((1, 1, 1, 3), f32),
                        months, o3, np.zeros((1, 1, 3), f32), rotate, f32(0.02), perez, rows, 0.0,
-                       900.0, rad, one_f, pr, one_f, one_i, one_i, o3, o3, np.zeros(1, np.bool_))
+                       900.0, _NO_BMASK, rad, one_f, pr, one_f, one_i, one_i, o3, o3,
+                       np.zeros(1, np.bool_), np.zeros(1, np.bool_))
                 for to_bins in (False, True):
                     _finish(0, 1, one_i, rad, one_f, pr, one_f, one_i, one_i, one_c, np.zeros(1, bool),
-                            np.zeros(1, np.bool_), one_c, one_f, one_f, one_c, one_c, perez, one_c,
+                            np.zeros(1, np.bool_), np.zeros(1, np.bool_), o3, one_c, one_f, one_f, one_c, one_c, perez, one_c,
                             one_f, one_c, one_f, bool(n_sky), np.zeros((1, 6), f32), rotate, 1, o3,
                             o3, 300.0, _NO_TREES, np.zeros((1, MASK_SECTORS)), to_bins,
                             np.zeros((_NB, 1), f32),

@@ -97,6 +97,24 @@ class Scene:
             crowns = self._crowns[key] = Crowns(self.trees, cfg, self.origin)
         return crowns
 
+    def sun_masks(self, origins_local, reach: float) -> np.ndarray:
+        """Per origin (n, 3; the scene's frame, :meth:`to_local`) and 1 deg azimuth sector
+        a slope above which a ray of length *reach* (m) meets no triangle of the scene
+        (:func:`vipvflow.models.horizon.building_masks`): (n,
+        :data:`~vipvflow.models.horizon.BUILDING_SECTORS`) float64."""
+        from .horizon import BUILDING_SECTORS, MASK_FLOOR, building_masks
+
+        o = np.ascontiguousarray(np.asarray(origins_local, np.float32).reshape(-1, 3))
+        out = np.empty((len(o), BUILDING_SECTORS))
+        v = np.asarray(self.mesh.vertices, np.float64)
+        tris = (np.ascontiguousarray((v[self.mesh.triangles] - self.origin).astype(np.float32))
+                if self.n_triangles else np.zeros((0, 3, 3), np.float32))
+        t64 = tris.astype(np.float64)
+        box = np.ascontiguousarray(np.concatenate([t64[:, :, :2].min(1), t64[:, :, :2].max(1)], axis=1))
+        building_masks(tris, np.ascontiguousarray(t64[:, :, 2].max(1)), box, o,
+                       float(reach) * 1.001 + 1.0, MASK_FLOOR, out)
+        return out
+
     # ------------------------------------------------------------------ helpers
     def _prepare(self, origins, dirs, tfar):
         o = np.ascontiguousarray((np.asarray(origins, np.float64) - self.origin).astype(np.float32))

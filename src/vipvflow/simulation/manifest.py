@@ -187,10 +187,12 @@ def write_manifest(cfg, year, run_dir, inputs: InputDigests, timings, results, b
             versions[name] = metadata.version(name)
         except metadata.PackageNotFoundError:
             versions[name] = None
-    stage = {}
+    stage, counts = {}, {}
     for res in results:
         for k, v in res.get("timings", {}).items():
             stage[k] = stage.get(k, 0.0) + v
+        for k, v in res.get("counts", {}).items():
+            counts[k] = counts.get(k, 0) + int(v)
     manifest = {
         "scenario": cfg.scenario, "year": year, "config_digest": cfg.digest(),
         "config": masked_config(cfg.model_dump(mode="json")),
@@ -203,6 +205,9 @@ def write_manifest(cfg, year, run_dir, inputs: InputDigests, timings, results, b
         "standing_partitions_computed": sum(1 for r in results if "intervals" in r),
         "standing_intervals": int(sum(r.get("intervals", 0) for r in results)),
         "passes_computed": int(sum(r["passes"] for r in results)),
+        # sun rays in front of the roof in the driving partitions: cast with Embree, or told
+        # clear by the sun masks among the buildings (irradiance.sun_masks)
+        "partition_counts": counts,
         "bvh_builds_per_worker": builds,
         "created_utc": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
     }

@@ -515,11 +515,14 @@ def run_partition(ctx: RunContext, tile: str, month: str,
     t3 = time.perf_counter()
     write_partition_files(run, tile, month, trip, segm, hourly)
     timings["write_s"] = time.perf_counter() - t3
+    # the kernel's counts (``*_n``) apart from its seconds
+    counts = {k.removeprefix("irradiance_")[:-2]: timings.pop(k) for k in
+              [k for k in timings if k.endswith("_n")]}
 
     kwh = trip.column("pv_kwh").to_numpy()
     return {"tile": tile, "month": month, "passes": n, "trips": trip.num_rows,
             "kwh": float(kwh.sum()), "kwh_by_route": _kwh_by_route(trip, kwh, ctx.route_of_trip),
-            "timings": timings,
+            "timings": timings, "counts": counts,
             "elapsed_s": time.perf_counter() - t0}
 
 
