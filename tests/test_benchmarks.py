@@ -63,6 +63,9 @@ def test_facts_in_the_tiny_results(tiny_results):
             assert set(per_worker) == {"worker1", "worker2"}, table
     line = json.loads((results / "line_year.tiny.json").read_text())["figures"]
     assert line["passes"] > 0 and line["partitions"] > 0
+    # the sun masks spare rays and change no result (the all-rays leg of the same round)
+    assert line["masks_equal_all_rays"] is True
+    assert line["sun_rays_masked"] > 0 and line["sun_rays_cast"] > 0
     # the trees' cost is measured on a demo that has trees, in the three legs of a round
     sky = json.loads((results / "sky.tiny.json").read_text())["figures"]
     assert sky["trees_in_city_model"] > 0

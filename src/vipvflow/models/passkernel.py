@@ -41,7 +41,7 @@ from functools import lru_cache
 import numpy as np
 from numba import njit
 
-from .horizon import BUILDING_SECTORS, building_sector
+from .horizon import BUILDING_SECTORS, MASK_FLOOR, building_masks, building_sector
 from .irradiance import ROULETTE_WEIGHT
 from .sky import COS_85, SECTOR_COS, SECTOR_SIN, SKY_AZIMUTH_BINS, SKY_LEVELS, SKY_PACK
 from .trees import _MAX_HITS, MASK_SECTORS, mask_sector, month0, transmit_one
@@ -898,5 +898,7 @@ def warm() -> float:
                np.zeros(1, np.bool_), np.zeros((tables.shape[1] * SKY_PACK, 1), f32),
                np.zeros((1, 2), f32), np.zeros((1, 2), f32), o3, ts, 1 << 20, np.zeros((1, 6), f32))
     _groups(one_i, one_i, one_i, one_t, one_t, 0, one_i, 0, one_t, one_i, one_i, one_i, one_i)
+    building_masks(np.zeros((1, 3, 3), f32), one_t, np.zeros((1, 4)), o3, 300.0, MASK_FLOOR,
+                   np.zeros((1, BUILDING_SECTORS)))
     _seconds(one_i, one_i, one_i, one_t, one_t, one_t, one_t, one_i, one_i)
     return time.perf_counter() - t
