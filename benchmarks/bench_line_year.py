@@ -50,7 +50,7 @@ def _line_year(size: str, months: list[int], sun_masks: bool = True, keep: bool 
     try:
         cfg = demo_config(size, out_dir=out, routes=["L1"], months=months, n_workers=2)
         cfg.irradiance.sun_masks = sun_masks
-        r = run_pipeline(cfg, YEAR, n_workers=2)
+        r = run_pipeline(cfg, YEAR, n_workers=2, pss=True)
         if keep:
             d = r["run_dir"]
             r["outputs"] = {"summary": json.loads((d / "summary.json").read_text()),
@@ -128,6 +128,9 @@ def run(tiny: bool = False) -> dict:
         "masks_equal_all_rays": _same_outputs(rounds[0][1]["outputs"], rounds[0][2]["outputs"]),
         "peak_rss_gb": round(max(line["peak_rss_mb"] for _, line in pairs) / 1024, 3),
         "peak_rss_main_gb": round(max(line["peak_rss_main_mb"] for _, line in pairs) / 1024, 3),
+        # the same peak counting each shared page once (PeakRSS: the workers share the
+        # forkserver's imported libraries): the memory the run takes from the machine
+        "peak_pss_gb": round(max(line["peak_pss_mb"] for _, line in pairs) / 1024, 3),
         "partitions": m["partitions_computed"],
         "bvh_builds": n_builds,
         "bvh_builds_per_tile": round(n_builds / max(tiles, 1), 2),

@@ -16,6 +16,13 @@ peak RSS of the process tree (this process and a LocalCluster's workers); on an 
 cluster also each worker's and the scheduler's own peak RSS (``cluster_peak_rss_mb``), asked
 of them after the run, and their sum.
 
+Issue 41: the bare kernel (:func:`benchmarks.bench_kernel.bare_kernel`, the line-year's
+passes of ``L1``) runs before and after the network, as ``line_year`` pairs them, and
+``kernel_ratio`` is its best passes per second over the network's (target 1.5); peak PSS
+beside the peak RSS (:class:`benchmarks.common.PeakRSS`) and each process's own peak RSS.
+``VIPVFLOW_BENCH_NETWORK_LINES`` sets the lines (default 200; the cost model in README.md
+ran 50, 100 and 200).
+
 Periods (``VIPVFLOW_BENCH_NETWORK`` or ``--week``/``--month`` on the module's command line):
 ``year`` (default: every day of 2024, all 12 months: ~3.5 G passes, 20-40 min of both
 cores), ``month`` (June 2024) and ``week`` (Monday 10 to Sunday 16 June 2024; long days:
@@ -40,6 +47,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from benchmarks.bench_kernel import bare_kernel
 from benchmarks.common import (WORK, YEAR, PeakRSS, demo_config, demo_paths, fresh_dir, prepare_demo,
                                remove, run_pipeline)
 
@@ -185,7 +193,7 @@ def run(tiny: bool = False, period: str | None = None, scheduler: str | None = N
     period = period or os.environ.get("VIPVFLOW_BENCH_NETWORK", "year")
     scheduler = scheduler or os.environ.get("VIPVFLOW_BENCH_SCHEDULER") or None
     size = "small" if tiny else "full"
-    n_lines = 4 if tiny else 200
+    n_lines = 4 if tiny else int(os.environ.get("VIPVFLOW_BENCH_NETWORK_LINES", "200"))
     days, months = period_days(period, tiny)
     prepare_demo(size)
     demo = demo_paths(size)
@@ -210,7 +218,9 @@ def run(tiny: bool = False, period: str | None = None, scheduler: str | None = N
             t = time.perf_counter()
             ensure_ingested(cfg, say=lambda *a: None)
             ingest_s = time.perf_counter() - t
-        r = run_pipeline(cfg, YEAR, n_workers=None if scheduler else 2, scheduler=scheduler)
+        kernel = [bare_kernel(size, months if tiny else list(range(1, 13)))]
+        r = run_pipeline(cfg, YEAR, n_workers=None if scheduler else 2, scheduler=scheduler, pss=True)
+        kernel.append(bare_kernel(size, months if tiny else list(range(1, 13))))
         cluster_rss = outside_cluster_peak_rss(scheduler) if scheduler else {}
         segments = len(pd.read_parquet(data_dir / "gtfs" / "segments.parquet", columns=["tile"]))
         trip_days = len(pd.read_parquet(r["run_dir"] / "trip_energy.parquet", columns=["trip_id"]))
@@ -221,7 +231,7 @@ def run(tiny: bool = False, period: str | None = None, scheduler: str | None = N
                    {"segments": segments, "trips_run": trip_days, "gtfs_ingest_s": round(ingest_s, 1),
                     "partition_bytes_per_pass": round(part_bytes / max(r["manifest"]["passes_computed"], 1), 3)},
                    feed_write_s=round(write_s, 1), ingest_peak_rss_mb=round(mem.peak_mb),
-                   **cluster_rss)
+                   kernel=kernel, **cluster_rss)
 
 
 def outside_cluster_peak_rss(scheduler: str) -> dict:
@@ -249,7 +259,8 @@ def _part_bytes(run_dir: Path) -> int:
                for f in (run_dir / "parts" / kind).glob("tile=*/month=*.parquet"))
 
 
-def _result(r: dict, counts: dict, days: list, period: str, scheduler, extra: dict, **more) -> dict:
+def _result(r: dict, counts: dict, days: list, period: str, scheduler, extra: dict, kernel=(),
+            **more) -> dict:
     m = r["manifest"]
     passes = m["passes_computed"]
     wall = r["wall_s"]
@@ -267,13 +278,20 @@ def _result(r: dict, counts: dict, days: list, period: str, scheduler, extra: di
         "reduce_share": round(reduce_s / wall, 4) if reduce_s is not None else None,
         "passes_per_s": round(passes / wall),
         "peak_rss_gb": round(r["peak_rss_mb"] / 1024, 3),
+        "peak_pss_gb": round(r["peak_pss_mb"] / 1024, 3) if r.get("peak_pss_mb") else None,
+        "peak_rss_by_process_mb": r.get("peak_rss_by_process_mb"),
         "partition_bytes_per_pass": extra["partition_bytes_per_pass"],
         "gtfs_ingest_s": extra["gtfs_ingest_s"],
     }
+    if kernel:                                        # the bare kernel before and after
+        k_pps = [k["passes"] / k["wall_s"] for k in kernel]
+        figures.update(kernel_passes_per_s_runs=[round(v) for v in k_pps],
+                       kernel_passes_per_s=round(max(k_pps)),
+                       kernel_ratio=round(max(k_pps) / (passes / wall), 3))
     if "cluster_peak_rss_gb_sum" in more:             # an outside cluster's processes
         figures["cluster_peak_rss_gb_sum"] = more.pop("cluster_peak_rss_gb_sum")
     targets = {"wall_min": "< 30 for the year (issue 21)", "reduce_share": "< 0.10",
-               "peak_rss_gb": "< 2 (wish)"}
+               "peak_rss_gb": "< 4 (issue 41)", "kernel_ratio": "<= 1.5 (issue 41)"}
     out = {"figures": figures, "targets": targets, "feed": counts,
            "cluster": scheduler or "LocalCluster, 2 workers",
            "peak_rss_note": "process tree of the benchmark (a LocalCluster's workers included; "

@@ -32,13 +32,22 @@ class PeakRSS:
     taken into account for ``peak_self_mb``.  A sample costs ~2.5 ms of CPU (psutil walks
     ``/proc`` for the children), taken from the run it measures when the workers fill the
     cores: 0.25 s keeps that to 1 % of a core.
+
+    With *pss* also ``mem.peak_pss_mb``: the same peak of the proportional set sizes
+    (``/proc/<pid>/smaps_rollup``: each shared page split among the processes mapping it).
+    The sum of RSS counts the pages a forked Dask worker shares with the forkserver it came
+    from (the imported libraries) once per process; the sum of PSS counts them once, so it
+    is the memory the run takes from the machine.  A PSS sample costs a few ms more.
     """
 
-    def __init__(self, pid: int | None = None, interval_s: float = 0.25):
+    def __init__(self, pid: int | None = None, interval_s: float = 0.25, pss: bool = False):
         self.pid = pid or os.getpid()
         self.interval_s = interval_s
+        self.pss = pss
         self.peak_mb = 0.0
+        self.peak_pss_mb = 0.0
         self.peak_self_mb = 0.0
+        self.by_pid: dict[int, float] = {}       # each process's own peak RSS (MB)
         self.samples = 0
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._poll, daemon=True, name="peak-rss")
@@ -52,12 +61,24 @@ class PeakRSS:
         except psutil.Error:
             return
         total = own
-        for child in root.children(recursive=True):
+        children = root.children(recursive=True)
+        self.by_pid[root.pid] = max(self.by_pid.get(root.pid, 0.0), own / 2**20)
+        for child in children:
             try:
-                total += child.memory_info().rss
+                rss = child.memory_info().rss
             except psutil.Error:
-                pass
+                continue
+            total += rss
+            self.by_pid[child.pid] = max(self.by_pid.get(child.pid, 0.0), rss / 2**20)
         self.peak_mb = max(self.peak_mb, total / 2**20)
+        if self.pss:
+            pss = 0
+            for p in [root, *children]:
+                try:
+                    pss += p.memory_full_info().pss
+                except psutil.Error:
+                    pass
+            self.peak_pss_mb = max(self.peak_pss_mb, pss / 2**20)
         self.peak_self_mb = max(self.peak_self_mb, own / 2**20)
         self.samples += 1
 
@@ -172,7 +193,7 @@ def remove(path: Path) -> None:
 
 
 def run_pipeline(cfg, year: int = YEAR, n_workers: int | None = None, rss_interval_s: float = 0.25,
-                 scheduler: str | None = None) -> dict:
+                 scheduler: str | None = None, pss: bool = False) -> dict:
     """One :func:`run_simulation` of *cfg* (on the cluster at *scheduler*, if given): wall
     time, peak RSS of the process tree, manifest, and the CPU time of this process (the
     command's: scheduler, client, prepare, the reduce's joins; all its threads) and of the
@@ -180,7 +201,7 @@ def run_pipeline(cfg, year: int = YEAR, n_workers: int | None = None, rss_interv
     from vipvflow.simulation.run import run_simulation
 
     log: list[str] = []
-    with PeakRSS(interval_s=rss_interval_s) as mem:
+    with PeakRSS(interval_s=rss_interval_s, pss=pss) as mem:
         cpu0, children0 = time.process_time(), _children_cpu()
         t0 = time.perf_counter()
         run_dir = run_simulation(cfg, year, scheduler=scheduler, n_workers=n_workers,
@@ -189,6 +210,8 @@ def run_pipeline(cfg, year: int = YEAR, n_workers: int | None = None, rss_interv
         cpu, children = time.process_time() - cpu0, _children_cpu() - children0
     manifest = json.loads((run_dir / "manifest.json").read_text())
     return {"wall_s": wall, "peak_rss_mb": mem.peak_mb, "peak_rss_main_mb": mem.peak_self_mb,
+            "peak_pss_mb": mem.peak_pss_mb if pss else None,
+            "peak_rss_by_process_mb": sorted((round(v) for v in mem.by_pid.values()), reverse=True),
             "cpu_s_command": cpu, "cpu_s_workers": children,
             "run_dir": run_dir, "manifest": manifest, "log": log}
 
