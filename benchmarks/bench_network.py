@@ -280,6 +280,7 @@ def _result(r: dict, counts: dict, days: list, period: str, scheduler, extra: di
         "peak_rss_gb": round(r["peak_rss_mb"] / 1024, 3),
         "peak_pss_gb": round(r["peak_pss_mb"] / 1024, 3) if r.get("peak_pss_mb") else None,
         "peak_rss_by_process_mb": r.get("peak_rss_by_process_mb"),
+        "peak_rss_main_gb": round(r["peak_rss_main_mb"] / 1024, 3),
         "partition_bytes_per_pass": extra["partition_bytes_per_pass"],
         "gtfs_ingest_s": extra["gtfs_ingest_s"],
     }

@@ -366,3 +366,40 @@ def test_harvest_chooses_the_standing_work(small_run, small_config, tmp_path, ha
     bd = pd.read_parquet(timeline_dir(tmp_path) / "block_days.parquet")
     assert (bd["window_end_utc"] - bd["window_start_utc"]
             == bd["driving_s"] + bd["layover_s"] + bd["parked_s"]).all()
+
+
+def test_a_large_timeline_is_cut_in_a_process_of_its_own(small_run, small_config, tmp_path, monkeypatch):
+    """Above TIMELINE_PROCESS_TRIP_DAYS the timeline is written by a spawned child (its
+    memory leaves with it): the same tables and tiles as in the command's own process, and
+    an error in the child is the command's error, message and type."""
+    import multiprocessing
+    import shutil
+    from pathlib import Path
+
+    from vipvflow.config import load_config
+    from vipvflow.simulation import standing
+
+    cfg = load_config(small_config)
+    here = standing.write_timeline(cfg, 2024, tmp_path / "here")
+    contexts = []
+    get_context = multiprocessing.get_context
+
+    def recording(method=None):
+        contexts.append(method)
+        return get_context(method)
+
+    monkeypatch.setattr(multiprocessing, "get_context", recording)
+    monkeypatch.setattr(standing, "TIMELINE_PROCESS_TRIP_DAYS", 0)
+    there = standing.write_timeline(cfg, 2024, tmp_path / "child")
+    assert contexts == ["spawn"]
+    assert here == there and here
+    for name in ("block_days", "intervals", "points", "trip_runs"):
+        pd.testing.assert_frame_equal(pd.read_parquet(standing.timeline_dir(tmp_path / "here") / f"{name}.parquet"),
+                                      pd.read_parquet(standing.timeline_dir(tmp_path / "child") / f"{name}.parquet"))
+    # a data dir whose feed lacks its pattern stops: the child's error, raised here
+    broken = tmp_path / "data" / "gtfs"
+    broken.mkdir(parents=True)
+    shutil.copy(Path(cfg.data_dir) / "gtfs" / "trips.parquet", broken / "trips.parquet")
+    bad = load_config(small_config, overrides={"data_dir": str(tmp_path / "data")})
+    with pytest.raises(FileNotFoundError, match="pattern_stops"):
+        standing.write_timeline(bad, 2024, tmp_path / "bad")

@@ -200,31 +200,67 @@ def depot_point(cfg, data_dir) -> tuple | None:
     return float(x), float(y), float(seg["z"].to_numpy()[near]), tile
 
 
+#: trip-days (trips in the feed x days of the run's months) from which the timeline is cut
+#: in a process of its own: its tables (~1 GB per million trip-days at their peak) then
+#: leave the command's memory with it, instead of staying with the command for the run
+#: (a 200-line network year: 3.4 GB at the peak, 1.5 GB kept after the tables were freed)
+TIMELINE_PROCESS_TRIP_DAYS = 300_000
+
+
 def write_timeline(cfg, year: int, run_dir, routes=None) -> list[tuple[str, str]]:
     """Cut the run's block-days into driving, layover and parked time
     (:func:`vipvflow.inputs.gtfs.schedule.block_timeline`), keep the kinds ``fleet.harvest``
     counts, write ``parts/timeline/{block_days,intervals,points,trip_runs}.parquet`` once per
-    run and return the tiles that have standing intervals (one ``standing`` task each)."""
-    from ..inputs.gtfs.schedule import block_timeline
+    run and return the tiles that have standing intervals (one ``standing`` task each).
 
+    A large timeline (:data:`TIMELINE_PROCESS_TRIP_DAYS`) is written by a child process
+    (spawned: the caller's threads stay out of it), its error raised here as it is."""
     run = RunDir(run_dir)
     if not run.timeline_table("points").exists():
-        tl = block_timeline(cfg.data_dir, year, months=cfg.run.months, routes=routes,
-                            depot=depot_point(cfg, cfg.data_dir), depot_shading=cfg.fleet.depot_shading)
-        iv = tl["intervals"]
-        # every interval, for the battery's balance (layover times, auxiliaries, chargers);
-        # the roof's light only of those fleet.harvest counts
-        harvest = {"whole_day": ("layover", "parked"), "in_service": ("layover",),
-                   "driving": ()}[cfg.fleet.harvest]
-        iv = iv.assign(harvested=iv["kind"].astype(str).isin(harvest))
-        write_parquet(tl["block_days"].reset_index(drop=True), run.timeline_table("block_days"))
-        write_parquet(iv.astype({"kind": str}).reset_index(drop=True), run.timeline_table("intervals"))
-        write_parquet(tl["trip_runs"], run.timeline_table("trip_runs"))
-        write_parquet(tl["points"].astype({"stop_id": str, "tile": str, "shading": str}),
-                      run.timeline_table("points"))
+        if _trip_days(cfg) >= TIMELINE_PROCESS_TRIP_DAYS:
+            import multiprocessing
+            from concurrent.futures import ProcessPoolExecutor
+
+            with ProcessPoolExecutor(1, mp_context=multiprocessing.get_context("spawn")) as pool:
+                pool.submit(_write_timeline_tables, cfg, year, str(run_dir), routes).result()
+        else:
+            _write_timeline_tables(cfg, year, run_dir, routes)
     iv = harvested_intervals(run, columns=["point_id"])
     tiles = pd.read_parquet(run.timeline_table("points")).set_index("point_id")["tile"]
     return sorted(set(tiles.reindex(iv["point_id"].unique()).astype(str)))
+
+
+def _trip_days(cfg) -> int:
+    """Trips in the ingested feed times the days of the run's months (an upper bound of the
+    trip-days, from the Parquet footer alone)."""
+    import pyarrow.parquet as pq
+
+    path = DataDir(cfg.data_dir).gtfs.trips
+    try:
+        trips = pq.ParquetFile(path).metadata.num_rows
+    except OSError:
+        return 0
+    return int(trips * 31 * len(cfg.run.months))
+
+
+def _write_timeline_tables(cfg, year: int, run_dir, routes=None) -> None:
+    """:func:`write_timeline`'s tables (in whichever process calls it)."""
+    from ..inputs.gtfs.schedule import block_timeline
+
+    run = RunDir(run_dir)
+    tl = block_timeline(cfg.data_dir, year, months=cfg.run.months, routes=routes,
+                        depot=depot_point(cfg, cfg.data_dir), depot_shading=cfg.fleet.depot_shading)
+    iv = tl["intervals"]
+    # every interval, for the battery's balance (layover times, auxiliaries, chargers);
+    # the roof's light only of those fleet.harvest counts
+    harvest = {"whole_day": ("layover", "parked"), "in_service": ("layover",),
+               "driving": ()}[cfg.fleet.harvest]
+    iv = iv.assign(harvested=iv["kind"].astype(str).isin(harvest))
+    write_parquet(tl["block_days"].reset_index(drop=True), run.timeline_table("block_days"))
+    write_parquet(iv.astype({"kind": str}).reset_index(drop=True), run.timeline_table("intervals"))
+    write_parquet(tl["trip_runs"], run.timeline_table("trip_runs"))
+    write_parquet(tl["points"].astype({"stop_id": str, "tile": str, "shading": str}),
+                  run.timeline_table("points"))
 
 
 def harvested_intervals(run: RunDir, columns=None) -> pd.DataFrame:
