@@ -201,7 +201,7 @@ def depot_point(cfg, data_dir) -> tuple | None:
 
 
 #: trip-days (trips in the feed x days of the run's months) from which the timeline is cut
-#: in a process of its own: its tables (~1 GB per million trip-days at their peak) then
+#: in a process of its own: its tables (~0.7 GB per million trip-days at their peak) then
 #: leave the command's memory with it, instead of staying with the command for the run
 #: (a 200-line network year: 3.4 GB at the peak, 1.5 GB kept after the tables were freed)
 TIMELINE_PROCESS_TRIP_DAYS = 300_000
