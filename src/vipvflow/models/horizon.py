@@ -16,6 +16,10 @@ sampled azimuths it is interpolated linearly.
 
 The same description of terrain shading is used by GRASS GIS ``r.horizon`` / ``r.sun``
 (horizon angle per azimuth direction; the sun shines when above it).
+
+The run's kernel uses a bound instead of the profile: :func:`building_masks` gives per roof
+point and 1 deg sector a slope above which no triangle can be met (conservative, so a sun
+ray above it is clear exactly, without a ray; :mod:`vipvflow.models.passkernel`).
 """
 from __future__ import annotations
 
@@ -230,7 +234,7 @@ def building_masks(tri, top, box, o, reach, floor_, out):
 
     A triangle's bound is its highest corner over its least horizontal distance from the
     origin, over the azimuths it covers (its corners' shortest arc and a sector more each
-    side); one seen across more than a few sectors is split in four (to a depth of 5), so a
+    side); one seen across more than a few sectors is split in four (to a depth of 3), so a
     long wall or roof counts its near part high and its far parts lower.  The margins (1 mm,
     0.1 % and 1e-4) keep the bound safe for float32 rays: where a ray's slope exceeds it,
     neither an exact test nor Embree finds a hit."""

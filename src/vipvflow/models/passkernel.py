@@ -7,8 +7,9 @@ call:
 
 1. :func:`_setup` looks up the radiation and the sun at each pass's time (linear in time,
    the :meth:`vipvflow.models.sun_sky.RadiationTable.lookup` arithmetic), skips dark passes, and
-   writes the pass's rays (the roof point towards the sun, one per reflector facing it)
-   straight into the ray batch;
+   writes the pass's rays (the roof point towards the sun, unless the segment's sun mask
+   among the buildings tells it clear; one per reflector facing it) straight into the
+   ray batch;
 2. Embree answers the batch (:meth:`vipvflow.models.shading.Scene.occluded_local`);
 3. with the Perez sky, :func:`_sky_terms` sums each segment's sky (and what the crowns take
    from it) over every sky step the chunk spans (:func:`_sky_grid`) and gives each pass its own;
@@ -105,10 +106,11 @@ def _setup(lo, hi, seg, t_start, dt, mid, row, loc_of_row, packed, cols, t0, ste
     ``pass_ray[i + 1] - pass_ray[i]`` rays: its direct ray first when the sun is in front of
     the roof and the segment's sun mask among the buildings *bmask* cannot tell it clear
     (``free[i]`` True where it can: no ray), then per reflector pair one ray, or P with
-    ``rotate`` False), ``done[i]`` False for a dark pass (every component 0).  ``pair_w`` / ``pair_pass``: per pair its
-    beam weight and pass (chunk index), ``pair_pt`` its (first) sample point's flat index
-    (reflector x P + point).  ``rad[c, _CLS]``: the crowns' class of the pass's
-    month (*tree_month*, per geometry row; *wn* per row and class).  Returns (rays, pairs).
+    ``rotate`` False), ``done[i]`` False for a dark pass (every component 0).
+    ``pair_w`` / ``pair_pass``: per pair its beam weight and pass (chunk index),
+    ``pair_pt`` its (first) sample point's flat index (reflector x P + point).
+    ``rad[c, _CLS]``: the crowns' class of the pass's month (*tree_month*, per geometry
+    row; *wn* per row and class).  Returns (rays, pairs).
     """
     n_t = packed.shape[1]
     J = wn.shape[2]
@@ -454,8 +456,8 @@ def _visibility(c, r, pass_ray, pair_w, pair_pass, pair_pt, gf, q, occ, cos_aoi,
 
 @njit(cache=True, nogil=True)
 def _finish(lo, hi, row, rad, cos_aoi, pass_ray, pair_w, pair_pass, pair_pt, gf, occ, done,
-            free, p_local, sky, sky_nt, iso, refl_sky, refl_ghi, perez, hbv, hbv_nt, refl_hor, sin_tilt, has_sky,
-            terms, rotate, P, o, d, tmax, tr, smask, to_bins, block, visible_out, dt, seg_hour,
+            free, p_local, sky, sky_nt, iso, refl_sky, refl_ghi, perez, hbv, hbv_nt, refl_hor,
+            sin_tilt, has_sky, terms, rotate, P, o, d, tmax, tr, smask, to_bins, block, visible_out, dt, seg_hour,
             run, seg_bins, run_bins):
     """Components of passes ``lo..hi``: into columns of *block* (14, n) and *visible_out*,
     or, with *to_bins*, as irradiation (Wh/m2) added into ``seg_bins[seg_hour[i]]`` and
