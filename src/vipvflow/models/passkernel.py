@@ -117,6 +117,7 @@ def _setup(lo, hi, seg, t_start, dt, mid, row, loc_of_row, packed, cols, t0, ste
     P = gp_local.shape[1]
     nr = 0
     npair = 0
+    last_day, month = np.nan, np.int64(0)
     for i in range(lo, hi):
         c = i - lo
         pass_ray[c] = nr
@@ -148,7 +149,10 @@ def _setup(lo, hi, seg, t_start, dt, mid, row, loc_of_row, packed, cols, t0, ste
         if dark:
             continue
         done[c] = True
-        cls = tree_month[r, month0(t)]
+        day = np.floor(t / 86400.0)
+        if day != last_day:      # the month of the day before (passes come in days)
+            last_day, month = day, month0(t)
+        cls = tree_month[r, month]
         rad[c, _CLS] = np.float32(cls)
         if sky_rows.shape[1]:
             # the Perez sky tables' row nearest the pass (RadiationTable.sky_steps)
@@ -393,91 +397,108 @@ def _may_cross(smask, r, dx, dy, dz):
     return not np.float64(dz) / h > smask[r, mask_sector(np.float64(dx), np.float64(dy))]
 
 
-@njit(cache=True, nogil=True, inline="always")
-def _visibility(c, r, pass_ray, pair_w, pair_pass, pair_pt, gf, q, occ, cos_aoi, free, rad,
-                p_local, rotate, P, o, d, tmax, cls, tr, smask, hits):
-    """Whether the pass's sun ray misses the buildings, its transmittance (0, else the
-    crowns' along it in class *cls*; 1 without a walk where segment row *r*'s sun mask
-    *smask* rules the crowns out), its reflectors' beam sum ``sum weight x lit``
-    (float64 like the reference's bincount, then float32; a sample point's ray lit in the
-    crowns' transmittance, times the point's factor through the crowns *gf*), and the next
-    pair.  A pass whose sun mask among the buildings told its sun ray clear (*free*) has no
-    ray of its own: it starts at the roof point (*p_local*) towards the sun (*rad*)."""
+@njit(cache=True, nogil=True)
+def _visibility(lo, hi, row, pass_ray, pair_w, pair_pt, gf, occ, done, cos_aoi, free, rad,
+                p_local, rotate, P, o, d, tmax, tr, smask, visible, vis_t, beam_sum):
+    """Per pass ``lo..hi`` (chunk index): whether its sun ray misses the buildings
+    (*visible*), its transmittance (*vis_t*: 0, else the crowns' along it in the pass's
+    class; 1 without a walk where segment row's sun mask *smask* rules the crowns out) and
+    its reflectors' beam sum ``sum weight x lit`` (*beam_sum*: float64 like the reference's
+    bincount, then float32; a sample point's ray lit in the crowns' transmittance, times
+    the point's factor through the crowns *gf*).  A pass whose sun mask among the buildings
+    told its sun ray clear (*free*) has no ray of its own: it starts at the roof point
+    (*p_local*) towards the sun (*rad*).
+
+    One loop over the chunk with the crowns' arrays (*tr*) taken apart once: a per-pass
+    helper holding them costs the kernel a third of its time (numba's reference counts)."""
     cx, cy, cz, ia2, ic2, meta, start, items, tau = tr
     trees = items.shape[0] > 0
-    r0, r1 = pass_ray[c], pass_ray[c + 1]
-    visible = False
-    vis_t = np.float32(0.0)
-    if cos_aoi[c] > 0:
-        if free[c]:
-            visible = True
-            ox, oy, oz = p_local[r, 0], p_local[r, 1], p_local[r, 2]
-            dx, dy, dz = rad[c, 6], rad[c, 7], rad[c, 8]
-        else:
-            visible = not occ[r0]
-            ox, oy, oz = o[r0, 0], o[r0, 1], o[r0, 2]
-            dx, dy, dz = d[r0, 0], d[r0, 1], d[r0, 2]
-            r0 += 1
-        if visible:
-            vis_t = np.float32(1.0)
-            # the crowns' walk only where the segment's sun mask cannot rule them out
-            if trees and _may_cross(smask, r, dx, dy, dz):
-                vis_t = transmit_one(ox, oy, oz, dx, dy, dz, tmax, cls, cx, cy, cz, ia2, ic2,
-                                     meta, start, items, tau, hits)
-    acc = 0.0
-    while r0 < r1:
-        if rotate:
-            t = np.float32(0.0)
-            if not occ[r0]:
-                t = np.float32(1.0)
-                if trees:
-                    t = transmit_one(o[r0, 0], o[r0, 1], o[r0, 2], d[r0, 0], d[r0, 1], d[r0, 2],
-                                     tmax, cls, cx, cy, cz, ia2, ic2, meta, start, items, tau, hits)
-            t = t * gf[pair_pt[q], cls]
-            acc += np.float64(pair_w[q] * t)
-            r0 += 1
-        else:
-            tsum = 0.0
-            for k in range(P):
-                if not occ[r0 + k]:
+    hits = np.empty(_MAX_HITS, np.int64)
+    q = 0
+    for i in range(lo, hi):
+        c = i - lo
+        visible[c] = False
+        vis_t[c] = np.float32(0.0)
+        beam_sum[c] = np.float32(0.0)
+        if not done[c]:
+            continue
+        cls = np.int64(rad[c, _CLS])
+        r = row[i]
+        r0, r1 = pass_ray[c], pass_ray[c + 1]
+        if cos_aoi[c] > 0:
+            if free[c]:
+                seen = True
+                ox, oy, oz = p_local[r, 0], p_local[r, 1], p_local[r, 2]
+                dx, dy, dz = rad[c, 6], rad[c, 7], rad[c, 8]
+            else:
+                seen = not occ[r0]
+                ox, oy, oz = o[r0, 0], o[r0, 1], o[r0, 2]
+                dx, dy, dz = d[r0, 0], d[r0, 1], d[r0, 2]
+                r0 += 1
+            if seen:
+                visible[c] = True
+                t_sun = np.float32(1.0)
+                # the crowns' walk only where the segment's sun mask cannot rule them out
+                if trees and _may_cross(smask, r, dx, dy, dz):
+                    t_sun = transmit_one(ox, oy, oz, dx, dy, dz, tmax, cls, cx, cy, cz, ia2,
+                                         ic2, meta, start, items, tau, hits)
+                vis_t[c] = t_sun
+        acc = 0.0
+        while r0 < r1:
+            if rotate:
+                t = np.float32(0.0)
+                if not occ[r0]:
                     t = np.float32(1.0)
                     if trees:
-                        i = r0 + k
-                        t = transmit_one(o[i, 0], o[i, 1], o[i, 2], d[i, 0], d[i, 1], d[i, 2],
-                                         tmax, cls, cx, cy, cz, ia2, ic2, meta, start, items,
-                                         tau, hits)
-                    tsum += np.float64(t * gf[pair_pt[q] + k, cls])
-            share = tsum * np.float64(np.float32(1.0 / P))
-            acc += np.float64(pair_w[q]) * share
-            r0 += P
-        q += 1
-    return visible, vis_t, np.float32(acc), q
+                        t = transmit_one(o[r0, 0], o[r0, 1], o[r0, 2], d[r0, 0], d[r0, 1],
+                                         d[r0, 2], tmax, cls, cx, cy, cz, ia2, ic2, meta, start,
+                                         items, tau, hits)
+                t = t * gf[pair_pt[q], cls]
+                acc += np.float64(pair_w[q] * t)
+                r0 += 1
+            else:
+                tsum = 0.0
+                for k in range(P):
+                    if not occ[r0 + k]:
+                        t = np.float32(1.0)
+                        if trees:
+                            j = r0 + k
+                            t = transmit_one(o[j, 0], o[j, 1], o[j, 2], d[j, 0], d[j, 1],
+                                             d[j, 2], tmax, cls, cx, cy, cz, ia2, ic2, meta,
+                                             start, items, tau, hits)
+                        tsum += np.float64(t * gf[pair_pt[q] + k, cls])
+                share = tsum * np.float64(np.float32(1.0 / P))
+                acc += np.float64(pair_w[q]) * share
+                r0 += P
+            q += 1
+        beam_sum[c] = np.float32(acc)
 
 
 @njit(cache=True, nogil=True)
 def _finish(lo, hi, row, rad, cos_aoi, pass_ray, pair_w, pair_pass, pair_pt, gf, occ, done,
             free, p_local, sky, sky_nt, iso, refl_sky, refl_ghi, perez, hbv, hbv_nt, refl_hor,
-            sin_tilt, has_sky, terms, rotate, P, o, d, tmax, tr, smask, to_bins, block, visible_out, dt, seg_hour,
-            run, seg_bins, run_bins):
+            sin_tilt, has_sky, terms, rotate, P, o, d, tmax, tr, smask, to_bins, block,
+            visible_out, dt, seg_hour, run, seg_bins, run_bins):
     """Components of passes ``lo..hi``: into columns of *block* (14, n) and *visible_out*,
     or, with *to_bins*, as irradiation (Wh/m2) added into ``seg_bins[seg_hour[i]]`` and
     ``run_bins[run[i]]`` ((bins, 14) float64, :data:`BLOCK_COLUMNS`); the other side's
     arrays are not touched (empty ones will do).  *o*, *d*: the chunk's rays (the crowns
-    along those the buildings let through, *tr*: :meth:`vipvflow.models.trees.Crowns.arrays`)."""
+    along those the buildings let through, *tr*: :meth:`vipvflow.models.trees.Crowns.arrays`).
+    The rays' answers first (:func:`_visibility`), then the arithmetic in a loop of its own."""
+    m = hi - lo
+    visible = np.empty(m, np.bool_)
+    vis_t = np.empty(m, np.float32)
+    beam_sum = np.empty(m, np.float32)
+    _visibility(lo, hi, row, pass_ray, pair_w, pair_pt, gf, occ, done, cos_aoi, free, rad,
+                p_local, rotate, P, o, d, tmax, tr, smask, visible, vis_t, beam_sum)
     out = np.empty(_NB, np.float32)
-    hits = np.empty(_MAX_HITS, np.int64)
-    q = 0
     for i in range(lo, hi):
         c = i - lo
         if not done[c]:
             continue
-        cls = np.int64(rad[c, _CLS])
-        visible, vis_t, beam_sum, q = _visibility(c, row[i], pass_ray, pair_w, pair_pass, pair_pt,
-                                                  gf, q, occ, cos_aoi, free, rad, p_local, rotate,
-                                                  P, o, d, tmax, cls, tr, smask, hits)
-        _components(c, row[i], rad, cos_aoi, vis_t, visible, beam_sum, sky, sky_nt, iso,
-                    refl_sky, refl_ghi, perez, hbv, hbv_nt, refl_hor, sin_tilt, has_sky, terms,
-                    out)
+        _components(c, row[i], rad, cos_aoi, vis_t[c], visible[c], beam_sum[c], sky, sky_nt,
+                    iso, refl_sky, refl_ghi, perez, hbv, hbv_nt, refl_hor, sin_tilt, has_sky,
+                    terms, out)
         if to_bins:
             w = dt[i] / 3600.0
             b, k = seg_hour[i], run[i]
@@ -488,7 +509,7 @@ def _finish(lo, hi, row, rad, cos_aoi, pass_ray, pair_w, pair_pass, pair_pt, gf,
         else:
             for j in range(_NB):
                 block[j, i] = out[j]
-            visible_out[i] = visible
+            visible_out[i] = visible[c]
 
 
 #: empty stand-ins for the side of :func:`_finish` a call does not fill
