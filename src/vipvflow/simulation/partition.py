@@ -78,7 +78,25 @@ def _segments(data_dir: str) -> pd.DataFrame:
 def _radiation(data_dir: str, year: int):
     from ..models.sun_sky import RadiationTable
 
-    return RadiationTable.load(data_dir, year)
+    table = RadiationTable.load(data_dir, year)
+    hand_back_memory()          # the load's temporaries: ~150 MB of a year's table per minute
+    return table
+
+
+def hand_back_memory() -> None:
+    """Hand the memory this process has freed back to the operating system: Arrow's pool
+    (mimalloc keeps what a Parquet read freed) and glibc's heap.  A few ms; called after
+    the radiation table's load and after each tile task, it keeps a worker's memory at what
+    it holds."""
+    import pyarrow as pa
+
+    pa.default_memory_pool().release_unused()
+    try:
+        import ctypes
+
+        ctypes.CDLL("libc.so.6").malloc_trim(0)
+    except (OSError, AttributeError):      # not glibc
+        pass
 
 
 def _scene(ctx: RunContext, tile: str):
@@ -203,7 +221,9 @@ def tile_task(ctx: RunContext, tile: str, months: list[str],
     LocalCluster) handles 12 times fewer tasks: the line-year's 492 partitions as 41 tasks
     took ~2 s of a core off the command's process."""
     frame = geometry.frame if geometry is not None else tile_geometry(ctx, tile)
-    return [run_partition(ctx, tile, month, frame) for month in months]
+    done = [run_partition(ctx, tile, month, frame) for month in months]
+    hand_back_memory()
+    return done
 
 
 def pv_energy_kwh(poa_wm2: np.ndarray, dt_s: np.ndarray, speed_mps: np.ndarray, month: int,
@@ -570,8 +590,6 @@ def release_memory() -> None:
     memory while the client joined the fleet's tables."""
     import gc
 
-    import pyarrow as pa
-
     from ..inputs.gtfs import schedule
     from ..models import shading
 
@@ -581,13 +599,7 @@ def release_memory() -> None:
     _radiation.cache_clear()
     schedule.clear_caches()
     gc.collect()
-    pa.default_memory_pool().release_unused()
-    try:
-        import ctypes
-
-        ctypes.CDLL("libc.so.6").malloc_trim(0)
-    except (OSError, AttributeError):      # not glibc
-        pass
+    hand_back_memory()
 
 
 def worker_bvh_builds(release: bool = False) -> dict:
