@@ -107,6 +107,41 @@ def test_layover_beside_tall_wall_analytic_shadow_and_sky_view_factor():
     assert res["h_diffuse"].sum() == pytest.approx(svf * dhi_wh.sum(), rel=0.02)
 
 
+def test_layovers_apart_take_only_their_own_minutes():
+    """Intervals hours apart at one point (only the minutes they cover go through the
+    kernel) give each what it gives alone; pieces that touch (at a minute's end or inside
+    one) add up to the whole; the minutes between take nothing."""
+    day = "2024-06-10"
+    table, *_ = _clear_day_table(day, cloud=0.2)
+    scene = Scene(box_mesh([[12.0, -LONG, 0.0, 13.0, LONG, 20.0]]))       # a wall east
+    cfg = IrradianceCfg(diffuse_model="sky_view_factor", svf_rays=256)
+    geom = point_geometry(scene, _point(), cfg)
+    base = pd.Timestamp(f"{day} 04:00", tz="UTC").timestamp()
+    pieces = [(base + 17.5, base + 600.0), (base + 600.0, base + 905.25),      # touching
+              (base + 4 * 3600 + 30.0, base + 4 * 3600 + 1230.0),              # hours later
+              (base + 9 * 3600 - 12.0, base + 9 * 3600 + 48.0)]                # within a minute or two
+    iv = pd.DataFrame({"point_id": 0, "t0_utc": [a for a, _ in pieces], "t1_utc": [b for _, b in pieces]})
+    together = interval_integrals(iv, geom, table, scene, cfg, _energy)
+    for i, (a, b) in enumerate(pieces):
+        alone = interval_integrals(pd.DataFrame({"point_id": [0], "t0_utc": [a], "t1_utc": [b]}),
+                                   geom, table, scene, cfg, _energy)
+        for c in ("pv_kwh", "h_total", "h_direct", "h_diffuse", "seconds"):
+            assert together[c].iloc[i] == pytest.approx(alone[c].iloc[0], rel=1e-12, abs=1e-15), (i, c)
+    assert (together["h_total"] > 0).all()
+    whole = interval_integrals(pd.DataFrame({"point_id": [0], "t0_utc": [pieces[0][0]],
+                                             "t1_utc": [pieces[1][1]]}), geom, table, scene, cfg, _energy)
+    assert together["pv_kwh"].iloc[:2].sum() == pytest.approx(whole["pv_kwh"].iloc[0], rel=1e-12)
+    # the same pieces by hand, minute by minute: each minute's value times its covered share
+    minutes = np.arange(base, base + 9 * 3600 + 60.0, 60.0)
+    from vipvflow.models.irradiance import evaluate_passes
+
+    irr = evaluate_passes(pd.DataFrame({"segment_id": 0, "t_utc": minutes, "dt_s": np.float32(60.0)}),
+                          None, geom, table, scene, cfg, time_at="mid")["total"].to_numpy(np.float64)
+    for i, (a, b) in enumerate(pieces):
+        share = np.clip(np.minimum(minutes + 60.0, b) - np.maximum(minutes, a), 0.0, None)
+        assert together["h_total"].iloc[i] == pytest.approx(float((irr * share).sum() / 3600.0), rel=1e-9)
+
+
 def _gtfs(folder):
     """A small feed in Luxembourg: one line A - B - C, block B1 of three trips, the last one
     past midnight (24:10 - 24:40), every day of 2024."""

@@ -4,11 +4,11 @@ A standing roof is a fixed point, so it goes through the same irradiance kernel 
 segment: its geometry factors (sky view factor, reflector groups) once per point with
 :func:`vipvflow.models.view_factors.segment_geometry` (a flat roof: no gradient), then
 :func:`vipvflow.models.irradiance.evaluate_passes` at the middle of every minute the point's
-intervals span (the radiation table's own grid: CAMS minute means at minute centres).  The
-minute values are summed into a running total per point, and an interval ``[t0, t1)`` takes
-the difference of that total at its ends, interpolated within a minute: the exact integral
-of the minute-constant irradiance, whatever the interval's length, so splitting a span into
-intervals never changes its sum.
+intervals cover, and of no other (the radiation table's own grid: CAMS minute means at minute
+centres).  The minute values are summed into a running total per point, and an interval
+``[t0, t1)`` takes the difference of that total at its ends, interpolated within a minute:
+the exact integral of the minute-constant irradiance, whatever the interval's length, so
+splitting a span into intervals never changes its sum.
 
 ``depot_shading``: ``city`` points are evaluated in their tile's city model, ``open`` points
 in an empty scene (no shade, no reflection: the roof of a bus in an open field, so the
@@ -91,17 +91,22 @@ def interval_integrals(intervals: pd.DataFrame, geometry: pd.DataFrame, radiatio
     pid = intervals["point_id"].to_numpy(np.int64)
     t0 = intervals["t0_utc"].to_numpy(float)
     t1 = intervals["t1_utc"].to_numpy(float)
+    names = list(PV_SOURCE) + [f"h_{c}" for c in H_COMPONENTS]
     for p in np.unique(pid):
         sel = np.flatnonzero(pid == p)
         lo = np.floor(t0[sel].min() / _MINUTE) * _MINUTE
-        hi = np.ceil(t1[sel].max() / _MINUTE) * _MINUTE
-        edges = np.arange(lo, hi + _MINUTE / 2, _MINUTE)
-        minutes = pd.DataFrame({"segment_id": np.full(len(edges) - 1, p, np.int64),
-                                "t_utc": edges[:-1], "dt_s": np.full(len(edges) - 1, _MINUTE, np.float32)})
+        # the minutes the point's intervals cover, and only those, through the kernel
+        first = np.floor((t0[sel] - lo) / _MINUTE).astype(np.int64)
+        end = np.ceil((t1[sel] - lo) / _MINUTE).astype(np.int64)
+        span = int(end.max()) + 1
+        depth = np.cumsum(np.bincount(first, minlength=span) - np.bincount(end, minlength=span))
+        minute = np.flatnonzero(depth[:-1] > 0)
+        minutes = pd.DataFrame({"segment_id": np.full(len(minute), p, np.int64),
+                                "t_utc": lo + minute * _MINUTE,
+                                "dt_s": np.full(len(minute), _MINUTE, np.float32)})
         irr = evaluate_passes(minutes, None, geometry, radiation, scene, cfg,
                               ground_albedo=ground_albedo, time_at="mid")
         dt = minutes["dt_s"].to_numpy(np.float64)
-        names = list(PV_SOURCE) + [f"h_{c}" for c in H_COMPONENTS]
         per_minute = np.empty((len(names), len(dt) + 1))      # running totals from 0
         per_minute[:, 0] = 0.0
         for j, comp in enumerate(PV_SOURCE.values()):
@@ -110,10 +115,16 @@ def interval_integrals(intervals: pd.DataFrame, geometry: pd.DataFrame, radiatio
             per_minute[j, 1:] = irr[c].to_numpy(np.float64) * dt / 3600.0
         total = np.cumsum(per_minute, axis=1)
 
-        def at(t):      # the running totals at times t, linear within a minute
-            f = np.clip((t - lo) / _MINUTE, 0, len(dt))
-            i = np.minimum(f.astype(np.int64), len(dt) - 1)
-            return total[:, i] + (f - i) * (total[:, i + 1] - total[:, i])
+        def at(t):
+            # the running totals at times t: those of the covered minutes before t's minute,
+            # and t's share of its own (linear within a minute); t lies in a covered
+            # minute or at the end of one
+            f = np.maximum((t - lo) / _MINUTE, 0.0)
+            i = np.floor(f).astype(np.int64)
+            k = np.searchsorted(minute, i)
+            own = (k < len(minute)) & (minute[np.minimum(k, len(minute) - 1)] == i)
+            kk = np.minimum(k, len(minute) - 1)
+            return total[:, k] + np.where(own, f - i, 0.0) * (total[:, kk + 1] - total[:, kk])
 
         sums = at(t1[sel]) - at(t0[sel])
         for j, name in enumerate(names):
