@@ -214,15 +214,40 @@ SKY_GRID_BUDGET = 8 << 20
 
 
 @njit(cache=True, nogil=True)
-def _sky_grid(TT, s0, r, sky_cell, sky_f, sky_t, sky_tilted, nrm, ts, cls_used, g):
+def _level_differences(TT, s0, m, ts, segs, n_used, DT):
+    """Into ``DT[b]`` the packed sky tables' difference between a cell and the cell one
+    level up (``TT[b] - TT[b + SKY_PACK]``, float32) at steps ``s0 .. s0 + m``, for the rows
+    *b* of the cells the crowns of the segments *segs* take sky from (:func:`_sky_grid`):
+    each made once a chunk rather than once per segment and crown cell; the same float32
+    values, so the sums are unchanged bit for bit."""
+    off, cell = ts[0], ts[1]
+    made = np.zeros(DT.shape[0] // SKY_PACK, np.bool_)
+    for q in range(n_used):
+        r = segs[q]
+        for e in range(off[r], off[r + 1]):
+            k = cell[e]
+            if made[k]:
+                continue
+            made[k] = True
+            b = SKY_PACK * k
+            for u in range(SKY_PACK):
+                lo_row, hi_row, out = TT[b + u, s0:s0 + m], TT[b + SKY_PACK + u, s0:s0 + m], DT[b + u]
+                for i in range(m):
+                    out[i] = lo_row[i] - hi_row[i]
+
+
+@njit(cache=True, nogil=True)
+def _sky_grid(TT, s0, r, sky_cell, sky_f, sky_t, sky_tilted, nrm, ts, cls_used, DT, g):
     """Segment row *r*'s Perez sky at sky steps ``s0 .. s0 + m`` (*TT*: the packed tables,
     :func:`vipvflow.models.sky.pack_sky`) into *g* (2 + 2 C, m) float32: row 0 its share of
     DHI all-sky, row 1 clear-sky (per sector its cell, interpolation weight and tilt
     weight, summed in sector order: :func:`vipvflow.models.sky.sky_share`), rows ``2 + 2 c``
     and ``3 + 2 c`` what the crowns of class *c* take from it (its sky cells with a loss,
     ``sum loss (n_z dG + t_k dH)`` cell by cell: :func:`vipvflow.models.sky.tree_share`),
-    for the classes in *cls_used*.  Each step's sum is the per-pass sum, term by term in the
-    same order; the steps side by side make every loop a run over contiguous memory."""
+    for the classes in *cls_used* (*DT*: the tables' level differences ``TT[b] - TT[b + 4]``
+    at the same steps, :func:`_level_differences`).  Each step's sum is the per-pass sum,
+    term by term in the same order; the steps side by side make every loop a run over
+    contiguous memory."""
     m = g.shape[1]
     for q in range(g.shape[0]):
         for i in range(m):
@@ -253,13 +278,10 @@ def _sky_grid(TT, s0, r, sky_cell, sky_f, sky_t, sky_tilted, nrm, ts, cls_used, 
         for e in range(off[r], off[r + 1]):
             b = SKY_PACK * cell[e]
             tk, we = sky_t[r, sector[e]], w[e, q]
-            ga0, ga1 = TT[b, s0:e1], TT[b + SKY_PACK, s0:e1]
-            ha0, ha1 = TT[b + 1, s0:e1], TT[b + SKY_PACK + 1, s0:e1]
-            gc0, gc1 = TT[b + 2, s0:e1], TT[b + SKY_PACK + 2, s0:e1]
-            hc0, hc1 = TT[b + 3, s0:e1], TT[b + SKY_PACK + 3, s0:e1]
+            dga, dha, dgc, dhc = DT[b], DT[b + 1], DT[b + 2], DT[b + 3]
             for i in range(m):
-                la[i] += we * (nz * (ga0[i] - ga1[i]) + tk * (ha0[i] - ha1[i]))
-                lc[i] += we * (nz * (gc0[i] - gc1[i]) + tk * (hc0[i] - hc1[i]))
+                la[i] += we * (nz * dga[i] + tk * dha[i])
+                lc[i] += we * (nz * dgc[i] + tk * dhc[i])
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -364,11 +386,14 @@ def _sky_terms(lo, hi, row, rad, done, sky_cell, sky_f, sky_t, sky_tilted, TT, t
     rows = 2 + 2 * C
     per_block = max(np.int64(1), budget // (rows * m))
     g = np.empty((min(per_block, n_used), rows, m), np.float32)
+    DT = np.empty((TT.shape[0] if C else 0, m), np.float32)
+    if C:
+        _level_differences(TT, s_lo, m, ts, segs, n_used, DT)
     for b0 in range(0, n_used, per_block):
         b1 = min(n_used, b0 + per_block)
         for q in range(b0, b1):
             _sky_grid(TT, s_lo, segs[q], sky_cell, sky_f, sky_t, sky_tilted, nrm, ts, cls_used,
-                      g[q - b0])
+                      DT, g[q - b0])
         for i in range(lo, hi):
             c = i - lo
             if not done[c]:
