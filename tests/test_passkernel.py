@@ -142,6 +142,32 @@ def test_fused_equals_numpy_on_the_demo_passes(small_run, small_config):
     assert n_passes > 1000
 
 
+def test_a_tile_task_leaves_no_packed_geometry_no_task_can_find(small_run, small_config, tmp_path):
+    """A tile task that read its own geometry table drops that table's packed geometry when
+    it is done (no other task holds the table the cache keys it by); one handed the table
+    (a geometry task's result, shared by the tile's tasks) leaves it for the next."""
+    import shutil
+
+    from vipvflow.config import load_config
+    from vipvflow.simulation import partition as part
+
+    cfg = load_config(small_config)
+    run_dir = tmp_path / "run"
+    shutil.copytree(small_run / "parts" / "geometry", run_dir / "parts" / "geometry")
+    ctx = part.RunContext(data_dir=str(cfg.data_dir), run_dir=str(run_dir), year=2024,
+                          irradiance=IrradianceCfg(**cfg.irradiance.model_dump()).model_dump(),
+                          pv_system=cfg.pv_system().model_dump(), pv_mode="paper",
+                          monthly_temperature_c=(15.0,) * 12, wind_speed_mps=2.0,
+                          timezone="Europe/Luxembourg")
+    tiles = sorted(p.name[5:-8] for p in (run_dir / "parts" / "geometry").glob("tile=*.parquet"))
+    tile = next(t for t in tiles if part.tile_task(ctx, t, ["2024-06"])[0]["passes"])
+    assert (ctx.run_dir, tile) not in part._PACKED
+    shared = part.geometry_task(ctx, tile)
+    done = part.tile_task(ctx, tile, ["2024-06"], shared)
+    assert done[0]["passes"] and part._PACKED[(ctx.run_dir, tile)][0] is shared.frame
+    part._PACKED.clear()
+
+
 def test_block_columns_are_the_components():
     assert passkernel.BLOCK_COLUMNS == tuple(COMPONENTS) + ("ghi", "ghi_clear")
 

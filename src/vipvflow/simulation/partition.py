@@ -222,6 +222,12 @@ def tile_task(ctx: RunContext, tile: str, months: list[str],
     took ~2 s of a core off the command's process."""
     frame = geometry.frame if geometry is not None else tile_geometry(ctx, tile)
     done = [run_partition(ctx, tile, month, frame) for month in months]
+    if geometry is None:
+        # the packed geometry of a table made here: no other task can find it (the cache
+        # holds it for the table it was made from), ~70 MB a tile of a network
+        kept = _PACKED.get((ctx.run_dir, tile))
+        if kept is not None and kept[0] is frame:
+            del _PACKED[(ctx.run_dir, tile)]
     hand_back_memory()
     return done
 
