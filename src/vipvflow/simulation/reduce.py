@@ -630,8 +630,8 @@ def reduce_run(cfg: Config, year: int, run_dir: Path, say=print, client=None, cl
     placed = _placed_trips(run_dir, totals)
     n_buses = int(placed.groupby("service_date")["block_id"].nunique().max())
     # the segments first: the workers draw the maps while the trips are joined here
-    _, segments, sm = _segment_outputs(cfg, run_dir, parts["segment_month"], parts["geometry"],
-                                       totals, n_buses, trips_meta)
+    segments, sm = _segment_outputs(cfg, run_dir, parts["segment_month"], parts["geometry"],
+                                    totals, n_buses, trips_meta)
     report.add_maps(figures, run_dir, cfg)
     # beside the figures, from the files just written: city.glb and the GeoParquet datasets
     model = _Aside(client, "city-glb", gltf.write_gltf, str(run_dir),
@@ -732,8 +732,9 @@ def _segment_outputs(cfg: Config, run_dir: Path, sm: pd.DataFrame, geo: pd.DataF
                      totals: pd.DataFrame, n_buses: int, trips_meta: pd.DataFrame):
     """Per segment and month (GeoParquet for maps) and per segment over the run (geometry
     factors and year) of the shapes of the trips in *totals* (:func:`_trip_totals`) run by
-    *n_buses*; writes ``segment_month.parquet`` and ``segments.parquet``.  Returns both and
-    the segment-month sums."""
+    *n_buses*; writes ``segment_month.parquet`` and ``segments.parquet``.  Returns the
+    segments and the segment-month sums (not the per segment-month table with its
+    geometries: a network's is hundreds of MB the rest of the reduce does not need)."""
     from . import annual
 
     data_dir = Path(cfg.data_dir)
@@ -752,12 +753,13 @@ def _segment_outputs(cfg: Config, run_dir: Path, sm: pd.DataFrame, geo: pd.DataF
     smg = gpd.GeoDataFrame(smg.merge(shape_route, on="shape_id", how="left"),
                            geometry="geometry", crs=segments.crs)
     write_parquet(smg, RunDir(run_dir).output("segment_month.parquet"))
+    del smg
     hours_per_bus = annual.service_hours_per_bus(float(totals["seconds"].sum()), n_buses,
                                                  12.0 / len(cfg.run.months))
     segments = annual.segment_year(segments.merge(shape_route, on="shape_id", how="left"), geo, sm,
                                    cfg.pv_system().kwp, hours_per_bus)
     write_parquet(segments, RunDir(run_dir).output("segments.parquet"))
-    return smg, segments, sm
+    return segments, sm
 
 
 def shape_routes(trips: pd.DataFrame) -> pd.DataFrame:
