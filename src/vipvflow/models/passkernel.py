@@ -434,8 +434,9 @@ def _visibility(lo, hi, row, pass_ray, pair_w, pair_pt, gf, occ, done, cos_aoi, 
     told its sun ray clear (*free*) has no ray of its own: it starts at the roof point
     (*p_local*) towards the sun (*rad*).
 
-    One loop over the chunk with the crowns' arrays (*tr*) taken apart once: a per-pass
-    helper holding them costs the kernel a third of its time (numba's reference counts)."""
+    One loop over the chunk with the crowns' arrays (*tr*) taken apart once, before the
+    loop: the same loop calling an inlined per-pass helper that took them apart per pass
+    was ~4x slower (149 against 39 ns a pass on L1's June chunks)."""
     cx, cy, cz, ia2, ic2, meta, start, items, tau = tr
     trees = items.shape[0] > 0
     hits = np.empty(_MAX_HITS, np.int64)

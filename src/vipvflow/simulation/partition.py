@@ -79,7 +79,7 @@ def _radiation(data_dir: str, year: int):
     from ..models.sun_sky import RadiationTable
 
     table = RadiationTable.load(data_dir, year)
-    hand_back_memory()          # the load's temporaries: ~150 MB of a year's table per minute
+    hand_back_memory()          # the load's temporaries (Arrow's pool kept ~100 MB of them)
     return table
 
 
