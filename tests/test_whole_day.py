@@ -128,6 +128,14 @@ def test_layovers_apart_take_only_their_own_minutes():
         for c in ("pv_kwh", "h_total", "h_direct", "h_diffuse", "seconds"):
             assert together[c].iloc[i] == pytest.approx(alone[c].iloc[0], rel=1e-12, abs=1e-15), (i, c)
     assert (together["h_total"] > 0).all()
+    # an empty interval on a minute's edge takes nothing, alone (no minute to evaluate) or not
+    edge = base + 2 * 3600.0
+    empty = pd.DataFrame({"point_id": [0, 1, 1], "t0_utc": [edge, edge, pieces[0][0]],
+                          "t1_utc": [edge, edge, pieces[0][1]]})
+    res = interval_integrals(empty, pd.concat([geom, geom.assign(segment_id=1)], ignore_index=True),
+                             table, scene, cfg, _energy)
+    assert res["pv_kwh"].iloc[0] == 0.0 and res["pv_kwh"].iloc[1] == 0.0
+    assert res["pv_kwh"].iloc[2] == pytest.approx(together["pv_kwh"].iloc[0], rel=1e-12)
     whole = interval_integrals(pd.DataFrame({"point_id": [0], "t0_utc": [pieces[0][0]],
                                              "t1_utc": [pieces[1][1]]}), geom, table, scene, cfg, _energy)
     assert together["pv_kwh"].iloc[:2].sum() == pytest.approx(whole["pv_kwh"].iloc[0], rel=1e-12)

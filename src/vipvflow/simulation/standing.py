@@ -101,6 +101,8 @@ def interval_integrals(intervals: pd.DataFrame, geometry: pd.DataFrame, radiatio
         span = int(end.max()) + 1
         depth = np.cumsum(np.bincount(first, minlength=span) - np.bincount(end, minlength=span))
         minute = np.flatnonzero(depth[:-1] > 0)
+        if not len(minute):         # every interval of the point is empty, at a minute's edge
+            continue
         minutes = pd.DataFrame({"segment_id": np.full(len(minute), p, np.int64),
                                 "t_utc": lo + minute * _MINUTE,
                                 "dt_s": np.full(len(minute), _MINUTE, np.float32)})
@@ -122,8 +124,8 @@ def interval_integrals(intervals: pd.DataFrame, geometry: pd.DataFrame, radiatio
             f = np.maximum((t - lo) / _MINUTE, 0.0)
             i = np.floor(f).astype(np.int64)
             k = np.searchsorted(minute, i)
-            own = (k < len(minute)) & (minute[np.minimum(k, len(minute) - 1)] == i)
             kk = np.minimum(k, len(minute) - 1)
+            own = (k < len(minute)) & (minute[kk] == i)
             return total[:, k] + np.where(own, f - i, 0.0) * (total[:, kk + 1] - total[:, kk])
 
         sums = at(t1[sel]) - at(t0[sel])
