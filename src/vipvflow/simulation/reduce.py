@@ -22,6 +22,7 @@ from ..config import Config
 from ..errors import InputError
 from ..models.irradiance import shading_loss
 from ..store import HOURLY_METADATA, DataDir, RunDir, write_json, write_parquet
+from .partition import hand_back_memory
 
 log = logging.getLogger(__name__)
 
@@ -457,6 +458,7 @@ def block_day_table(cfg: Config, run_dir: Path, trip: pd.DataFrame, vehicle, pla
         bd[f"seconds_{kind}"] = bd.pop(f"{kind}_s")
     bd["pv_kwh_whole_day"] = bd["pv_kwh_driving"] + bd["pv_kwh_layover"] + bd["pv_kwh_parked"]
     bd["window_s"] = bd["window_end_utc"] - bd["window_start_utc"]
+    del tl
 
     # the layovers (every one, with its terminal and PV) and the parked time at the depot
     iv = pd.read_parquet(run.timeline_table("intervals"))
@@ -467,6 +469,8 @@ def block_day_table(cfg: Config, run_dir: Path, trip: pd.DataFrame, vehicle, pla
     lit = st.groupby(ikey)["pv_kwh"].sum()
     iv["pv_kwh"] = lit.reindex(pd.MultiIndex.from_frame(iv[ikey].astype({"kind": str}))).fillna(0.0).to_numpy()
     iv["seconds"] = (iv["t1_utc"] - iv["t0_utc"]).to_numpy(float)
+    del st, lit, points                    # the standing rows are summed: not held through the battery's day
+    hand_back_memory()
 
     # the layovers' auxiliaries (kWh from the battery) at the month's temperature
     temps = np.asarray(cfg.monthly_temperature_c(), float)
@@ -626,7 +630,7 @@ def reduce_run(cfg: Config, year: int, run_dir: Path, say=print, client=None, cl
     hp = _hourly_pattern(parts["hourly"])
     report.add_hourly(figures, hp)
     trips_meta = pd.read_parquet(DataDir(cfg.data_dir).gtfs.trips)
-    totals = _trip_totals(run_dir, parts["trip"])
+    totals = _trip_totals(run_dir, parts.pop("trip"))     # the Arrow sums not held on
     placed = _placed_trips(run_dir, totals)
     n_buses = int(placed.groupby("service_date")["block_id"].nunique().max())
     # the segments first: the workers draw the maps while the trips are joined here
@@ -681,13 +685,17 @@ class _Aside:
 
 
 class _Clock:
-    """``clock(step)`` adds the seconds since the last call to ``timings["reduce_<step>_s"]``."""
+    """``clock(step)`` adds the seconds since the last call to ``timings["reduce_<step>_s"]``
+    and hands the memory the step freed back to the operating system."""
 
     def __init__(self, timings: dict | None):
         self._timings = timings if timings is not None else {}
         self._last = time.perf_counter()
 
     def __call__(self, step: str) -> None:
+        # the step's temporaries handed back (Arrow's pool keeps what its reads and string
+        # columns freed, and numpy's allocations cannot reuse it): a few ms
+        hand_back_memory()
         now = time.perf_counter()
         self._timings[f"reduce_{step}_s"] = now - self._last
         self._last = now
