@@ -64,6 +64,8 @@ def write_datasets(run_dir, per_partition: int = SEGMENTS_PER_PARTITION) -> dict
     import pyarrow.parquet as pq
     import pyproj
 
+    from ..simulation.partition import hand_back_memory
+
     run = RunDir(run_dir)
     segments = pd.read_parquet(run.output(DATASETS["segments"]),
                                columns=["tile", "x", "y", "x_end", "y_end"])
@@ -75,6 +77,7 @@ def write_datasets(run_dir, per_partition: int = SEGMENTS_PER_PARTITION) -> dict
         # the rows as Arrow (geometry as WKB); each partition becomes a GeoDataFrame in its
         # own task, so one partition's geometries are decoded at a time
         table = pq.read_table(run.output(source))
+        hand_back_memory()                  # the read's buffers (as much again as the table)
         meta = table.schema.metadata or {}
         crs_json = json.loads(meta[b"geo"])["columns"]["geometry"].get("crs")
         crs = pyproj.CRS.from_json_dict(crs_json) if crs_json else None
@@ -83,14 +86,16 @@ def write_datasets(run_dir, per_partition: int = SEGMENTS_PER_PARTITION) -> dict
             raise ValueError(f"{run.output(source)}: rows of tiles without segments in "
                              f"{run.output(DATASETS['segments'])}")
         part = part.to_numpy(np.int64)
+        # the rows in partition order (in file order within one): each partition takes its
+        # own rows when it is written (a reordered copy of the whole table was a second
+        # table: 3.4 GB on a 200-line network's worker)
         order = np.argsort(part, kind="stable")
-        table = table.take(order)           # once, in partition order: each partition a slice
         bounds = np.searchsorted(part[order], np.arange(max(groups.values()) + 2))
         pieces = [(int(a), int(b)) for a, b in zip(bounds[:-1], bounds[1:])]
         custom = {k: v for k, v in meta.items() if k.startswith(b"vipvflow:")}
         final = run.dataset(name)
         stage = staging_dir(final)
-        rows = _Rows(table, crs)
+        rows = _Rows(table, order, crs)
         ddf = dd.from_map(rows, pieces, meta=rows((0, 0)), enforce_metadata=False)
         # month a date, as in the single file (pandas holds dates as timestamps)
         ddf.to_parquet(stage, write_index=False, custom_metadata=custom, overwrite=False,
@@ -98,17 +103,18 @@ def write_datasets(run_dir, per_partition: int = SEGMENTS_PER_PARTITION) -> dict
                        compute_kwargs={"scheduler": "sync"})
         swap_dir(stage, final)
         out[name] = len(pieces)
-        del table, ddf
+        del table, ddf, rows
+        hand_back_memory()
     return out
 
 
 class _Rows:
-    """``rows((a, b))``: rows a:b of an Arrow table of a run output as a GeoDataFrame
-    (columns in the file's order).  Named for Dask by a random token: hashing the table to
-    name the tasks cost more than writing it."""
+    """``rows((a, b))``: the rows ``order[a:b]`` of an Arrow table of a run output as a
+    GeoDataFrame (columns in the file's order).  Named for Dask by a random token: hashing
+    the table to name the tasks cost more than writing it."""
 
-    def __init__(self, table, crs):
-        self.table, self.crs, self.token = table, crs, uuid.uuid4().hex
+    def __init__(self, table, order, crs):
+        self.table, self.order, self.crs, self.token = table, order, crs, uuid.uuid4().hex
 
     def __dask_tokenize__(self):
         return self.token
@@ -117,7 +123,7 @@ class _Rows:
         import geopandas as gpd
         import pandas as pd
 
-        df = self.table.slice(rows[0], rows[1] - rows[0]).to_pandas()
+        df = self.table.take(self.order[rows[0]:rows[1]]).to_pandas()
         if "month" in df:
             df["month"] = pd.to_datetime(df["month"])
         df["geometry"] = gpd.GeoSeries.from_wkb(df["geometry"].to_numpy(), crs=self.crs)
