@@ -281,6 +281,9 @@ def _result(r: dict, counts: dict, days: list, period: str, scheduler, extra: di
         "peak_pss_gb": round(r["peak_pss_mb"] / 1024, 3) if r.get("peak_pss_mb") else None,
         "peak_rss_by_process_mb": r.get("peak_rss_by_process_mb"),
         "peak_rss_main_gb": round(r["peak_rss_main_mb"] / 1024, 3),
+        "peak_at_s": r.get("peak_at_s"),
+        "rss_at_peak_by_process_mb": r.get("rss_at_peak_by_process_mb"),
+        "peak_after_line": r.get("peak_after_line"),
         "partition_bytes_per_pass": extra["partition_bytes_per_pass"],
         "gtfs_ingest_s": extra["gtfs_ingest_s"],
     }

@@ -48,7 +48,10 @@ class PeakRSS:
         self.peak_pss_mb = 0.0
         self.peak_self_mb = 0.0
         self.by_pid: dict[int, float] = {}       # each process's own peak RSS (MB)
+        self.peak_at_s = 0.0                      # when the total peaked (s after the start)
+        self.at_peak_mb: list[int] = []           # each process's RSS then (MB, largest first)
         self.samples = 0
+        self._t0 = time.perf_counter()
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._poll, daemon=True, name="peak-rss")
 
@@ -63,14 +66,19 @@ class PeakRSS:
         total = own
         children = root.children(recursive=True)
         self.by_pid[root.pid] = max(self.by_pid.get(root.pid, 0.0), own / 2**20)
+        now = [own]
         for child in children:
             try:
                 rss = child.memory_info().rss
             except psutil.Error:
                 continue
             total += rss
+            now.append(rss)
             self.by_pid[child.pid] = max(self.by_pid.get(child.pid, 0.0), rss / 2**20)
-        self.peak_mb = max(self.peak_mb, total / 2**20)
+        if total / 2**20 > self.peak_mb:
+            self.peak_mb = total / 2**20
+            self.peak_at_s = time.perf_counter() - self._t0
+            self.at_peak_mb = sorted((round(v / 2**20) for v in now), reverse=True)
         if self.pss:
             pss = 0
             for p in [root, *children]:
@@ -91,6 +99,7 @@ class PeakRSS:
             self._stop.wait(self.interval_s)
 
     def __enter__(self) -> "PeakRSS":
+        self._t0 = time.perf_counter()
         self._thread.start()
         return self
 
@@ -201,17 +210,26 @@ def run_pipeline(cfg, year: int = YEAR, n_workers: int | None = None, rss_interv
     from vipvflow.simulation.run import run_simulation
 
     log: list[str] = []
+    said: list[float] = []                  # when each line of *log* was said (s after the start)
     with PeakRSS(interval_s=rss_interval_s, pss=pss) as mem:
         cpu0, children0 = time.process_time(), _children_cpu()
         t0 = time.perf_counter()
-        run_dir = run_simulation(cfg, year, scheduler=scheduler, n_workers=n_workers,
-                                 say=lambda *a: log.append(" ".join(map(str, a))))
+
+        def say(*a):
+            said.append(time.perf_counter() - t0)
+            log.append(" ".join(map(str, a)))
+
+        run_dir = run_simulation(cfg, year, scheduler=scheduler, n_workers=n_workers, say=say)
         wall = time.perf_counter() - t0
         cpu, children = time.process_time() - cpu0, _children_cpu() - children0
     manifest = json.loads((run_dir / "manifest.json").read_text())
+    before = [line for t, line in zip(said, log) if t <= mem.peak_at_s]
     return {"wall_s": wall, "peak_rss_mb": mem.peak_mb, "peak_rss_main_mb": mem.peak_self_mb,
             "peak_pss_mb": mem.peak_pss_mb if pss else None,
             "peak_rss_by_process_mb": sorted((round(v) for v in mem.by_pid.values()), reverse=True),
+            # the moment of the peak: when, each process's RSS then, and the run's last line before
+            "peak_at_s": round(mem.peak_at_s, 1), "rss_at_peak_by_process_mb": mem.at_peak_mb,
+            "peak_after_line": before[-1][:120] if before else None,
             "cpu_s_command": cpu, "cpu_s_workers": children,
             "run_dir": run_dir, "manifest": manifest, "log": log}
 

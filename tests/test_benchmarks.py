@@ -61,6 +61,13 @@ def test_facts_in_the_tiny_results(tiny_results):
         assert mirror["figures"]["rows"] == sum(mirror["rows_per_table"].values()) > 0
         for table, per_worker in (mirror["citus_placement"] or {}).items():
             assert set(per_worker) == {"worker1", "worker2"}, table
+    # the network's peak RSS is stated with its moment and each process's share then
+    net = json.loads((results / "network.tiny.json").read_text())["figures"]
+    assert 0 < net["peak_at_s"] <= net["wall_s"] + 1
+    assert len(net["rss_at_peak_by_process_mb"]) >= 2          # the command and its workers
+    assert abs(sum(net["rss_at_peak_by_process_mb"]) - net["peak_rss_gb"] * 1024) <= len(
+        net["rss_at_peak_by_process_mb"]) + 2
+    assert net["peak_after_line"]
     line = json.loads((results / "line_year.tiny.json").read_text())["figures"]
     assert line["passes"] > 0 and line["partitions"] > 0
     # the sun masks spare rays and change no result (the all-rays leg of the same round)
