@@ -171,3 +171,34 @@ def test_ranking_orders_blocks_and_routes(small_run):
     ok = r[np.isfinite(r["payback_years"])]
     cost = 1.5 * 1000 * 3.5
     np.testing.assert_allclose(ok["payback_years"], cost / (ok["grid_kwh_avoided_per_year"] * 0.21), rtol=1e-9)
+
+
+def test_the_battery_in_chunks_is_the_battery_at_once(small_run, small_config, monkeypatch):
+    """The block-days' battery run a few block-days at a time (as a network's year is, to
+    bound its memory) gives every block-day, every trip's SoC at departure and the traced
+    days exactly as all of them at once, and as the run wrote them."""
+    from vipvflow.config import load_config
+    from vipvflow.simulation import reduce
+
+    cfg = load_config(small_config, overrides={"dask": {"n_workers": 2}})
+    written = pd.read_parquet(small_run / "trip_energy.parquet")
+    trip = written.drop(columns=["block_id", "soc_at_departure"])
+    trip["service_date"] = pd.to_datetime(trip["service_date"]).astype("datetime64[ns]")  # a date in the file
+    placed = reduce._placed_trips(small_run, trip[["trip_id", "service_date"]])
+
+    def table(rows: int):
+        monkeypatch.setattr(reduce, "BATTERY_ROWS", rows)
+        return reduce.block_day_table(cfg, small_run, trip.copy(), cfg.vehicle_params(), placed)
+
+    bd, idle, trips, traces = table(1 << 20)
+    assert len(bd) > 7
+    pd.testing.assert_series_equal(trips["soc_at_departure"], written["soc_at_departure"])
+    ran = pd.read_parquet(small_run / "block_day.parquet")
+    for c in ("soc_start", "soc_lowest_pv", "soc_lowest_nopv", "grid_kwh_avoided", "pv_kwh_curtailed"):
+        pd.testing.assert_series_equal(bd[c], ran[c], check_exact=True)
+    for rows in (3, 7):
+        bd_c, _, trips_c, traces_c = table(rows)
+        pd.testing.assert_frame_equal(bd_c, bd, check_exact=True)
+        pd.testing.assert_series_equal(trips_c["soc_at_departure"], trips["soc_at_departure"], check_exact=True)
+        pd.testing.assert_frame_equal(traces_c, traces, check_exact=True)
+    assert set(traces["which"]) == {"worst", "typical"}

@@ -495,11 +495,18 @@ def block_day_table(cfg: Config, run_dir: Path, trip: pd.DataFrame, vehicle, pla
     return bd, idle, trip, balance["traces"]
 
 
+#: block-days whose battery is run at once (:func:`_battery_day`): each morning starts at
+#: the depot's SoC, so the rows are independent, and a chunk's (rows x trips) grids stay
+#: ~50 MB where a network's year held all of them at once (hundreds of MB)
+BATTERY_ROWS = 8192
+
+
 def _battery_day(cfg: Config, run_dir: Path, bd: pd.DataFrame, idx, trip: pd.DataFrame,
                  position: np.ndarray, lay: pd.DataFrame, iv: pd.DataFrame, vehicle) -> dict:
     """The block-days' battery under the charging plan, with PV and without
-    (:func:`vipvflow.models.charging.block_day_soc`): the columns of ``block_day`` it gives,
-    and ``soc_at_departure`` row by row with *trip*."""
+    (:func:`vipvflow.models.charging.block_day_soc`, :data:`BATTERY_ROWS` block-days at a
+    time): the columns of ``block_day`` it gives, and ``soc_at_departure`` row by row with
+    *trip*."""
     import json
 
     from ..inputs.gtfs.schedule import service_day_origin_utc
@@ -511,27 +518,27 @@ def _battery_day(cfg: Config, run_dir: Path, bd: pd.DataFrame, idx, trip: pd.Dat
     row = pd.Series(np.arange(n), index=idx)
     key = ["block_id", "service_date"]
 
-    def grid(frame, values, pos, fill=0.0):
-        out = np.full((n, K), fill, float)
-        r = row.reindex(pd.MultiIndex.from_frame(frame[key])).to_numpy()
-        ok = np.isfinite(r.astype(float)) & (pos >= 0) & (pos < K)
-        out[r[ok].astype(np.int64), pos[ok]] = np.asarray(values, float)[ok]
-        return out
+    def rows_of(frame) -> np.ndarray:
+        """Each row's block-day (its row of *bd*; -1: none)."""
+        r = row.reindex(pd.MultiIndex.from_frame(frame[key])).to_numpy(dtype=float, na_value=np.nan)
+        return np.where(np.isfinite(r), r, -1).astype(np.int64)
 
     t0 = (service_day_origin_utc(trip["service_date"].to_numpy(), tz)
           + trip["start_s"].to_numpy(float))
     t1 = t0 + trip["seconds"].to_numpy(float)
-    trip_pv = grid(trip, trip["pv_kwh"], position)
-    trip_use = grid(trip, trip["consumption_kwh"], position)
-    trip_t0, trip_t1 = grid(trip, t0, position, np.nan), grid(trip, t1, position, np.nan)
+    trip_at, lay_at = rows_of(trip), rows_of(lay)
     lpos = lay["after_trip"].to_numpy(np.int64)
     opp = plan.opportunity
     at_charger = (np.ones(len(lay), bool) if opp.terminals == "all" else
                   lay["stop_id"].astype(str).isin(opp.terminals or []).to_numpy())
     charge = at_charger & (lay["seconds"].to_numpy() >= opp.min_layover_min * 60.0)
-    lay_pv, lay_use = grid(lay, lay["pv_kwh"], lpos), grid(lay, lay["aux_kwh"], lpos)
-    lay_t0, lay_t1 = grid(lay, lay["t0_utc"], lpos), grid(lay, lay["t1_utc"], lpos)
-    lay_charge = grid(lay, charge, lpos) > 0
+    steps = {"trip": (trip_at, position, {"pv": trip["pv_kwh"], "use": trip["consumption_kwh"],
+                                          "t0": t0, "t1": t1}),
+             "lay": (lay_at, lpos, {"pv": lay["pv_kwh"], "use": lay["aux_kwh"], "t0": lay["t0_utc"],
+                                    "t1": lay["t1_utc"], "charge": charge})}
+    steps = {k: (at, np.asarray(pos, np.int64), {c: np.asarray(v, float) for c, v in vals.items()},
+                 np.argsort(at, kind="stable"))
+             for k, (at, pos, vals) in steps.items()}
     # the depot's hours: the parked time within the chargers' local hours
     parked = iv[iv["kind"] == "parked"]
     if plan.depot.hours is None:
@@ -544,22 +551,51 @@ def _battery_day(cfg: Config, run_dir: Path, bd: pd.DataFrame, idx, trip: pd.Dat
                                    parked["t1_utc"].to_numpy(float) + offset, *plan.depot.hours)
     depot_hours = (pd.Series(hours_s, index=pd.MultiIndex.from_frame(parked[key]))
                    .groupby(level=[0, 1]).sum().reindex(idx, fill_value=0.0).to_numpy())
+    parked_pv = bd["pv_kwh_parked"].to_numpy()
     car = Vehicle(vehicle.battery_kwh, vehicle.soc_min, vehicle.soc_max)
     depot = Charger(plan.depot.power_kw, plan.depot.efficiency,
                     plan.depot.target_soc if plan.depot.target_soc is not None else vehicle.soc_max)
     opportunity = None if opp.terminals is None else Charger(
         opp.power_kw, opp.efficiency, opp.target_soc if opp.target_soc is not None else vehicle.soc_max)
-    common = dict(trip_t0=trip_t0, trip_t1=trip_t1, lay_t0=lay_t0, lay_t1=lay_t1, lay_charge=lay_charge,
-                  depot_hours_s=depot_hours, depot=depot, opportunity=opportunity,
-                  connect_s=opp.connect_min * 60.0)
-    with_pv = block_day_soc(car, trip_pv, trip_use, lay_pv=lay_pv, lay_use=lay_use,
-                            parked_pv=bd["pv_kwh_parked"].to_numpy(), trace=True, **common)
-    no_pv = block_day_soc(car, np.zeros_like(trip_pv), trip_use, lay_pv=np.zeros_like(lay_pv),
-                          lay_use=lay_use, parked_pv=np.zeros(n), trace=True, **common)
-    # each trip's SoC at its departure: the morning's, or after the layover before it
-    before = np.column_stack([with_pv["soc_start"], with_pv["soc_after_layover"][:, :-1]])
-    r = row.reindex(pd.MultiIndex.from_frame(trip[key])).to_numpy()
-    soc_dep = before[r, np.clip(position, 0, K - 1)]
+
+    def run(a: int, b: int):
+        """Block-days a:b with PV and without (traced), their steps' grids, and the rows of
+        *trip* in them."""
+        grids, taken = {}, {}
+        for kind, (at, pos, vals, order) in steps.items():
+            lo, hi = np.searchsorted(at, [a, b], sorter=order)
+            i = order[lo:hi]                       # in their order: a step given twice keeps the last
+            taken[kind] = i
+            r, p = at[i] - a, pos[i]
+            ok = (p >= 0) & (p < K)
+            for c, v in vals.items():
+                g = np.full((b - a, K), np.nan if kind == "trip" and c in ("t0", "t1") else 0.0)
+                g[r[ok], p[ok]] = v[i][ok]
+                grids[f"{kind}_{c}"] = g
+        common = dict(trip_t0=grids["trip_t0"], trip_t1=grids["trip_t1"], lay_t0=grids["lay_t0"],
+                      lay_t1=grids["lay_t1"], lay_charge=grids["lay_charge"] > 0,
+                      depot_hours_s=depot_hours[a:b], depot=depot, opportunity=opportunity,
+                      connect_s=opp.connect_min * 60.0)
+        with_pv = block_day_soc(car, grids["trip_pv"], grids["trip_use"], lay_pv=grids["lay_pv"],
+                                lay_use=grids["lay_use"], parked_pv=parked_pv[a:b], trace=True, **common)
+        no_pv = block_day_soc(car, np.zeros((b - a, K)), grids["trip_use"], lay_pv=np.zeros((b - a, K)),
+                              lay_use=grids["lay_use"], parked_pv=np.zeros(b - a), trace=True, **common)
+        return with_pv, no_pv, grids, taken["trip"]
+
+    with_pv, no_pv = {}, {}
+    soc_dep = np.full(len(trip), np.nan)
+    for a in range(0, max(n, 1), BATTERY_ROWS):
+        b = min(n, a + BATTERY_ROWS)
+        w, o, _, i = run(a, b)
+        for out, part in ((with_pv, w), (no_pv, o)):
+            for c, v in part.items():
+                if np.ndim(v) == 1:
+                    out.setdefault(c, []).append(v)
+        # each trip's SoC at its departure: the morning's, or after the layover before it
+        before = np.column_stack([w["soc_start"], w["soc_after_layover"][:, :-1]])
+        soc_dep[i] = before[trip_at[i] - a, np.clip(position[i], 0, K - 1)]
+    with_pv = {c: np.concatenate(v) for c, v in with_pv.items()}
+    no_pv = {c: np.concatenate(v) for c, v in no_pv.items()}
     # to the second (interpolated within a trip: finer would be false precision)
     fail = pd.to_datetime(np.round(with_pv["fail_utc"]), unit="s", utc=True)
     grid_pv = with_pv["depot_grid_kwh"] + with_pv["opportunity_grid_kwh"]
@@ -576,28 +612,30 @@ def _battery_day(cfg: Config, run_dir: Path, bd: pd.DataFrame, idx, trip: pd.Dat
         "grid_kwh_opportunity_without_pv": no_pv["opportunity_grid_kwh"],
         "grid_kwh_avoided": grid_nopv - grid_pv,
         "soc_at_departure": soc_dep,
-        "traces": _soc_traces(bd, with_pv, no_pv, trip_t0, trip_t1, lay_t1),
+        "traces": _soc_traces(bd, with_pv["soc_lowest"], run),
     }
 
 
-def _soc_traces(bd: pd.DataFrame, with_pv: dict, no_pv: dict, trip_t0, trip_t1, lay_t1) -> pd.DataFrame:
+def _soc_traces(bd: pd.DataFrame, lowest: np.ndarray, run) -> pd.DataFrame:
     """The SoC through two block-days, with PV and without, at each trip's departure and
-    arrival and each layover's end: the worst (lowest SoC with PV) and a typical one (the
-    median lowest SoC): ``which, block_id, service_date, t_utc, soc_pv, soc_nopv``."""
+    arrival and each layover's end: the worst (lowest SoC with PV, *lowest*) and a typical
+    one (the median lowest SoC), each run again alone (``run(i, i + 1)``, as
+    :func:`_battery_day`'s): ``which, block_id, service_date, t_utc, soc_pv, soc_nopv``."""
     if not len(bd):
         return pd.DataFrame(columns=["which", "block_id", "service_date", "t_utc", "soc_pv", "soc_nopv"])
-    low = with_pv["soc_lowest"]
-    order = np.argsort(low, kind="stable")
+    order = np.argsort(lowest, kind="stable")
     picks = {"worst": int(order[0]), "typical": int(order[len(order) // 2])}
     rows = []
     for which, i in picks.items():
+        with_pv, no_pv, grids, _ = run(i, i + 1)
+        trip_t0, trip_t1, lay_t1 = grids["trip_t0"][0], grids["trip_t1"][0], grids["lay_t1"][0]
         k_n = int(bd["trips"].iloc[i])
-        pts = [(trip_t0[i, 0], with_pv["soc_start"][i], no_pv["soc_start"][i])]
+        pts = [(trip_t0[0], with_pv["soc_start"][0], no_pv["soc_start"][0])]
         for k in range(k_n):
-            pts.append((trip_t1[i, k], with_pv["soc_after_trip"][i, k], no_pv["soc_after_trip"][i, k]))
+            pts.append((trip_t1[k], with_pv["soc_after_trip"][0, k], no_pv["soc_after_trip"][0, k]))
             if k < k_n - 1:
-                pts.append((lay_t1[i, k], with_pv["soc_after_layover"][i, k],
-                            no_pv["soc_after_layover"][i, k]))
+                pts.append((lay_t1[k], with_pv["soc_after_layover"][0, k],
+                            no_pv["soc_after_layover"][0, k]))
         for t, a, b in pts:
             rows.append({"which": which, "block_id": str(bd["block_id"].iloc[i]),
                          "service_date": bd["service_date"].iloc[i], "t_utc": float(t),
