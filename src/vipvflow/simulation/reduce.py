@@ -67,9 +67,13 @@ def _part_table(run_dir: Path, kind: str, pattern: str = "tile=*/month=*.parquet
 
 def _read_parts(run_dir: Path, kind: str, columns: list[str] | None = None) -> pd.DataFrame:
     """Every partition file of *kind*, in path order, as one DataFrame (with *columns*, only
-    those)."""
+    those); the read's Arrow buffers handed back (twice the frame's size on a network's
+    standing intervals)."""
     table = _part_table(run_dir, kind, columns=columns)
-    return pd.DataFrame() if table is None else table.to_pandas()
+    frame = pd.DataFrame() if table is None else table.to_pandas()
+    del table
+    hand_back_memory()
+    return frame
 
 
 # --- the partial sums, computed where the partitions are (Dask tasks on the run's workers)
@@ -461,15 +465,20 @@ def block_day_table(cfg: Config, run_dir: Path, trip: pd.DataFrame, vehicle, pla
     del tl
 
     # the layovers (every one, with its terminal and PV) and the parked time at the depot
-    iv = pd.read_parquet(run.timeline_table("intervals"))
+    iv = pd.read_parquet(run.timeline_table("intervals"), columns=[
+        "block_id", "service_date", "kind", "after_trip", "point_id", "t0_utc", "t1_utc"])
     iv = iv[iv["block_id"].astype(str) != IDLE_BLOCK]
-    points = pd.read_parquet(run.timeline_table("points"), columns=["point_id", "stop_id"])
-    iv = iv.merge(points, on="point_id", how="left")
-    ikey = key + ["kind", "after_trip"]
-    lit = st.groupby(ikey)["pv_kwh"].sum()
-    iv["pv_kwh"] = lit.reindex(pd.MultiIndex.from_frame(iv[ikey].astype({"kind": str}))).fillna(0.0).to_numpy()
-    iv["seconds"] = (iv["t1_utc"] - iv["t0_utc"]).to_numpy(float)
-    del st, lit, points                    # the standing rows are summed: not held through the battery's day
+    kind = iv["kind"].astype(str).to_numpy()
+    lay, parked = iv[kind == "layover"], iv[kind == "parked"]
+    del iv, kind
+    hand_back_memory()
+    lay = lay.merge(pd.read_parquet(run.timeline_table("points"), columns=["point_id", "stop_id"]),
+                    on="point_id", how="left")
+    lit = st[st["kind"].astype(str) == "layover"].groupby(key + ["after_trip"])["pv_kwh"].sum()
+    lay["pv_kwh"] = lit.reindex(pd.MultiIndex.from_frame(lay[key + ["after_trip"]])).fillna(0.0).to_numpy()
+    lay["seconds"] = (lay["t1_utc"] - lay["t0_utc"]).to_numpy(float)
+    parked = parked.assign(seconds=(parked["t1_utc"] - parked["t0_utc"]).to_numpy(float))
+    del st, lit                          # the standing rows are summed: not held through the battery's day
     hand_back_memory()
 
     # the layovers' auxiliaries (kWh from the battery) at the month's temperature
@@ -480,13 +489,12 @@ def block_day_table(cfg: Config, run_dir: Path, trip: pd.DataFrame, vehicle, pla
         return (np.asarray(vehicle.aux_kw(temps[month_no - 1]), float) * np.asarray(seconds, float)
                 / 3600.0 / vehicle.discharge_efficiency)
 
-    lay = iv[iv["kind"] == "layover"].copy()
     lay["aux_kwh"] = aux_kwh(lay["service_date"], lay["seconds"])
     bd["layover_aux_kwh"] = (lay.groupby(key)["aux_kwh"].sum().reindex(idx, fill_value=0.0)
                              .to_numpy())
     # the battery's demand in service: the trips and the layovers' auxiliaries
     bd["demand_kwh"] = bd["consumption_kwh"] + bd["layover_aux_kwh"]
-    balance = _battery_day(cfg, run_dir, bd, idx, trip, position, lay, iv, vehicle)
+    balance = _battery_day(cfg, run_dir, bd, idx, trip, position, lay, parked, vehicle)
     for c, v in balance.items():
         if c not in ("soc_at_departure", "traces"):
             bd[c] = v
@@ -502,11 +510,11 @@ BATTERY_ROWS = 8192
 
 
 def _battery_day(cfg: Config, run_dir: Path, bd: pd.DataFrame, idx, trip: pd.DataFrame,
-                 position: np.ndarray, lay: pd.DataFrame, iv: pd.DataFrame, vehicle) -> dict:
+                 position: np.ndarray, lay: pd.DataFrame, parked: pd.DataFrame, vehicle) -> dict:
     """The block-days' battery under the charging plan, with PV and without
     (:func:`vipvflow.models.charging.block_day_soc`, :data:`BATTERY_ROWS` block-days at a
-    time): the columns of ``block_day`` it gives, and ``soc_at_departure`` row by row with
-    *trip*."""
+    time), from their trips, layovers (*lay*) and parked time (*parked*): the columns of
+    ``block_day`` it gives, and ``soc_at_departure`` row by row with *trip*."""
     import json
 
     from ..inputs.gtfs.schedule import service_day_origin_utc
@@ -540,7 +548,6 @@ def _battery_day(cfg: Config, run_dir: Path, bd: pd.DataFrame, idx, trip: pd.Dat
                  np.argsort(at, kind="stable"))
              for k, (at, pos, vals) in steps.items()}
     # the depot's hours: the parked time within the chargers' local hours
-    parked = iv[iv["kind"] == "parked"]
     if plan.depot.hours is None:
         hours_s = parked["seconds"].to_numpy(float)
     else:
