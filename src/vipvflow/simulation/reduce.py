@@ -535,6 +535,8 @@ def _battery_day(cfg: Config, run_dir: Path, bd: pd.DataFrame, idx, trip: pd.Dat
           + trip["start_s"].to_numpy(float))
     t1 = t0 + trip["seconds"].to_numpy(float)
     trip_at, lay_at = rows_of(trip), rows_of(lay)
+    if (trip_at < 0).any():              # the timeline places every trip in a block-day
+        raise ValueError(f"{int((trip_at < 0).sum())} trips have no block-day in the run's timeline")
     lpos = lay["after_trip"].to_numpy(np.int64)
     opp = plan.opportunity
     at_charger = (np.ones(len(lay), bool) if opp.terminals == "all" else
