@@ -13,6 +13,7 @@ import pyarrow.parquet as pq
 import pytest
 import shapely
 
+from vipvflow.outputs import datasets
 from vipvflow.outputs.datasets import read_dataset, write_datasets
 
 
@@ -70,3 +71,32 @@ def test_partitions_are_whole_tiles_in_their_boxes(small_run, tmp_path):
     assert [p.name for p in (run / "geoparquet" / "segments").iterdir()] == ["part.0.parquet"]
     with pytest.raises(ValueError, match="no dataset"):
         read_dataset(run, "trips")
+
+
+def test_passes_over_the_file_write_the_files_of_one_pass(small_run, tmp_path, monkeypatch):
+    """The partitions written in passes over each file (a partition a pass, or a few, each
+    pass holding its rows alone) are the files written in one pass, byte for byte in their
+    values, schema and metadata."""
+    run = tmp_path / "run"
+    run.mkdir()
+    for name in ("segments.parquet", "segment_month.parquet"):
+        shutil.copy(Path(small_run) / name, run / name)
+    rows = len(pd.read_parquet(run / "segment_month.parquet", columns=["segment_id"]))
+    n_segments = len(pd.read_parquet(run / "segments.parquet", columns=["segment_id"]))
+    per = max(1, n_segments // 6)
+    monkeypatch.setattr(datasets, "READ_BATCH_ROWS", 7)      # a pass's rows from many batches
+    written = {}
+    for rows_per_pass in (rows, rows // 3, 1):
+        parts = write_datasets(run, per_partition=per, rows_per_pass=rows_per_pass)
+        assert parts["segment_month"] >= 3
+        written[rows_per_pass] = {
+            f"{name}/{f.name}": pq.read_table(f)
+            for name in ("segments", "segment_month")
+            for f in sorted((run / "geoparquet" / name).glob("*"))}
+    one = written[rows]
+    for rows_per_pass in (rows // 3, 1):
+        assert written[rows_per_pass].keys() == one.keys()
+        for f, table in one.items():
+            got = written[rows_per_pass][f]
+            assert got.schema.equals(table.schema, check_metadata=True), f
+            assert got.equals(table), f

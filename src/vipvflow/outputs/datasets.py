@@ -27,6 +27,11 @@ from ..store import RunDir, staging_dir, swap_dir
 
 #: segments per partition the tiles are grouped to (a tile is never split)
 SEGMENTS_PER_PARTITION = 2000
+#: rows of a dataset held at once: its partitions are written in passes over the file, each
+#: of consecutive partitions of about this many rows (a partition is never split)
+ROWS_PER_PASS = 250_000
+#: rows of a file read at a time in a pass
+READ_BATCH_ROWS = 65_536
 #: the datasets: name -> the run output holding the same rows
 DATASETS = {"segments": "segments.parquet", "segment_month": "segment_month.parquet"}
 
@@ -54,9 +59,11 @@ def tile_groups(segments, per_partition: int = SEGMENTS_PER_PARTITION) -> dict[s
     return out
 
 
-def write_datasets(run_dir, per_partition: int = SEGMENTS_PER_PARTITION) -> dict:
+def write_datasets(run_dir, per_partition: int = SEGMENTS_PER_PARTITION,
+                   rows_per_pass: int = ROWS_PER_PASS) -> dict:
     """Write ``geoparquet/segments/`` and ``geoparquet/segment_month/`` from the run's
-    ``segments.parquet`` and ``segment_month.parquet``; return the partitions of each."""
+    ``segments.parquet`` and ``segment_month.parquet``; return the partitions of each.  The
+    partitions are written in passes over each file of about *rows_per_pass* rows."""
     import dask.dataframe as dd
     import dask_geopandas  # noqa: F401  (registers the GeoDataFrame backend of dask)
     import pandas as pd
@@ -74,38 +81,70 @@ def write_datasets(run_dir, per_partition: int = SEGMENTS_PER_PARTITION) -> dict
     if not groups:                          # a run without segments: no dataset
         return out
     for name, source in DATASETS.items():
-        # the rows as Arrow (geometry as WKB); each partition becomes a GeoDataFrame in its
-        # own task, so one partition's geometries are decoded at a time
-        table = pq.read_table(run.output(source))
-        hand_back_memory()                  # the read's buffers (as much again as the table)
-        meta = table.schema.metadata or {}
+        path = run.output(source)
+        meta = pq.read_schema(path).metadata or {}
         crs_json = json.loads(meta[b"geo"])["columns"]["geometry"].get("crs")
         crs = pyproj.CRS.from_json_dict(crs_json) if crs_json else None
-        part = pd.Series(table.column("tile").to_numpy(zero_copy_only=False)).map(groups)
+        part = pd.Series(pq.read_table(path, columns=["tile"]).column("tile")
+                         .to_numpy(zero_copy_only=False)).map(groups)
         if part.isna().any():
-            raise ValueError(f"{run.output(source)}: rows of tiles without segments in "
+            raise ValueError(f"{path}: rows of tiles without segments in "
                              f"{run.output(DATASETS['segments'])}")
         part = part.to_numpy(np.int64)
-        # the rows in partition order (in file order within one): each partition takes its
-        # own rows when it is written (a reordered copy of the whole table was a second
-        # table: 3.4 GB on a 200-line network's worker)
-        order = np.argsort(part, kind="stable")
-        bounds = np.searchsorted(part[order], np.arange(max(groups.values()) + 2))
-        pieces = [(int(a), int(b)) for a, b in zip(bounds[:-1], bounds[1:])]
         custom = {k: v for k, v in meta.items() if k.startswith(b"vipvflow:")}
         final = run.dataset(name)
         stage = staging_dir(final)
-        rows = _Rows(table, order, crs)
-        ddf = dd.from_map(rows, pieces, meta=rows((0, 0)), enforce_metadata=False)
-        # month a date, as in the single file (pandas holds dates as timestamps)
-        ddf.to_parquet(stage, write_index=False, custom_metadata=custom, overwrite=False,
-                       schema={"month": pa.date32()} if "month" in table.column_names else "infer",
-                       compute_kwargs={"scheduler": "sync"})
+        sizes = np.bincount(part, minlength=max(groups.values()) + 1)
+        for first, last in _passes(sizes, rows_per_pass):
+            # this pass's rows, streamed from the file (the file whole, read at once, took
+            # its worker to 0.82 GB on a 50-line network, and grew with it); each partition
+            # takes its own rows when it is written, in file order
+            mine = (part >= first) & (part < last)
+            table = _rows_of(path, mine)
+            hand_back_memory()              # the read's buffers
+            at = part[mine]
+            order = np.argsort(at, kind="stable")
+            bounds = np.searchsorted(at[order], np.arange(first, last + 1))
+            pieces = [(int(a), int(b)) for a, b in zip(bounds[:-1], bounds[1:])]
+            rows = _Rows(table, order, crs)
+            ddf = dd.from_map(rows, pieces, meta=rows((0, 0)), enforce_metadata=False)
+            # month a date, as in the single file (pandas holds dates as timestamps)
+            ddf.to_parquet(stage, write_index=False, custom_metadata=custom, overwrite=False,
+                           schema={"month": pa.date32()} if "month" in table.column_names else "infer",
+                           name_function=lambda i, first=first: f"part.{first + i}.parquet",
+                           compute_kwargs={"scheduler": "sync"})
+            del table, ddf, rows
+            hand_back_memory()
         swap_dir(stage, final)
-        out[name] = len(pieces)
-        del table, ddf, rows
-        hand_back_memory()
+        out[name] = len(sizes)
     return out
+
+
+def _passes(sizes, rows_per_pass: int) -> list[tuple[int, int]]:
+    """Consecutive partitions ``[first, last)`` of about *rows_per_pass* rows together
+    (*sizes*: the rows of each partition; a partition larger than that is a pass alone)."""
+    passes, first, rows = [], 0, 0
+    for i, n in enumerate(sizes):
+        if rows and rows + n > rows_per_pass:
+            passes.append((first, i))
+            first, rows = i, 0
+        rows += int(n)
+    passes.append((first, len(sizes)))
+    return passes
+
+
+def _rows_of(path, mine):
+    """The rows of the Parquet file *path* where the boolean array *mine* is true, as one
+    Arrow table, read in batches and streamed (neither the file nor a row group is held
+    whole: pre-buffering a row group held its column chunks)."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    source, kept, at = pq.ParquetFile(path, pre_buffer=False, buffer_size=1 << 20), [], 0
+    for batch in source.iter_batches(batch_size=READ_BATCH_ROWS):
+        kept.append(batch.filter(pa.array(mine[at:at + batch.num_rows])))
+        at += batch.num_rows
+    return pa.Table.from_batches(kept, schema=source.schema_arrow)
 
 
 class _Rows:
