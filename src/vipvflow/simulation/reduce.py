@@ -11,6 +11,7 @@ import logging
 import re
 import time
 from pathlib import Path
+from typing import NamedTuple
 
 import geopandas as gpd
 import numpy as np
@@ -436,8 +437,11 @@ def block_day_table(cfg: Config, run_dir: Path, trip: pd.DataFrame, vehicle, pla
     st = _read_parts(run_dir, "standing", columns=[c for c, _ in kept])
     if st.empty:
         st = pd.DataFrame({c: pd.Series(dtype=t) for c, t in kept})
-    idle = st[st["block_id"] == IDLE_BLOCK].copy()
-    st = st[st["block_id"] != IDLE_BLOCK]
+    idle_rows = (st["block_id"] == IDLE_BLOCK).to_numpy(bool)
+    idle = st.loc[idle_rows]
+    # the buses in service: the columns summed below
+    st = st.loc[~idle_rows, key + ["kind", "after_trip", "pv_kwh", "pv_kwh_clear"]]
+    del idle_rows
     idle["month"] = pd.to_datetime(idle["service_date"]).dt.strftime("%Y-%m")
     idle["pv_kwh_curtailed"] = idle["pv_kwh"]            # an idle bus's battery is full
 
@@ -467,13 +471,12 @@ def block_day_table(cfg: Config, run_dir: Path, trip: pd.DataFrame, vehicle, pla
     # the layovers (every one, with its terminal and PV) and the parked time at the depot
     iv = pd.read_parquet(run.timeline_table("intervals"), columns=[
         "block_id", "service_date", "kind", "after_trip", "point_id", "t0_utc", "t1_utc"])
-    iv = iv[iv["block_id"].astype(str) != IDLE_BLOCK]
-    kind = iv["kind"].astype(str).to_numpy()
-    lay, parked = iv[kind == "layover"], iv[kind == "parked"]
+    kind = np.where(iv["block_id"].astype(str) == IDLE_BLOCK, "", iv["kind"].astype(str))
+    lay, parked = (iv.loc[kind == k].drop(columns="kind") for k in ("layover", "parked"))
     del iv, kind
     hand_back_memory()
     lay = lay.merge(pd.read_parquet(run.timeline_table("points"), columns=["point_id", "stop_id"]),
-                    on="point_id", how="left")
+                    on="point_id", how="left").drop(columns="point_id")
     lit = st[st["kind"].astype(str) == "layover"].groupby(key + ["after_trip"])["pv_kwh"].sum()
     lay["pv_kwh"] = lit.reindex(pd.MultiIndex.from_frame(lay[key + ["after_trip"]])).fillna(0.0).to_numpy()
     lay["seconds"] = (lay["t1_utc"] - lay["t0_utc"]).to_numpy(float)
@@ -681,8 +684,8 @@ def reduce_run(cfg: Config, year: int, run_dir: Path, say=print, client=None, cl
     placed = _placed_trips(run_dir, totals)
     n_buses = int(placed.groupby("service_date")["block_id"].nunique().max())
     # the segments first: the workers draw the maps while the trips are joined here
-    segments, sm = _segment_outputs(cfg, run_dir, parts["segment_month"], parts["geometry"],
-                                    totals, n_buses, trips_meta)
+    segments, sums = _segment_outputs(cfg, run_dir, parts.pop("segment_month"), parts["geometry"],
+                                      totals, n_buses, trips_meta)
     report.add_maps(figures, run_dir, cfg)
     # beside the figures, from the files just written: city.glb and the GeoParquet datasets
     model = _Aside(client, "city-glb", gltf.write_gltf, str(run_dir),
@@ -703,7 +706,7 @@ def reduce_run(cfg: Config, year: int, run_dir: Path, say=print, client=None, cl
     write_parquet(ranking, RunDir(run_dir).output("ranking.parquet"))
     report.add_ranking(figures, ranking)
     write_parquet(hp, RunDir(run_dir).output("hourly_pattern.parquet"))
-    monthly, summary = _fleet_year(cfg, year, run_dir, trip, bd, idle, sm, segments, n_buses)
+    monthly, summary = _fleet_year(cfg, year, run_dir, trip, bd, idle, sums, segments, n_buses)
     write_parquet(monthly, RunDir(run_dir).output("monthly.parquet"))
     write_json(summary, RunDir(run_dir).output("summary.json"))
     report.add_charts(figures, summary, monthly)
@@ -788,8 +791,9 @@ def _segment_outputs(cfg: Config, run_dir: Path, sm: pd.DataFrame, geo: pd.DataF
     """Per segment and month (GeoParquet for maps) and per segment over the run (geometry
     factors and year) of the shapes of the trips in *totals* (:func:`_trip_totals`) run by
     *n_buses*; writes ``segment_month.parquet`` and ``segments.parquet``.  Returns the
-    segments and the segment-month sums (not the per segment-month table with its
-    geometries: a network's is hundreds of MB the rest of the reduce does not need)."""
+    segments and the sums over them the fleet-year's summary takes (:class:`_SegmentSums`;
+    not the per segment-month table: a network's is hundreds of MB the trips' step does not
+    need)."""
     from . import annual
 
     data_dir = Path(cfg.data_dir)
@@ -814,7 +818,32 @@ def _segment_outputs(cfg: Config, run_dir: Path, sm: pd.DataFrame, geo: pd.DataF
     segments = annual.segment_year(segments.merge(shape_route, on="shape_id", how="left"), geo, sm,
                                    cfg.pv_system().kwp, hours_per_bus)
     write_parquet(segments, RunDir(run_dir).output("segments.parquet"))
-    return segments, sm
+    return segments, _SegmentSums.of(sm, segments)
+
+
+class _SegmentSums(NamedTuple):
+    """What the fleet-year's summary takes of the segment-month rows: the irradiation sums
+    ``h_*`` of all of them (*light*) and of the road's (*road*: not inside a building
+    footprint), the passes, each segment's sums (*per_segment*, :func:`_study_area`) and
+    the segments' flags (:func:`_segment_flags`)."""
+    light: pd.Series
+    road: pd.Series
+    passes: int
+    per_segment: pd.DataFrame
+    flags: pd.DataFrame
+
+    @classmethod
+    def of(cls, sm: pd.DataFrame, segments: pd.DataFrame) -> "_SegmentSums":
+        h_cols = [c for c in sm.columns if c.startswith("h_")]
+        # the light on the roofs: every segment; the shading statistics: the road, without
+        # the segments inside building footprints (they take a nearby street's light)
+        flags = _segment_flags(segments)
+        street = ~sm["segment_id"].map(flags["in_building"]).fillna(False).to_numpy(bool)
+        return cls(light=sm[h_cols].sum(), road=sm.loc[street, h_cols].sum(),
+                   passes=int(sm["n_passes"].sum()),
+                   per_segment=sm.groupby("segment_id")[["seconds", "pv_kwh", "h_direct", "h_diffuse",
+                                                         "h_total_unshaded"]].sum(),
+                   flags=flags)
 
 
 def shape_routes(trips: pd.DataFrame) -> pd.DataFrame:
@@ -1065,14 +1094,13 @@ def _segment_flags(segments: pd.DataFrame) -> pd.DataFrame:
     return out
 
 
-def _study_area(sm: pd.DataFrame, flags: pd.DataFrame, kwh_per_kwp_driving: float) -> dict:
+def _study_area(sums: pd.DataFrame, flags: pd.DataFrame, kwh_per_kwp_driving: float) -> dict:
     """What of the run lies in the city model: route-km, driving time and PV inside it, the
     driving yield of the whole lines and of the part inside (a bus driving only the
     modelled streets: the yield scaled by the PV per second inside over the PV per second
     of the whole), the shading loss inside, the segments inside building footprints and
-    where the segments' ground heights come from."""
-    sums = sm.groupby("segment_id")[["seconds", "pv_kwh", "h_direct", "h_diffuse",
-                                     "h_total_unshaded"]].sum()
+    where the segments' ground heights come from.  *sums*: per segment id, its ``seconds,
+    pv_kwh, h_direct, h_diffuse, h_total_unshaded`` (:class:`_SegmentSums`)."""
     f = flags.reindex(sums.index)
     inside, street = f["in_city_model"].to_numpy(bool), ~f["in_building"].to_numpy(bool)
     seg = flags[flags.index.isin(sums.index)]
@@ -1132,8 +1160,8 @@ def _tree_figures(cfg: Config, tot: pd.Series) -> dict:
             "tree_shading_loss_allsky": with_trees - without}
 
 
-def _fleet_year(cfg: Config, year: int, run_dir: Path, trip, bd, idle, sm, segments,
-                n_buses: int) -> tuple[pd.DataFrame, dict]:
+def _fleet_year(cfg: Config, year: int, run_dir: Path, trip, bd, idle, sums: _SegmentSums,
+                segments, n_buses: int) -> tuple[pd.DataFrame, dict]:
     """The fleet per month and the fleet-year summary (checked: :func:`_check_totals`)."""
     from . import annual
 
@@ -1142,20 +1170,14 @@ def _fleet_year(cfg: Config, year: int, run_dir: Path, trip, bd, idle, sm, segme
     # a run over some months states annual figures scaled by 12 / months (flagged in the summary)
     annualise = 12.0 / len(cfg.run.months)
     hours_per_bus = annual.service_hours_per_bus(float(trip["seconds"].sum()), n_buses, annualise)
-    h_cols = [c for c in sm.columns if c.startswith("h_")]
-    # the light on the roofs: every segment; the shading statistics: the road, without the
-    # segments inside building footprints (they take a nearby street's light: in_building)
-    flags = _segment_flags(segments)
-    street = ~sm["segment_id"].map(flags["in_building"]).fillna(False).to_numpy(bool)
-    tot_all = sm[h_cols].sum()
-    tot = sm.loc[street, h_cols].sum()
+    tot_all, tot = sums.light, sums.road
     summary = {
         "scenario": cfg.scenario, "year": year, "months": cfg.run.months, "pv_mode": cfg.pv.mode,
         "diffuse_model": cfg.irradiance.diffuse_model,
         "air_temperature_c": cfg.monthly_temperature_c(),
         "air_temperature_source": cfg.temperature_source(),
         "routes": int(trip["route_id"].nunique()), "trips": int(len(trip)), "buses": n_buses,
-        "segments": int(len(segments)), "passes": int(sm["n_passes"].sum()),
+        "segments": int(len(segments)), "passes": sums.passes,
         "kwp_per_bus": pv.kwp,
         "pv_kwh_driving_clearsky": float(trip["pv_kwh_clear"].sum()),
         "pv_kwh_driving_unshaded": float(trip["pv_kwh_unshaded"].sum()),
@@ -1175,7 +1197,7 @@ def _fleet_year(cfg: Config, year: int, run_dir: Path, trip, bd, idle, sm, segme
         **_economics(cfg, bd, n_buses, annualise),
         **annual.per_bus_figures(tot_all, n_buses, annualise, hours_per_bus, data_dir, year),
     }
-    summary.update(_study_area(sm, flags, summary["kwh_per_kwp_driving"]))
+    summary.update(_study_area(sums.per_segment, sums.flags, summary["kwh_per_kwp_driving"]))
     summary.update(_radiation_gaps(data_dir, year, cfg.run.months))
     _check_totals(summary, run_dir)
     return _monthly(cfg, trip, bd, idle, n_buses), summary
