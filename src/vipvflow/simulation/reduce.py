@@ -773,15 +773,25 @@ def _trip_outputs(cfg: Config, year: int, run_dir: Path, totals: pd.DataFrame, p
     meta = trips_meta.reindex(columns=["trip_id", "route_id", "route_short_name", "route_long_name",
                                        "trip_headsign", "direction_id", "shape_id", "service_id",
                                        "block_id", "pattern_id", "start_s"])
-    trip = totals.merge(meta, on="trip_id", how="left", validate="many_to_one")
+    # the trips' names and ids repeat on every service day: held as categories through the
+    # block-days (a network's strings were half its trip table), as they were at the write
+    strings = {c: meta[c].dtype for c in meta.columns.drop(["trip_id", "pattern_id"])
+               if pd.api.types.is_string_dtype(meta[c].dtype)}
+    trip = totals.merge(meta.astype({c: "category" for c in strings}), on="trip_id", how="left",
+                        validate="many_to_one")
     trip["month"] = pd.to_datetime(trip["service_date"]).dt.strftime("%Y-%m")
     cons = trip_consumption(cfg, Path(cfg.data_dir), year, trip["pattern_id"].unique(),
                             vecto_dir=RunDir(run_dir).vecto, say=say, made=consumption)
     trip = trip.merge(cons, on=["pattern_id", "month"], how="left", validate="many_to_one")
     trip["coverage"] = trip["pv_kwh"] / trip["consumption_kwh"]
+    later = {c: trip[c].dtype for c in ("pattern_id", "month", "consumption_source")
+             if c in trip and pd.api.types.is_string_dtype(trip[c].dtype)}
+    trip = trip.astype({c: "category" for c in later})
+    strings.update(later)
     # vehicle block per day: driving, layovers, parked; the battery's share (sets the
     # trips' block_id to the timeline's: the GTFS block or the inferred one)
     bd, idle, trip, traces = block_day_table(cfg, run_dir, trip, cfg.vehicle_params(), placed)
+    trip = trip.astype({c: t for c, t in strings.items() if isinstance(trip[c].dtype, pd.CategoricalDtype)})
     write_parquet(trip, RunDir(run_dir).output("trip_energy.parquet"))
     return trip, bd, idle, traces
 
