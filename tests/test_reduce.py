@@ -6,7 +6,7 @@ import pandas as pd
 import pytest
 
 from vipvflow.errors import InputError
-from vipvflow.simulation.reduce import _read_parts, _trip_totals
+from vipvflow.simulation.reduce import _join_months, _read_parts, _trip_totals, sum_trips
 from vipvflow.store import RunDir, write_parquet
 
 PV = ["pv_kwh", "pv_kwh_clear", "pv_kwh_direct"]
@@ -40,6 +40,28 @@ def test_trips_are_summed_over_tiles_and_sorted(tmp_path):
     np.testing.assert_allclose(got[PV + ["seconds"]].to_numpy(), want[PV + ["seconds"]].to_numpy(),
                                rtol=1e-14)
     assert len(got) == 3 * 3
+
+
+def test_months_are_joined_as_the_sum_of_all_their_rows(tmp_path):
+    """A trip past midnight at a month's end is in two months' sums: the join sums those
+    rows again and takes the rest as they are; the table is the whole's sum, exactly."""
+    rng = np.random.default_rng(5)
+    months = {"2024-01": ["2024-01-30", "2024-01-31"], "2024-02": ["2024-01-31", "2024-02-01", "2024-02-29"],
+              "2024-03": ["2024-02-29", "2024-03-01"], "2024-05": ["2024-05-02"]}
+    tables = []
+    for month, dates in months.items():
+        df = _trip_part(rng, ["t2", "t10", "t1"], dates).iloc[::-1]
+        df["tile"] = "a"
+        write_parquet(df, RunDir(tmp_path / month).part("trip", "a", month))
+        tables.append(sum_trips([RunDir(tmp_path / month).part("trip", "a", month)]))
+    got = _join_months(tables + [None])
+    assert got.equals(sum_trips(tables))
+    assert got.num_rows == 3 * 6                  # 6 service dates, two of them in two months
+    twice = got.to_pandas().set_index(["trip_id", "service_date"]).loc[("t10", pd.Timestamp("2024-01-31"))]
+    jan, feb = (t.to_pandas().set_index(["trip_id", "service_date"]).loc[("t10", pd.Timestamp("2024-01-31"))]
+                for t in tables[:2])
+    assert twice["pv_kwh"] == jan["pv_kwh"] + feb["pv_kwh"]
+    assert _join_months(tables[:1]) is tables[0] and _join_months([]) is None
 
 
 def test_files_with_different_schemas_are_promoted(tmp_path):

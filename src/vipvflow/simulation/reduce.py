@@ -203,8 +203,34 @@ def _trip_tree(run_dir: Path, client) -> list:
 
 
 def _join_months(tables: list) -> pa.Table | None:
-    """The months' trip sums as one table (a trip past midnight at a month's end is in two)."""
-    return sum_trips(tables) if len(tables) > 1 else (tables[0] if tables else None)
+    """The months' trip sums (:func:`sum_trips`, each one row per trip and service date) as
+    one table sorted by both.  A trip past midnight at a month's end is in two months: the
+    rows whose date lies within another month's dates are summed again (in month order, as
+    a sum of the whole would), the rest taken as they are (summing the whole held four times
+    its size)."""
+    import pyarrow.compute as pc
+
+    tables = [t for t in tables if t is not None and t.num_rows]
+    if len(tables) <= 1:
+        return tables[0] if tables else None
+    keys = ["trip_id", "service_date"]
+    spans = [(pc.min(t.column("service_date")), pc.max(t.column("service_date"))) for t in tables]
+    shared = []
+    for k, t in enumerate(tables):
+        date, mask = t.column("service_date"), np.zeros(t.num_rows, bool)
+        for j, (lo, hi) in enumerate(spans):
+            if j != k:
+                mask |= pc.and_(pc.greater_equal(date, lo), pc.less_equal(date, hi)).to_numpy(
+                    zero_copy_only=False)
+        shared.append(mask)
+    again = sum_trips([t.filter(pa.array(m)) for t, m in zip(tables, shared)])
+    whole = pa.concat_tables(tables + ([again] if again is not None else []),
+                             promote_options="permissive")
+    rows = np.flatnonzero(np.concatenate([~m for m in shared]
+                                         + [np.ones(again.num_rows if again is not None else 0, bool)]))
+    order = pc.sort_indices(whole.select(keys).take(rows),
+                            sort_keys=[(k, "ascending") for k in keys]).to_numpy()
+    return whole.take(rows[order])
 
 
 def partial_sums(run_dir: Path, client=None) -> dict:
