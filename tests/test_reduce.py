@@ -1,13 +1,17 @@
 """The reduce's reading of partition files: one Arrow dataset per kind, trips summed in Arrow."""
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pandas as pd
+import pyarrow as pa
 import pytest
 
 from vipvflow.errors import InputError
-from vipvflow.simulation.reduce import _join_months, _read_parts, _trip_totals, sum_trips
-from vipvflow.store import RunDir, write_parquet
+from vipvflow.simulation.reduce import (_join_months, _months_frame, _read_parts, _trip_totals,
+                                       segment_month_part, sum_trips)
+from vipvflow.store import HOURLY_METADATA, RunDir, write_parquet
 
 PV = ["pv_kwh", "pv_kwh_clear", "pv_kwh_direct"]
 
@@ -62,6 +66,31 @@ def test_months_are_joined_as_the_sum_of_all_their_rows(tmp_path):
                 for t in tables[:2])
     assert twice["pv_kwh"] == jan["pv_kwh"] + feb["pv_kwh"]
     assert _join_months(tables[:1]) is tables[0] and _join_months([]) is None
+
+
+def test_the_months_segment_tables_are_one_frame_with_tile_and_month(tmp_path):
+    """The months' segment tables (Arrow, from the cluster) make the frame the months'
+    DataFrames concatenated would: the same columns, dtypes and values, each row with the
+    tile and month of its file; an older run's DataFrame joins them."""
+    rng = np.random.default_rng(7)
+    parts, want = [], []
+    for month in ("2024-01", "2024-02"):
+        files = []
+        for tile, n in (("E1", 3), ("E2", 2)):
+            df = pd.DataFrame({"segment_id": np.arange(n, dtype=np.int64), "h_total": rng.random(n),
+                               "shape_id": [f"s{i}" for i in range(n)]})
+            files.append(RunDir(tmp_path).part("segment_month", tile, month))
+            hourly = json.dumps({"hour": [12], "h_total": [float(df["h_total"].sum())], "seconds": [1.0]})
+            write_parquet(pa.Table.from_pandas(df, preserve_index=False)
+                          .replace_schema_metadata({HOURLY_METADATA: hourly}), files[-1])
+            want.append(df.assign(tile=tile, month=month))
+        parts.append(segment_month_part([str(f) for f in files], month)[0])
+    got = _months_frame(list(parts))
+    pd.testing.assert_frame_equal(got, pd.concat(want, ignore_index=True), check_exact=True)
+    older = want[0].copy()
+    mixed = _months_frame([parts[1], older])
+    pd.testing.assert_frame_equal(mixed, pd.concat(want[2:] + [older], ignore_index=True), check_exact=True)
+    assert _months_frame([]).empty
 
 
 def test_files_with_different_schemas_are_promoted(tmp_path):

@@ -119,16 +119,18 @@ def sum_trips(parts: list) -> pa.Table | None:
     return summed.sort_by([(k, "ascending") for k in keys])
 
 
-def segment_month_part(files: list, month: str) -> tuple[pd.DataFrame, pd.DataFrame]:
+def segment_month_part(files: list, month: str) -> tuple[pa.Table | pd.DataFrame, pd.DataFrame]:
     """The segment partitions of one month as one table, each row with its ``tile`` and
     ``month`` (named by the file's path; older runs stored them as columns), and the
-    month's sums per local hour (:func:`hourly_sums`).  A Dask task of the reduce."""
+    month's sums per local hour (:func:`hourly_sums`).  A Dask task of the reduce: the
+    table in Arrow (:func:`_months_frame` makes the run's frame of them), an older run's
+    as a DataFrame."""
     files = [Path(f) for f in files]
     if not files:
         return pd.DataFrame(), hourly_sums([], month)
     tables = [_read_file(f) for f in files]
     hourly = hourly_sums([_hourly_of(t, f) for t, f in zip(tables, files)], month)
-    try:                                    # one conversion to pandas for the month
+    try:
         table = pa.concat_tables(tables)
     except pa.ArrowInvalid:                 # schemas differ (an older run's files)
         table = None
@@ -136,11 +138,26 @@ def segment_month_part(files: list, month: str) -> tuple[pd.DataFrame, pd.DataFr
         frames = [_with_tile_month(t.to_pandas(), _tile_of(f), month) for t, f in zip(tables, files)]
         frames = [d for d in frames if len(d)] or frames[:1]
         return pd.concat(frames, ignore_index=True), hourly
-    df = table.to_pandas()
-    df["tile"] = np.repeat(np.array([_tile_of(f) for f in files], dtype=object),
-                           [t.num_rows for t in tables])
-    df["month"] = month
-    return df, hourly
+    tile = np.repeat(np.array([_tile_of(f) for f in files], dtype=object), [t.num_rows for t in tables])
+    table = table.append_column("tile", pa.array(tile, pa.string()))
+    return table.append_column("month", pa.array(np.full(table.num_rows, month, object), pa.string())), hourly
+
+
+def _months_frame(parts: list) -> pd.DataFrame:
+    """The months' segment tables (:func:`segment_month_part`) as one DataFrame.  Arrow tables
+    are joined without a copy and converted column by column, each column's Arrow buffers
+    released as it is converted (a concatenation of the months' frames held them twice)."""
+    if parts and all(isinstance(p, pa.Table) for p in parts):
+        table = pa.concat_tables(parts)
+        parts.clear()
+        # the strings copied: pandas keeps Arrow's string columns as they are, and each
+        # received column is a view of its whole message, which it would keep alive
+        for i, field in enumerate(table.schema):
+            if not (pa.types.is_floating(field.type) or pa.types.is_integer(field.type)):
+                table = table.set_column(i, field, pa.chunked_array([table.column(i).combine_chunks()]))
+        return table.to_pandas(self_destruct=True)
+    frames = [p.to_pandas() if isinstance(p, pa.Table) else p for p in parts]
+    return pd.concat(frames, ignore_index=True) if frames else pd.DataFrame()
 
 
 def _with_tile_month(df: pd.DataFrame, tile: str, month: str) -> pd.DataFrame:
@@ -250,10 +267,10 @@ def partial_sums(run_dir: Path, client=None) -> dict:
     geometry = client.submit(geometry_factors, [str(f) for f in RunDir(run_dir).part_files(
         "geometry", "tile=*.parquet")], pure=False)
     trip, sm, geometry = client.gather([trip, sm, geometry])
-    return {"trip": _join_months(trip),
-            "segment_month": pd.concat([s for s, _ in sm], ignore_index=True) if sm else pd.DataFrame(),
-            "hourly": (pd.concat([h for _, h in sm], ignore_index=True) if sm
-                       else hourly_sums([], "")[:0]),
+    hourly = pd.concat([h for _, h in sm], ignore_index=True) if sm else hourly_sums([], "")[:0]
+    tables = [s for s, _ in sm]
+    del sm
+    return {"trip": _join_months(trip), "segment_month": _months_frame(tables), "hourly": hourly,
             "geometry": geometry}
 
 
