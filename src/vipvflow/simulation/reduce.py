@@ -817,7 +817,7 @@ def _trip_outputs(cfg: Config, year: int, run_dir: Path, totals: pd.DataFrame, p
                                        "trip_headsign", "direction_id", "shape_id", "service_id",
                                        "block_id", "pattern_id", "start_s"])
     # the trips' names and ids repeat on every service day: held as categories through the
-    # block-days (a network's strings were half its trip table), as they were at the write
+    # block-days (a network's strings were half its trip table), written as the strings they are
     strings = {c: meta[c].dtype for c in meta.columns.drop(["trip_id", "pattern_id"])
                if pd.api.types.is_string_dtype(meta[c].dtype)}
     trip = totals.merge(meta.astype({c: "category" for c in strings}), on="trip_id", how="left",
