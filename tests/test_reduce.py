@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import json
+import threading
 
 import numpy as np
 import pandas as pd
@@ -10,7 +11,7 @@ import pytest
 
 from vipvflow.errors import InputError
 from vipvflow.simulation.reduce import (_join_months, _months_frame, _read_parts, _trip_totals,
-                                       segment_month_part, sum_trips)
+                                       forget_and_hand_back, segment_month_part, sum_trips)
 from vipvflow.store import HOURLY_METADATA, RunDir, write_parquet
 
 PV = ["pv_kwh", "pv_kwh_clear", "pv_kwh_direct"]
@@ -133,3 +134,28 @@ def test_trip_sums_from_unaligned_buffers_are_summed_without_a_warning(capfd):
     assert got["trip_id"].tolist() == [f"t{i}" for i in range(7)]
     assert got["pv_kwh"].sum() == 2 * np.arange(n).sum() + n and got["seconds"].sum() == 2 * n
     assert "aligned" not in capfd.readouterr().err
+
+
+def test_a_worker_hands_back_once_it_has_dropped_the_results():
+    """The reduce's sums gathered, each worker waits until it has dropped them (a release
+    reaches it on its own), then hands back what they took; a result still held does not
+    stop it past its wait."""
+    from dask.distributed import Client, LocalCluster
+
+    with LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None) as cluster, \
+            Client(cluster) as client:
+        def held(dask_worker=None):
+            return key in dask_worker.data
+
+        future = client.submit(np.ones, 1000, pure=False)
+        future.result()
+        key = future.key
+        threading.Timer(1.0, future.release).start()    # released while the worker waits
+        client.run(forget_and_hand_back, [key])
+        assert list(client.run(held).values()) == [False]
+
+        kept = client.submit(np.ones, 1000, pure=False)
+        kept.result()
+        key = kept.key
+        client.run(forget_and_hand_back, [key], wait_s=0.2)
+        assert list(client.run(held).values()) == [True]

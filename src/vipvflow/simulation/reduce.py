@@ -266,12 +266,33 @@ def partial_sums(run_dir: Path, client=None) -> dict:
           for m, files in _month_files(run_dir, "segment_month").items()]
     geometry = client.submit(geometry_factors, [str(f) for f in RunDir(run_dir).part_files(
         "geometry", "tile=*.parquet")], pure=False)
+    futures = [*trip, *sm, geometry]
     trip, sm, geometry = client.gather([trip, sm, geometry])
+    if not isinstance(client, _InProcess):
+        # the sums' results are here: the workers, once they have dropped them, hand back
+        # what the reads and sums took (200 lines: 1.9 and 2.3 GB held, 0.4 after)
+        keys = [f.key for f in futures]
+        del futures
+        client.run(forget_and_hand_back, keys)
     hourly = pd.concat([h for _, h in sm], ignore_index=True) if sm else hourly_sums([], "")[:0]
     tables = [s for s, _ in sm]
     del sm
     return {"trip": _join_months(trip), "segment_month": _months_frame(tables), "hourly": hourly,
             "geometry": geometry}
+
+
+async def forget_and_hand_back(keys: list, dask_worker=None, wait_s: float = 10.0) -> None:
+    """On a worker (``client.run``; a coroutine, so the worker's event loop goes on): wait
+    until it has dropped the results *keys* (a client's release reaches the workers on its
+    own, after this call may), then hand the memory freed back to the operating system
+    (:func:`hand_back_memory`)."""
+    import asyncio
+
+    if dask_worker is not None:
+        keys, end = set(keys), time.monotonic() + wait_s
+        while time.monotonic() < end and not keys.isdisjoint(dask_worker.data):
+            await asyncio.sleep(0.01)
+    hand_back_memory()
 
 
 def geometry_factors(files: list) -> pd.DataFrame | None:
