@@ -7,12 +7,13 @@ import threading
 import numpy as np
 import pandas as pd
 import pyarrow as pa
+import pyarrow.parquet as pq
 import pytest
 
 from vipvflow.errors import InputError
 from vipvflow.simulation.reduce import (_join_months, _months_frame, _read_parts, _trip_totals,
                                        forget_and_hand_back, segment_month_part, sum_trips)
-from vipvflow.store import HOURLY_METADATA, RunDir, write_parquet
+from vipvflow.store import HOURLY_METADATA, RunDir, write_parquet, write_parquet_parts
 
 PV = ["pv_kwh", "pv_kwh_clear", "pv_kwh_direct"]
 
@@ -159,3 +160,41 @@ def test_a_worker_hands_back_once_it_has_dropped_the_results():
         key = kept.key
         client.run(forget_and_hand_back, [key], wait_s=0.2)
         assert list(client.run(held).values()) == [True]
+
+
+def test_segment_month_is_written_in_parts_as_the_whole_merge_was(tmp_path, monkeypatch):
+    """segment_month.parquet, written a slice of rows at a time, holds what writing the
+    merge of the segments, their month rows and the shapes' routes at once wrote: the
+    merge's row order (a row whose segment is not run dropped, a shape without routes
+    null), schema and metadata; in one part, the same bytes."""
+    import geopandas as gpd
+    from shapely.geometry import LineString
+
+    from vipvflow.simulation import reduce as R
+
+    segments = gpd.GeoDataFrame(
+        {"segment_id": [7, 3, 5, 9], "shape_id": ["b", "a", "b", "c"], "length_m": [10.0] * 4},
+        geometry=[LineString([(i, 0, 3.2), (i + 1, 1 + i, 3.2)]) for i in range(4)], crs="EPSG:25833")
+    rng = np.random.default_rng(5)
+    sm = pd.DataFrame({"segment_id": [5, 3, 11, 7, 5, 3, 9, 7],
+                       "month": ["2024-01"] * 4 + ["2024-02"] * 4,
+                       "n_passes": rng.integers(1, 50, 8), "pv_kwh": rng.random(8)})
+    shape_route = pd.DataFrame({"shape_id": ["a", "b"],
+                                "route_short_name": pd.array(["1", "2, 3"], dtype="string"),
+                                "direction_id": pd.array([0, pd.NA], dtype="Int32")})
+    whole = segments[["segment_id", "shape_id", "geometry"]].merge(sm, on="segment_id", how="inner")
+    whole = gpd.GeoDataFrame(whole.merge(shape_route, on="shape_id", how="left"), geometry="geometry",
+                             crs=segments.crs)
+    at_once = write_parquet(whole, tmp_path / "whole" / "segment_month.parquet")
+
+    rows, geo = R._segment_month_rows(segments, sm, shape_route)
+    one = write_parquet_parts(rows, tmp_path / "one" / "segment_month.parquet", geo)
+    assert one.read_bytes() == at_once.read_bytes()
+
+    monkeypatch.setattr(R, "ROW_GROUP_ROWS", 3)
+    rows, geo = R._segment_month_rows(segments, sm, shape_route)
+    parts = write_parquet_parts(rows, tmp_path / "parts" / "segment_month.parquet", geo)
+    a, b = pq.read_table(at_once), pq.read_table(parts)
+    assert b.schema.equals(a.schema, check_metadata=True) and b.equals(a)
+    assert pq.ParquetFile(parts).metadata.num_row_groups == 3
+    assert b.column("segment_id").to_pylist() == [7, 7, 3, 3, 5, 5, 9]

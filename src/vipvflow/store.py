@@ -366,6 +366,45 @@ def write_parquet(df, path: str | Path, pandas_dtypes: bool = False, compact: bo
     return path
 
 
+#: pyarrow's row group (rows): parts of this size written one by one (:func:`write_parquet_parts`)
+#: give a file the row groups of the whole written at once
+ROW_GROUP_ROWS = 1 << 20
+
+
+def write_parquet_parts(parts, path: str | Path, metadata: dict | None = None) -> Path:
+    """Write the frames *parts* (consecutive slices of one DataFrame or GeoDataFrame, in
+    order) to *path* atomically as one file, as :func:`write_parquet` writes their
+    concatenation, holding one part at a time: each converted the same way and written as
+    its own row groups (parts of :data:`ROW_GROUP_ROWS` rows give the file the whole's).
+    *metadata* replaces the entries of the file's key-value metadata that describe the
+    whole rather than a part (a GeoParquet's ``geo``: the bounding box and geometry types
+    of all rows).  A part whose schema differs from the first's is an error."""
+    import pyarrow.parquet as pq
+
+    from .simulation.dictionary import OUTPUTS, annotate
+
+    path = Path(path)
+    output = path.stem if path.suffix == ".parquet" and path.stem in OUTPUTS else None
+    with atomic_path(path) as tmp:
+        writer = None
+        try:
+            for part in parts:
+                table = _plain_table(part)
+                table = _arrow_table(part) if table is None else table
+                if metadata:
+                    table = table.replace_schema_metadata({**(table.schema.metadata or {}), **metadata})
+                table = annotate(table, output) if output else table
+                if writer is None:
+                    writer = pq.ParquetWriter(tmp, table.schema)
+                writer.write_table(table)
+        finally:
+            if writer is not None:
+                writer.close()
+        if writer is None:
+            raise ValueError(f"{path}: no parts to write")
+    return path
+
+
 def _as_float32(table, prefixes: tuple[str, ...]):
     """*table* with its float columns named ``<prefix>...`` cast to float32."""
     import pyarrow as pa
