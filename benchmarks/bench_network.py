@@ -284,6 +284,7 @@ def _result(r: dict, counts: dict, days: list, period: str, scheduler, extra: di
         "peak_at_s": r.get("peak_at_s"),
         "rss_at_peak_by_process_mb": r.get("rss_at_peak_by_process_mb"),
         "peak_after_line": r.get("peak_after_line"),
+        "peak_rss_by_step_mb": r.get("peak_rss_by_step_mb"),
         "partition_bytes_per_pass": extra["partition_bytes_per_pass"],
         "gtfs_ingest_s": extra["gtfs_ingest_s"],
     }

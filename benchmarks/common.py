@@ -51,6 +51,7 @@ class PeakRSS:
         self.peak_at_s = 0.0                      # when the total peaked (s after the start)
         self.at_peak_mb: list[int] = []           # each process's RSS then (MB, largest first)
         self.samples = 0
+        self.series: list[tuple[float, float]] = []   # (s after the start, total RSS MB) of each sample
         self._t0 = time.perf_counter()
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._poll, daemon=True, name="peak-rss")
@@ -75,6 +76,7 @@ class PeakRSS:
             total += rss
             now.append(rss)
             self.by_pid[child.pid] = max(self.by_pid.get(child.pid, 0.0), rss / 2**20)
+        self.series.append((time.perf_counter() - self._t0, total / 2**20))
         if total / 2**20 > self.peak_mb:
             self.peak_mb = total / 2**20
             self.peak_at_s = time.perf_counter() - self._t0
@@ -230,8 +232,30 @@ def run_pipeline(cfg, year: int = YEAR, n_workers: int | None = None, rss_interv
             # the moment of the peak: when, each process's RSS then, and the run's last line before
             "peak_at_s": round(mem.peak_at_s, 1), "rss_at_peak_by_process_mb": mem.at_peak_mb,
             "peak_after_line": before[-1][:120] if before else None,
+            "peak_rss_by_step_mb": peaks_by_step(mem.series, t0 - mem._t0, manifest.get("timings_s", {})),
             "cpu_s_command": cpu, "cpu_s_workers": children,
             "run_dir": run_dir, "manifest": manifest, "log": log}
+
+
+def peaks_by_step(series: list, run_start: float, timings: dict) -> dict:
+    """The process tree's peak RSS (MB) in each step of a run: before the map (the cluster's
+    start, the timeline), the map, and each step of the reduce, from *series* (the sampler's
+    ``(s, MB)``), the run's start on the sampler's clock and the run's own *timings*
+    (``map_s``, ``reduce_<step>_s``, ``close_wait_s``, ``total_s``).  The steps are placed
+    back from the run's end: the reduce's steps run one after another, the map just
+    before them."""
+    if "total_s" not in timings or "map_s" not in timings:
+        return {}
+    steps = [(k[len("reduce_"):-2], v) for k, v in timings.items()
+             if k.startswith("reduce_") and k.endswith("_s") and k != "reduce_s"]
+    end = run_start + timings["total_s"] - timings.get("close_wait_s", 0.0)
+    start = end - sum(v for _, v in steps)
+    bounds = [("before_map", run_start, start - timings["map_s"]), ("map", start - timings["map_s"], start)]
+    for name, seconds in steps:
+        bounds.append((f"reduce_{name}", start, start + seconds))
+        start += seconds
+    peaks = {name: max((mb for t, mb in series if lo <= t < hi), default=None) for name, lo, hi in bounds}
+    return {name: round(mb) if mb is not None else None for name, mb in peaks.items()}   # None: no sample
 
 
 def _children_cpu() -> float:
