@@ -48,6 +48,33 @@ def test_trips_are_summed_over_tiles_and_sorted(tmp_path):
     assert len(got) == 3 * 3
 
 
+def test_trip_files_read_a_few_at_a_time_are_summed_as_all_at_once(tmp_path, monkeypatch):
+    """A task reads its trip files a few at a time, each group summed into the sums so far:
+    the sums are bit for bit those of every row in file order (each key's values added one
+    after another), whatever the group size."""
+    from vipvflow.simulation import reduce as R
+
+    rng = np.random.default_rng(11)
+    files, rows = [], []
+    for i in range(7):
+        df = _trip_part(rng, [f"t{j}" for j in rng.permutation(6)[:4]], ["2024-03-01", "2024-03-02"])
+        for c in PV + ["seconds"]:                 # magnitudes whose order of addition shows
+            df[c] = rng.standard_normal(len(df)) * 10.0 ** rng.integers(-4, 7, len(df))
+        files.append(str(write_parquet(df, tmp_path / f"tile=x{i}" / "month=2024-03.parquet")))
+        rows.append(df)
+    whole = pd.concat(rows, ignore_index=True)
+    for size in (1, 2, 3, 100):
+        monkeypatch.setattr(R, "TRIP_READ_FILES", size)
+        got = sum_trips(files).to_pandas()
+        for (trip, date), g in whole.groupby(["trip_id", "service_date"], sort=True):
+            one = got[(got["trip_id"] == trip) & (got["service_date"] == date)]
+            for c in PV + ["seconds"]:              # one after another, from zero
+                assert one[c].item() == np.cumsum(g[c].to_numpy(np.float64))[-1], (size, trip, c)
+        assert got[["trip_id", "service_date"]].equals(
+            whole[["trip_id", "service_date"]].drop_duplicates().sort_values(["trip_id", "service_date"])
+            .reset_index(drop=True))
+
+
 def test_months_are_joined_as_the_sum_of_all_their_rows(tmp_path):
     """A trip past midnight at a month's end is in two months' sums: the join sums those
     rows again and takes the rest as they are; the table is the whole's sum, exactly."""
