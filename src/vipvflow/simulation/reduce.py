@@ -543,11 +543,8 @@ def block_day_table(cfg: Config, run_dir: Path, trip: pd.DataFrame, vehicle, pla
     del tl
 
     # the layovers (every one, with its terminal and PV) and the parked time at the depot
-    iv = pd.read_parquet(run.timeline_table("intervals"), columns=[
-        "block_id", "service_date", "kind", "after_trip", "point_id", "t0_utc", "t1_utc"])
-    kind = np.where(iv["block_id"].astype(str) == IDLE_BLOCK, "", iv["kind"].astype(str))
-    lay, parked = (iv.loc[kind == k].drop(columns="kind") for k in ("layover", "parked"))
-    del iv, kind
+    lay, parked = _service_intervals(run.timeline_table("intervals"), ("layover", "parked"), [
+        "block_id", "service_date", "after_trip", "point_id", "t0_utc", "t1_utc"])
     hand_back_memory()
     lay = lay.merge(pd.read_parquet(run.timeline_table("points"), columns=["point_id", "stop_id"]),
                     on="point_id", how="left").drop(columns="point_id")
@@ -578,6 +575,26 @@ def block_day_table(cfg: Config, run_dir: Path, trip: pd.DataFrame, vehicle, pla
     trip["soc_at_departure"] = balance["soc_at_departure"]
     bd["pv_kwh_usable"] = bd["pv_kwh_whole_day"] - bd["pv_kwh_curtailed"]
     return bd, idle, trip, balance["traces"]
+
+
+def _service_intervals(path: Path, kinds: tuple, columns: list) -> list:
+    """The timeline's intervals (*path*) of each of *kinds* of the buses in service (not the
+    idle buses' block), each kind's rows in the file's order as a DataFrame of *columns*;
+    read a batch at a time (a network's 4.9 M intervals were held whole, with two copies of
+    their strings, to pick them)."""
+    import pyarrow.compute as pc
+
+    from ..inputs.gtfs.schedule import IDLE_BLOCK
+
+    pieces = {k: [] for k in kinds}
+    with pq.ParquetFile(path) as pf:
+        schema = pa.schema([pf.schema_arrow.field(c) for c in columns])
+        for batch in pf.iter_batches(batch_size=1 << 20, columns=list(dict.fromkeys([*columns, "kind"])),
+                                     use_threads=False):
+            busy = pc.fill_null(pc.not_equal(batch.column("block_id"), IDLE_BLOCK), True)
+            for k in kinds:
+                pieces[k].append(batch.filter(pc.and_(busy, pc.equal(batch.column("kind"), k))).select(columns))
+    return [pa.Table.from_batches(pieces[k], schema=schema).to_pandas() for k in kinds]
 
 
 #: block-days whose battery is run at once (:func:`_battery_day`): each morning starts at
