@@ -51,7 +51,7 @@ class PeakRSS:
         self.peak_at_s = 0.0                      # when the total peaked (s after the start)
         self.at_peak_mb: list[int] = []           # each process's RSS then (MB, largest first)
         self.samples = 0
-        self.series: list[tuple[float, float]] = []   # (s after the start, total RSS MB) of each sample
+        self.series: list[tuple] = []   # each sample: s after the start, total MB, each process's bytes
         self._t0 = time.perf_counter()
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._poll, daemon=True, name="peak-rss")
@@ -76,7 +76,7 @@ class PeakRSS:
             total += rss
             now.append(rss)
             self.by_pid[child.pid] = max(self.by_pid.get(child.pid, 0.0), rss / 2**20)
-        self.series.append((time.perf_counter() - self._t0, total / 2**20))
+        self.series.append((time.perf_counter() - self._t0, total / 2**20, now))
         if total / 2**20 > self.peak_mb:
             self.peak_mb = total / 2**20
             self.peak_at_s = time.perf_counter() - self._t0
@@ -238,9 +238,9 @@ def run_pipeline(cfg, year: int = YEAR, n_workers: int | None = None, rss_interv
 
 
 def peaks_by_step(series: list, run_start: float, timings: dict) -> dict:
-    """The process tree's peak RSS (MB) in each step of a run: before the map (the cluster's
+    """The process tree's peak RSS (MB, and each process's then) in each step of a run: before the map (the cluster's
     start, the timeline), the map, and each step of the reduce, from *series* (the sampler's
-    ``(s, MB)``), the run's start on the sampler's clock and the run's own *timings*
+    ``(s, MB, bytes of each process)``), the run's start on the sampler's clock and the run's own *timings*
     (``map_s``, ``reduce_<step>_s``, ``close_wait_s``, ``total_s``).  The steps are placed
     back from the run's end: the reduce's steps run one after another, the map just
     before them."""
@@ -254,8 +254,13 @@ def peaks_by_step(series: list, run_start: float, timings: dict) -> dict:
     for name, seconds in steps:
         bounds.append((f"reduce_{name}", start, start + seconds))
         start += seconds
-    peaks = {name: max((mb for t, mb in series if lo <= t < hi), default=None) for name, lo, hi in bounds}
-    return {name: round(mb) if mb is not None else None for name, mb in peaks.items()}   # None: no sample
+    out = {}
+    for name, lo, hi in bounds:
+        top = max((s for s in series if lo <= s[0] < hi), key=lambda s: s[1], default=None)
+        # the peak, and each process's RSS then (largest first); None: no sample in the step
+        out[name] = None if top is None else {
+            "mb": round(top[1]), "by_process_mb": sorted((round(v / 2**20) for v in top[2]), reverse=True)}
+    return out
 
 
 def _children_cpu() -> float:
