@@ -623,7 +623,7 @@ def pass_groups(trip_code, day, seg, t_utc, dt, timezone: str) -> dict:
     Returns
     -------
     dict of arrays: ``run``, ``seg_pos`` (position among the sorted distinct ``seg_ids``),
-    ``hour`` (local, 0..23), ``seg_hour`` (``seg_pos x 24 + hour``), ``starts`` (first pass
+    ``seg_hour`` (``seg_pos x 24 +`` the local hour 0..23), ``starts`` (first pass
     of each run), ``seg_ids``; and per run, segment and hour the seconds ``run_s, seg_s,
     hour_s`` and the pass counts ``seg_n, hour_n``.
     """
@@ -641,9 +641,10 @@ def pass_groups(trip_code, day, seg, t_utc, dt, timezone: str) -> dict:
     h_lo = int(np.floor(t_utc.min() / 3600.0)) if n else 0
     h_hi = int(np.floor(t_utc.max() / 3600.0)) if n else 0
     offset = utc_offsets(timezone, h_lo, h_hi)
-    out = {k: np.empty(n, np.int64) for k in ("run", "seg_pos", "seg_hour", "hour")}
+    out = {k: np.empty(n, np.int64) for k in ("run", "seg_pos", "seg_hour")}
+    hour = np.empty(n, np.int64)            # in seg_hour: not held on (8 bytes a pass)
     n_runs = _groups(trip_code, day, seg, t_utc, dt, lo, seg_pos_of, h_lo, _writable(offset),
-                     out["run"], out["seg_pos"], out["seg_hour"], out["hour"])
+                     out["run"], out["seg_pos"], out["seg_hour"], hour)
     new_run = np.empty(n, bool)
     if n:
         new_run[0] = True
@@ -651,7 +652,7 @@ def pass_groups(trip_code, day, seg, t_utc, dt, timezone: str) -> dict:
     out.update(starts=np.flatnonzero(new_run), seg_ids=seg_ids, run_s=np.zeros(n_runs),
                seg_s=np.zeros(len(seg_ids)), hour_s=np.zeros(24),
                seg_n=np.zeros(len(seg_ids), np.int64), hour_n=np.zeros(24, np.int64))
-    _seconds(out["run"], out["seg_pos"], out["hour"], dt, out["run_s"], out["seg_s"],
+    _seconds(out["run"], out["seg_pos"], hour, dt, out["run_s"], out["seg_s"],
              out["hour_s"], out["seg_n"], out["hour_n"])
     return out
 

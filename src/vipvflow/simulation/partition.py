@@ -295,8 +295,8 @@ def partition_groups(passes: pd.DataFrame, ctx: RunContext) -> dict:
     """Each pass's (trip, service date) run, segment position and local hour, and the
     seconds per run, segment and hour (:func:`vipvflow.models.passkernel.pass_groups`).
 
-    Returns its dict with ``trip_code``, ``trip_uniques``, ``day`` (days since 1970) and
-    ``dt`` (n,) s on the segment.  The runs come from the pass order (sorted by service
+    Returns its dict with ``trip_code`` and ``day`` (days since 1970) of each run, the trip
+    names ``trip_uniques`` the codes index, and ``dt`` (n,) s on the segment.  The runs come from the pass order (sorted by service
     date, trip and time, as :func:`vipvflow.inputs.gtfs.iter_passes` gives them).
     """
     from ..models.passkernel import pass_groups
@@ -312,7 +312,8 @@ def partition_groups(passes: pd.DataFrame, ctx: RunContext) -> dict:
     dt = np.ascontiguousarray(passes["dt_s"].to_numpy(np.float64))
     g = pass_groups(trip_code, day, passes["segment_id"].to_numpy(np.int64),
                     passes["t_utc"].to_numpy(np.float64), dt, ctx.timezone)
-    g.update(trip_code=trip_code, trip_uniques=trip_uniques, day=day, dt=dt)
+    # the trip and date of each run, not of each pass (16 bytes a pass held through the kernel)
+    g.update(trip_code=trip_code[g["starts"]], trip_uniques=trip_uniques, day=day[g["starts"]], dt=dt)
     return g
 
 
@@ -435,7 +436,7 @@ def _trip_table(passes: pd.DataFrame, g: dict, per_run: dict):
     import pyarrow as pa
 
     starts = g["starts"]
-    code, day = g["trip_code"][starts], g["day"][starts]
+    code, day = g["trip_code"], g["day"]
     order = np.lexsort((day, code))
     code, day = code[order], day[order]
     dates = passes["service_date"].to_numpy()[starts][order]
