@@ -225,3 +225,26 @@ def test_segment_month_is_written_in_parts_as_the_whole_merge_was(tmp_path, monk
     assert b.schema.equals(a.schema, check_metadata=True) and b.equals(a)
     assert pq.ParquetFile(parts).metadata.num_row_groups == 3
     assert b.column("segment_id").to_pylist() == [7, 7, 3, 3, 5, 5, 9]
+
+
+def test_the_service_intervals_are_each_kind_of_the_buses_in_service_in_file_order(tmp_path):
+    """The layovers and parked intervals the battery's day takes, read a batch at a time:
+    each kind's rows in the file's order, without the idle buses' block or other kinds."""
+    from vipvflow.inputs.gtfs.schedule import IDLE_BLOCK
+    from vipvflow.simulation import reduce as R
+
+    rng = np.random.default_rng(2)
+    n = 5000
+    iv = pd.DataFrame({"block_id": rng.choice(["b1", "b2", IDLE_BLOCK], n),
+                       "service_date": pd.to_datetime("2024-06-01") + pd.to_timedelta(rng.integers(0, 3, n), "D"),
+                       "kind": rng.choice(["layover", "parked", "driving"], n),
+                       "after_trip": rng.integers(-1, 9, n), "point_id": rng.integers(0, 50, n),
+                       "t0_utc": rng.random(n), "t1_utc": rng.random(n) + 1})
+    path = write_parquet(iv, tmp_path / "intervals.parquet")
+    cols = ["block_id", "service_date", "after_trip", "point_id", "t0_utc", "t1_utc"]
+    pq.write_table(pq.read_table(path), tmp_path / "small_groups.parquet", row_group_size=700)
+    for f in (path, tmp_path / "small_groups.parquet"):
+        lay, parked = R._service_intervals(f, ("layover", "parked"), cols)
+        for got, kind in ((lay, "layover"), (parked, "parked")):
+            want = iv[(iv["block_id"] != IDLE_BLOCK) & (iv["kind"] == kind)][cols].reset_index(drop=True)
+            pd.testing.assert_frame_equal(got, want)
