@@ -296,8 +296,9 @@ def partition_groups(passes: pd.DataFrame, ctx: RunContext) -> dict:
     seconds per run, segment and hour (:func:`vipvflow.models.passkernel.pass_groups`).
 
     Returns its dict with ``trip_code`` and ``day`` (days since 1970) of each run, the trip
-    names ``trip_uniques`` the codes index, and ``dt`` (n,) s on the segment.  The runs come from the pass order (sorted by service
-    date, trip and time, as :func:`vipvflow.inputs.gtfs.iter_passes` gives them).
+    names ``trip_uniques`` the codes index, and ``dt`` (n,) s on the segment.  The runs come
+    from the pass order (sorted by service date, trip and time, as
+    :func:`vipvflow.inputs.gtfs.iter_passes` gives them).
     """
     from ..models.passkernel import pass_groups
 

@@ -617,7 +617,8 @@ def _service_intervals(path: Path, kinds: tuple, columns: list) -> list:
                                      use_threads=False):
             busy = pc.fill_null(pc.not_equal(batch.column("block_id"), IDLE_BLOCK), True)
             for k in kinds:
-                pieces[k].append(batch.filter(pc.and_(busy, pc.equal(batch.column("kind"), k))).select(columns))
+                chosen = pc.and_(busy, pc.equal(batch.column("kind"), k))
+                pieces[k].append(batch.filter(chosen).select(columns))
     return [pa.Table.from_batches(pieces[k], schema=schema).to_pandas() for k in kinds]
 
 
