@@ -51,7 +51,7 @@ class PeakRSS:
         self.peak_at_s = 0.0                      # when the total peaked (s after the start)
         self.at_peak_mb: list[int] = []           # each process's RSS then (MB, largest first)
         self.samples = 0
-        self.series: list[tuple] = []   # each sample: s after the start, total MB, each process's bytes
+        self.series: list[tuple] = []             # each sample: s, total MB, each process's bytes
         self._t0 = time.perf_counter()
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._poll, daemon=True, name="peak-rss")
@@ -238,12 +238,12 @@ def run_pipeline(cfg, year: int = YEAR, n_workers: int | None = None, rss_interv
 
 
 def peaks_by_step(series: list, run_start: float, timings: dict) -> dict:
-    """The process tree's peak RSS (MB, and each process's then) in each step of a run: before the map (the cluster's
-    start, the timeline), the map, and each step of the reduce, from *series* (the sampler's
-    ``(s, MB, bytes of each process)``), the run's start on the sampler's clock and the run's own *timings*
-    (``map_s``, ``reduce_<step>_s``, ``close_wait_s``, ``total_s``).  The steps are placed
-    back from the run's end: the reduce's steps run one after another, the map just
-    before them."""
+    """The process tree's peak RSS (MB, and each process's then) in each step of a run:
+    before the map (the cluster's start, the timeline), the map, and each step of the
+    reduce, from *series* (the sampler's ``(s, MB, bytes of each process)``), the run's start
+    on the sampler's clock and the run's own *timings* (``map_s``, ``reduce_<step>_s``,
+    ``close_wait_s``, ``total_s``).  The steps are placed back from the run's end: the
+    reduce's steps run one after another, the map just before them."""
     if "total_s" not in timings or "map_s" not in timings:
         return {}
     steps = [(k[len("reduce_"):-2], v) for k, v in timings.items()
