@@ -130,7 +130,8 @@ def test_fused_equals_numpy_on_the_demo_passes(small_run, small_config):
         ref = evaluate_passes(passes, None, geometry, table, scene, irr_cfg, packed=geo, kernel="numpy")
         _assert_same(ref, evaluate_passes(passes, None, geometry, table, scene, irr_cfg, packed=geo))
         want = part.aggregate_partition(passes, ref, 6, ctx)
-        groups, bins = part._fused_sums(ctx, tile, passes, geometry, {})
+        groups, bins, n = part._fused_sums(ctx, tile, [passes], geometry, {})
+        assert n == len(passes)
         got = part.aggregate_partition(passes, None, 6, ctx, groups=groups, bins=bins)
         for a, b in zip(want, got):
             assert list(a.columns) == list(b.columns) and len(a) == len(b)
@@ -140,6 +141,41 @@ def test_fused_equals_numpy_on_the_demo_passes(small_run, small_config):
                 else:
                     assert (a[c].to_numpy() == b[c].to_numpy()).all(), c
     assert n_passes > 1000
+
+
+def test_fused_sums_of_passes_in_chunks_are_those_of_all_at_once(small_run, small_config):
+    """The small demo's June, tile by tile: the fused kernel fed a few service days at a time
+    (PassChunks) gives the partition tables of all the passes at once, bit for bit."""
+    from vipvflow.config import load_config
+    from vipvflow.inputs.gtfs import PassChunks, iter_passes
+    from vipvflow.simulation import partition as part
+
+    cfg = load_config(small_config)
+    data_dir = str(cfg.data_dir)
+    ctx = part.RunContext(data_dir=data_dir, run_dir=str(small_run), year=2024,
+                          irradiance=IrradianceCfg(**cfg.irradiance.model_dump()).model_dump(),
+                          pv_system=cfg.pv_system().model_dump(), pv_mode="paper",
+                          monthly_temperature_c=(15.0,) * 12, wind_speed_mps=2.0,
+                          timezone="Europe/Luxembourg")
+    tiles = sorted(p.name[5:-8] for p in (small_run / "parts" / "geometry").glob("tile=*.parquet"))
+    most = 0
+    for tile in tiles:
+        passes = iter_passes(data_dir, tile, "2024-06", 2024)
+        if not len(passes):
+            continue
+        geometry = read_geometry(small_run / "parts" / "geometry" / f"tile={tile}.parquet")
+        budget = int(passes.groupby("service_date").size().max() * 3)
+        chunks = PassChunks(data_dir, tile, "2024-06", 2024, max_passes=budget)
+        most = max(most, len(chunks.bounds()))
+        timings: dict = {}
+        groups, bins, n = part._fused_sums(ctx, tile, chunks, geometry, timings)
+        assert n == len(passes) and timings["passes_s"] > 0
+        got = part.partition_tables(None, None, 6, ctx, groups=groups, bins=bins)
+        groups, bins, _ = part._fused_sums(ctx, tile, [passes], geometry, {})
+        want = part.partition_tables(None, None, 6, ctx, groups=groups, bins=bins)
+        for a, b in zip(want, got):
+            assert a.equals(b), tile
+    assert most >= 5
 
 
 def test_a_tile_task_leaves_no_packed_geometry_no_task_can_find(small_run, small_config, tmp_path):
@@ -197,6 +233,20 @@ def test_pass_groups_equal_the_numpy_reference(spread):
     np.testing.assert_allclose(g["run_s"], np.bincount(g["run"], dt), rtol=1e-12)
     np.testing.assert_allclose(g["hour_s"], np.bincount(hour, dt, 24), rtol=1e-12)
     assert (g["seg_n"] == np.bincount(pos)).all() and g["seg_s"].sum() == pytest.approx(dt.sum())
+
+    # positions among a wider set of ids, the passes in three parts adding to the same totals
+    extra = np.r_[seg.min() - 1, np.unique(seg), seg.max() + spread]
+    totals = dict(seg_s=np.zeros(len(extra)), hour_s=np.zeros(24),
+                  seg_n=np.zeros(len(extra), np.int64), hour_n=np.zeros(24, np.int64))
+    cuts = [0, 10_000, 30_000, n]
+    for a, b in zip(cuts, cuts[1:]):
+        part = passkernel.pass_groups(trip[a:b], day[a:b], seg[a:b], t[a:b], dt[a:b],
+                                      "Europe/Luxembourg", extra, totals)
+        assert (part["seg_pos"] == pos[a:b] + 1).all() and part["seg_s"] is totals["seg_s"]
+        assert (part["seg_hour"] % 24 == hour[a:b]).all()
+    assert (totals["seg_n"][1:-1] == g["seg_n"]).all() and totals["seg_n"][[0, -1]].sum() == 0
+    assert (totals["seg_s"][1:-1] == g["seg_s"]).all() and (totals["hour_s"] == g["hour_s"]).all()
+    assert (totals["hour_n"] == g["hour_n"]).all()
 
 
 def test_utc_offsets_from_the_cached_table_equal_pandas_conversion():

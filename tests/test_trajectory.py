@@ -257,6 +257,32 @@ def test_iter_passes_equals_brute_force(lux):
     assert iter_passes(d, "E9999N9999", "2024-03").empty
 
 
+def test_pass_chunks_are_whole_service_days_that_make_up_the_month(lux):
+    """A partition's passes a few service days at a time: in order, each chunk whole days
+    and at most the budget unless one day alone is more, together iter_passes' frame."""
+    from vipvflow.inputs.gtfs import PassChunks
+
+    d, _ = lux
+    tile = _read(d, "segments.parquet")["tile"].value_counts().index[0]
+    whole = iter_passes(d, tile, "2024-03", 2024)
+    per_day = whole.groupby("service_date").size()
+    budget = int(per_day.max() * 2.5)
+    chunks = PassChunks(d, tile, "2024-03", 2024, max_passes=budget)
+    parts = list(chunks)
+    assert chunks.n == len(whole) and 3 < len(parts) < len(per_day)
+    days = [set(p["service_date"]) for p in parts]
+    assert all(not (a & b) for a, b in zip(days, days[1:]))          # no day in two chunks
+    assert all(len(p) <= budget or len(days[i]) == 1 for i, p in enumerate(parts))
+    # a chunk is as full as the next day allows
+    assert all(len(p) + per_day[min(days[i + 1])] > budget for i, p in enumerate(parts[:-1]))
+    joined = pd.concat(parts, ignore_index=True)
+    pd.testing.assert_frame_equal(joined, whole)
+    one_day = list(PassChunks(d, tile, "2024-03", 2024, max_passes=1))
+    assert len(one_day) == len(per_day)
+    assert PassChunks(d, "E9999N9999", "2024-03").n == 0
+    assert not list(PassChunks(d, "E9999N9999", "2024-03"))
+
+
 # ---- driving cycles ------------------------------------------------------------------------
 
 def _cycle_checks(cyc, stops, length, cfg):

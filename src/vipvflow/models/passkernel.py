@@ -608,7 +608,8 @@ def _offsets(timezone: str, h_lo: int, h_hi: int) -> np.ndarray:
     return ((local - span.tz_localize(None)) / pd.Timedelta(seconds=1)).to_numpy(np.float64)
 
 
-def pass_groups(trip_code, day, seg, t_utc, dt, timezone: str) -> dict:
+def pass_groups(trip_code, day, seg, t_utc, dt, timezone: str, seg_ids=None,
+                totals: dict | None = None) -> dict:
     """The (trip, date) run, segment and local hour of every pass, in one compiled loop.
 
     Parameters
@@ -619,25 +620,41 @@ def pass_groups(trip_code, day, seg, t_utc, dt, timezone: str) -> dict:
     t_utc : (n,) float64, Unix s
     dt : (n,) float64, s on the segment
     timezone : str, IANA name of the local clock
+    seg_ids : (m,) int64, optional, sorted distinct segment ids holding every id of *seg*
+        (the positions index them; default: the distinct ids of *seg*)
+    totals : dict, optional, the ``seg_s, seg_n, hour_s, hour_n`` of earlier passes (with
+        *seg_ids*), which these passes' are added to, pass after pass: a partition's passes
+        in chunks give the sums of all at once, bit for bit
 
     Returns
     -------
     dict of arrays: ``run``, ``seg_pos`` (position among the sorted distinct ``seg_ids``),
     ``seg_hour`` (``seg_pos x 24 +`` the local hour 0..23), ``starts`` (first pass
     of each run), ``seg_ids``; and per run, segment and hour the seconds ``run_s, seg_s,
-    hour_s`` and the pass counts ``seg_n, hour_n``.
+    hour_s`` and the pass counts ``seg_n, hour_n`` (*totals*' arrays when given).
     """
     trip_code, day, seg, t_utc, dt = (_writable(a) for a in (trip_code, day, seg, t_utc, dt))
     n = len(seg)
-    lo, hi = (int(seg.min()), int(seg.max())) if n else (0, 0)
-    if hi - lo > 8 * n + 1024:          # sparse ids: positions by sorting
-        seg_ids, seg = np.unique(seg, return_inverse=True)
-        seg, lo, seg_pos_of = _writable(seg.astype(np.int64)), 0, np.arange(len(seg_ids))
+    if seg_ids is not None:
+        seg_ids = np.asarray(seg_ids, np.int64)
+        lo, hi = (int(seg_ids[0]), int(seg_ids[-1])) if len(seg_ids) else (0, 0)
     else:
+        lo, hi = (int(seg.min()), int(seg.max())) if n else (0, 0)
+    if hi - lo > 8 * max(n, len(seg_ids) if seg_ids is not None else 0) + 1024:
+        # sparse ids: positions by sorting
+        if seg_ids is None:
+            seg_ids, seg = np.unique(seg, return_inverse=True)
+        else:
+            seg = np.searchsorted(seg_ids, seg)
+        seg, lo, seg_pos_of = _writable(seg.astype(np.int64)), 0, np.arange(len(seg_ids))
+    elif seg_ids is None:
         present = np.zeros(hi - lo + 1, bool)
         present[seg - lo] = True
         seg_pos_of = np.cumsum(present) - 1
         seg_ids = np.flatnonzero(present) + lo if n else seg[:0]
+    else:
+        seg_pos_of = np.full(hi - lo + 1, -1, np.int64)
+        seg_pos_of[seg_ids - lo] = np.arange(len(seg_ids))
     h_lo = int(np.floor(t_utc.min() / 3600.0)) if n else 0
     h_hi = int(np.floor(t_utc.max() / 3600.0)) if n else 0
     offset = utc_offsets(timezone, h_lo, h_hi)
@@ -649,9 +666,10 @@ def pass_groups(trip_code, day, seg, t_utc, dt, timezone: str) -> dict:
     if n:
         new_run[0] = True
         np.not_equal(out["run"][1:], out["run"][:-1], out=new_run[1:])
-    out.update(starts=np.flatnonzero(new_run), seg_ids=seg_ids, run_s=np.zeros(n_runs),
-               seg_s=np.zeros(len(seg_ids)), hour_s=np.zeros(24),
-               seg_n=np.zeros(len(seg_ids), np.int64), hour_n=np.zeros(24, np.int64))
+    if totals is None:
+        totals = dict(seg_s=np.zeros(len(seg_ids)), hour_s=np.zeros(24),
+                      seg_n=np.zeros(len(seg_ids), np.int64), hour_n=np.zeros(24, np.int64))
+    out.update(starts=np.flatnonzero(new_run), seg_ids=seg_ids, run_s=np.zeros(n_runs), **totals)
     _seconds(out["run"], out["seg_pos"], hour, dt, out["run_s"], out["seg_s"],
              out["hour_s"], out["seg_n"], out["hour_n"])
     return out
@@ -876,7 +894,7 @@ def evaluate_block(seg, t_start, dt, mid, row, geo, cfg, radiation_table, scene,
 
 
 def accumulate(seg, t_start, dt, mid, row, geo, cfg, radiation_table, scene, seg_hour, n_seg_hour,
-               run, n_runs, loc_of_row=None, timings: dict | None = None):
+               run, n_runs, loc_of_row=None, timings: dict | None = None, seg_bins=None):
     """Irradiation of every pass summed into bins, without per-pass outputs.
 
     Parameters
@@ -885,6 +903,9 @@ def accumulate(seg, t_start, dt, mid, row, geo, cfg, radiation_table, scene, seg
         as in :func:`evaluate_block`
     seg_hour : (n,) int64, bin of each pass (segment x 24 + local hour), < *n_seg_hour*
     run : (n,) int64, (trip, service date) run of each pass, < *n_runs*
+    seg_bins : (n_seg_hour, 14) float64, optional, the bins of earlier passes, which these
+        passes are added to, pass after pass (a partition's passes in chunks: the sums of
+        all at once, bit for bit); default new bins of zeros
 
     Returns
     -------
@@ -892,7 +913,10 @@ def accumulate(seg, t_start, dt, mid, row, geo, cfg, radiation_table, scene, seg
     run_bins : (n_runs, 14) float64, Wh/m2 per run
     """
     seg, t_start, dt, row, seg_hour, run = (_writable(a) for a in (seg, t_start, dt, row, seg_hour, run))
-    seg_bins = np.zeros((n_seg_hour, len(BLOCK_COLUMNS)))
+    if seg_bins is None:
+        seg_bins = np.zeros((n_seg_hour, len(BLOCK_COLUMNS)))
+    elif seg_bins.shape != (n_seg_hour, len(BLOCK_COLUMNS)) or not seg_bins.flags.c_contiguous:
+        raise ValueError(f"seg_bins must be C-contiguous ({n_seg_hour}, {len(BLOCK_COLUMNS)})")
     run_bins = np.zeros((n_runs, len(BLOCK_COLUMNS)))
 
     finish = _finisher(row, dt, True, _NO_BLOCK, _NO_VISIBLE, seg_hour, run, seg_bins, run_bins)

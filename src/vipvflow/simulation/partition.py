@@ -291,9 +291,11 @@ def _dense_positions(ids: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return np.flatnonzero(present) + lo, pos[ids - lo]
 
 
-def partition_groups(passes: pd.DataFrame, ctx: RunContext) -> dict:
+def partition_groups(passes: pd.DataFrame, ctx: RunContext, seg_ids=None,
+                     totals: dict | None = None) -> dict:
     """Each pass's (trip, service date) run, segment position and local hour, and the
-    seconds per run, segment and hour (:func:`vipvflow.models.passkernel.pass_groups`).
+    seconds per run, segment and hour (:func:`vipvflow.models.passkernel.pass_groups`, with
+    its *seg_ids* and *totals*).
 
     Returns its dict with ``trip_code`` and ``day`` (days since 1970) of each run, the trip
     names ``trip_uniques`` the codes index, and ``dt`` (n,) s on the segment.  The runs come
@@ -312,7 +314,7 @@ def partition_groups(passes: pd.DataFrame, ctx: RunContext) -> dict:
     day = passes["service_date"].to_numpy().astype("datetime64[D]").astype(np.int64)
     dt = np.ascontiguousarray(passes["dt_s"].to_numpy(np.float64))
     g = pass_groups(trip_code, day, passes["segment_id"].to_numpy(np.int64),
-                    passes["t_utc"].to_numpy(np.float64), dt, ctx.timezone)
+                    passes["t_utc"].to_numpy(np.float64), dt, ctx.timezone, seg_ids, totals)
     # the trip and date of each run, not of each pass (16 bytes a pass held through the kernel)
     g.update(trip_code=trip_code[g["starts"]], trip_uniques=trip_uniques, day=day[g["starts"]], dt=dt)
     return g
@@ -362,12 +364,14 @@ def partition_tables(passes: pd.DataFrame, irr: pd.DataFrame | None, month: int,
     Parameters
     ----------
     passes : DataFrame of the partition's passes (``trip_id, service_date, segment_id,
-        t_utc, dt_s, speed_mps``), in :func:`vipvflow.inputs.gtfs.iter_passes` order
+        t_utc, dt_s, speed_mps``), in :func:`vipvflow.inputs.gtfs.iter_passes` order; None
+        with *groups* and *bins*
     irr : DataFrame of per-pass irradiance (W/m2, :func:`vipvflow.models.irradiance.evaluate_passes`),
         or None with *bins*
     month : int, 1..12 (the month's air temperature in ``pvlib`` mode)
     ctx : RunContext
     groups : dict, optional, :func:`partition_groups` of *passes* when the caller has it
+        (with *bins*: per segment of *seg_ids*, those without passes left out)
     bins : (seg_bins, run_bins), optional, irradiation (Wh/m2) already summed per (segment x
         24 + local hour) bin and per run, columns ``COMPONENTS`` (the fused kernel,
         :func:`vipvflow.models.passkernel.accumulate`); only in the linear ``paper`` PV mode
@@ -388,8 +392,7 @@ def partition_tables(passes: pd.DataFrame, irr: pd.DataFrame | None, month: int,
     pv_source = {**{f"pv_kwh{suffix}": col for suffix, col in VARIANTS.items()},
                  **{f"pv_kwh_{c}": c for c in PV_COMPONENTS}}
     g = groups if groups is not None else partition_groups(passes, ctx)
-    dt, run, seg_pos, starts = g["dt"], g["run"], g["seg_pos"], g["starts"]
-    n_runs, seg_ids = len(starts), g["seg_ids"]
+    n_runs, seg_ids, seg_n, seg_s = len(g["trip_code"]), g["seg_ids"], g["seg_n"], g["seg_s"]
     n_seg = len(seg_ids)
     if bins is None:
         table, per_run, comp, act = _irradiation_sums(irr, g, n_seg, n_runs)
@@ -398,6 +401,11 @@ def partition_tables(passes: pd.DataFrame, irr: pd.DataFrame | None, month: int,
             raise ValueError("summed bins need the linear 'paper' PV mode")
         table, per_run = bins
     table = table.reshape(n_seg, 24, len(COMPONENTS))
+    if bins is not None and not seg_n.all():
+        # bins of a tile's segments (passes in chunks): the segments with passes
+        kept = seg_n > 0
+        table, seg_ids, seg_n, seg_s = table[kept], seg_ids[kept], seg_n[kept], seg_s[kept]
+        n_seg = len(seg_ids)
     sums = {"trip": {}, "seg": {}, "hour": {}}
     for j, c in enumerate(COMPONENTS):
         t_c = np.ascontiguousarray(table[:, :, j])
@@ -414,15 +422,16 @@ def partition_tables(passes: pd.DataFrame, irr: pd.DataFrame | None, month: int,
                 sums[grp][name] = k * sums[grp][f"h_{col}"]
     else:
         speed = passes["speed_mps"].to_numpy(np.float64)[act]
+        dt, run, seg_pos = g["dt"], g["run"], g["seg_pos"]
         for name, col in pv_source.items():
             e = pv_energy_kwh(comp[col][act].astype(np.float64), dt[act], speed, month, ctx)
             sums["trip"][name] = np.bincount(run[act], e, n_runs)
             sums["seg"][name] = np.bincount(seg_pos[act], e, n_seg)
     pv_cols = list(pv_source)
     h_cols = [f"h_{c}" for c in COMPONENTS]
-    trip = _trip_table(passes, g, {**{c: sums["trip"][c] for c in pv_cols}, "seconds": g["run_s"]})
-    segm = pa.table({"segment_id": seg_ids, "n_passes": g["seg_n"],
-                     **{c: sums["seg"][c] for c in pv_cols + h_cols}, "seconds": g["seg_s"]})
+    trip = _trip_table(g, {**{c: sums["trip"][c] for c in pv_cols}, "seconds": g["run_s"]})
+    segm = pa.table({"segment_id": seg_ids, "n_passes": seg_n,
+                     **{c: sums["seg"][c] for c in pv_cols + h_cols}, "seconds": seg_s})
     present = np.flatnonzero(g["hour_n"] > 0)
     hourly = pa.table({"hour": present.astype(np.int8),
                        **{c: sums["hour"][c][present] for c in h_cols},
@@ -430,17 +439,16 @@ def partition_tables(passes: pd.DataFrame, irr: pd.DataFrame | None, month: int,
     return trip, segm, hourly
 
 
-def _trip_table(passes: pd.DataFrame, g: dict, per_run: dict):
+def _trip_table(g: dict, per_run: dict):
     """The runs' sums *per_run* (name -> (n_runs,) array) as an Arrow table per trip and
     service date, sorted by both (trip codes follow the sorted trip names); a (trip, date)
     split over several runs is merged."""
     import pyarrow as pa
 
-    starts = g["starts"]
     code, day = g["trip_code"], g["day"]
     order = np.lexsort((day, code))
     code, day = code[order], day[order]
-    dates = passes["service_date"].to_numpy()[starts][order]
+    dates = day.astype("datetime64[D]").astype("datetime64[ns]")
     cols = {c: v[order] for c, v in per_run.items()}
     first = np.flatnonzero(np.r_[True, (code[1:] != code[:-1]) | (day[1:] != day[:-1])])
     if len(first) < len(code):
@@ -452,13 +460,21 @@ def _trip_table(passes: pd.DataFrame, g: dict, per_run: dict):
                      "service_date": dates, **cols})
 
 
-def _fused_sums(ctx: RunContext, tile: str, passes: pd.DataFrame, geometry: pd.DataFrame,
-                timings: dict):
+def _fused_sums(ctx: RunContext, tile: str, chunks, geometry: pd.DataFrame, timings: dict):
     """The partition's irradiation summed by the fused kernel (:mod:`vipvflow.models.passkernel`)
     into (segment, local hour) and (trip, date) bins, without per-pass outputs; None where
-    the kernel cannot run (geometry not in the scene's frame).  Adds its stages to
-    *timings* (``irradiance_*`` like :func:`vipvflow.models.irradiance.evaluate_passes`; the pass
-    grouping to ``reduce_s``)."""
+    the kernel cannot run (geometry not in the scene's frame).
+
+    *chunks* gives the partition's passes as frames of consecutive service days, in pass
+    order (:class:`vipvflow.inputs.gtfs.PassChunks`, or a list of one frame).  Each chunk is
+    grouped and run through the kernel, which adds it to the bins of the tile's segments,
+    pass after pass: the sums are those of all the passes at once, bit for bit, while only
+    one chunk's passes are held.  Returns (groups, bins, passes): :func:`partition_groups`'s
+    dict over the chunks (per run, and per segment of the tile's geometry), the bins as
+    :func:`partition_tables` takes them.  Adds to *timings* the pass generation
+    (``passes_s``), the grouping (``reduce_s``) and the kernel (``irradiance_s`` and its
+    stages, like :func:`vipvflow.models.irradiance.evaluate_passes`).
+    """
     from ..models import passkernel
 
     t0 = time.perf_counter()
@@ -467,28 +483,59 @@ def _fused_sums(ctx: RunContext, tile: str, passes: pd.DataFrame, geometry: pd.D
     if not passkernel.usable(geo, scene):
         return None
     radiation = _radiation(ctx.data_dir, ctx.year)
+    cfg = IrradianceCfg(**ctx.irradiance)
     ids = geometry["segment_id"].to_numpy(np.int64)
     pos = np.full(int(ids.max()) + 1 if len(ids) else 1, -1, np.int64)
     pos[ids] = np.arange(len(ids))
-    seg = np.ascontiguousarray(passes["segment_id"].to_numpy(np.int64))
-    if seg.max() >= len(pos) or seg.min() < 0 or (pos[seg] < 0).any():
-        raise KeyError("passes reference segments missing from the geometry")
+    seg_ids = np.unique(ids)
     loc = geometry["rad_location"].to_numpy(np.int64) if "rad_location" in geometry else None
-    t1 = time.perf_counter()
-    groups = partition_groups(passes, ctx)
-    seg_hour = groups["seg_hour"]
-    t2 = time.perf_counter()
+    n_bins = len(seg_ids) * 24
+    totals = dict(seg_s=np.zeros(len(seg_ids)), hour_s=np.zeros(24),
+                  seg_n=np.zeros(len(seg_ids), np.int64), hour_n=np.zeros(24, np.int64))
+    seg_bins = np.zeros((n_bins, len(passkernel.BLOCK_COLUMNS)))
+    per_run: dict = {"trip_code": [], "day": [], "run_s": [], "bins": []}
     stages: dict = {}
-    seg_bins, run_bins = passkernel.accumulate(
-        seg, np.ascontiguousarray(passes["t_utc"].to_numpy(np.float64)), groups["dt"], True,
-        pos[seg], geo, IrradianceCfg(**ctx.irradiance), radiation, scene, seg_hour,
-        len(groups["seg_ids"]) * 24, groups["run"], len(groups["starts"]), loc, stages)
-    t3 = time.perf_counter()
-    order = [passkernel.BLOCK_COLUMNS.index(c) for c in COMPONENTS]
-    timings["irradiance_s"] = (t1 - t0) + (t3 - t2)
+    clock = {"passes_s": 0.0, "reduce_s": 0.0, "irradiance_s": time.perf_counter() - t0}
+    n, uniques, chunks = 0, None, iter(chunks)
+    while True:
+        t1 = time.perf_counter()
+        passes = next(chunks, None)
+        t2 = time.perf_counter()
+        clock["passes_s"] += t2 - t1
+        if passes is None:
+            break
+        seg = np.ascontiguousarray(passes["segment_id"].to_numpy(np.int64))
+        if len(seg) and (seg.max() >= len(pos) or seg.min() < 0 or (pos[seg] < 0).any()):
+            raise KeyError("passes reference segments missing from the geometry")
+        g = partition_groups(passes, ctx, seg_ids, totals)
+        if uniques is None:
+            uniques = g["trip_uniques"]
+        elif g["trip_uniques"] is not uniques and not g["trip_uniques"].equals(uniques):
+            raise ValueError("the chunks of a partition must share their trip categories")
+        t3 = time.perf_counter()
+        _, run_bins = passkernel.accumulate(
+            seg, np.ascontiguousarray(passes["t_utc"].to_numpy(np.float64)), g["dt"], True,
+            pos[seg], geo, cfg, radiation, scene, g["seg_hour"], n_bins, g["run"],
+            len(g["starts"]), loc, stages, seg_bins=seg_bins)
+        clock["reduce_s"] += t3 - t2
+        clock["irradiance_s"] += time.perf_counter() - t3
+        for k in ("trip_code", "day", "run_s"):
+            per_run[k].append(g[k])
+        per_run["bins"].append(run_bins)
+        n += len(passes)
+        del passes, g, seg
+    for k, v in clock.items():
+        timings[k] = timings.get(k, 0.0) + v
     timings.update({f"irradiance_{k}": v for k, v in stages.items()})
-    timings["reduce_s"] = t2 - t1
-    return groups, (seg_bins[:, order], run_bins[:, order])
+    order = [passkernel.BLOCK_COLUMNS.index(c) for c in COMPONENTS]
+    if not per_run["bins"]:
+        per_run = {"trip_code": [np.zeros(0, np.int64)], "day": [np.zeros(0, np.int64)],
+                   "run_s": [np.zeros(0)], "bins": [np.zeros((0, seg_bins.shape[1]))]}
+    groups = {k: np.concatenate(v) for k, v in per_run.items() if k != "bins"}
+    groups.update(seg_ids=seg_ids, trip_uniques=uniques if uniques is not None else pd.Index([]),
+                  **totals)
+    run_bins = np.concatenate(per_run["bins"])
+    return groups, (seg_bins[:, order], run_bins[:, order]), n
 
 
 def run_partition(ctx: RunContext, tile: str, month: str,
@@ -499,9 +546,11 @@ def run_partition(ctx: RunContext, tile: str, month: str,
     all-sky, clear-sky and the unshaded references, and per component) and
     ``parts/segment_month/...`` (per segment: passes, irradiation sums in Wh/m2, kWh) and
     ``parts/hourly/...`` (per local hour: irradiation and pass time, for the daily pattern).
+    The fused kernel takes the passes a few service days at a time
+    (:class:`vipvflow.inputs.gtfs.PassChunks`); the numpy reference all at once.
     Returns a small summary for the progress view.
     """
-    from ..inputs.gtfs import iter_passes
+    from ..inputs.gtfs import PassChunks
     from ..models.irradiance import evaluate_passes
 
     tune_malloc()
@@ -509,20 +558,25 @@ def run_partition(ctx: RunContext, tile: str, month: str,
     run = RunDir(ctx.run_dir)
     if geometry is None:
         geometry = tile_geometry(ctx, tile)
-    passes = iter_passes(ctx.data_dir, tile, month, ctx.year, routes=ctx.routes)
+    chunks = PassChunks(ctx.data_dir, tile, month, ctx.year, routes=ctx.routes)
     timings = {"passes_s": time.perf_counter() - t0}
-    n = len(passes)
-    seg = _segments(ctx.data_dir)
+    n = chunks.n
     fused = None
     if n and ctx.pv_mode == "paper":
-        fused = _fused_sums(ctx, tile, passes, geometry, timings)
+        fused = _fused_sums(ctx, tile, chunks, geometry, timings)
+    passes = None
+    if fused is None:
+        t1 = time.perf_counter()
+        passes = chunks.all()
+        timings["passes_s"] += time.perf_counter() - t1
     if fused is not None:
         irr = None
     elif n:
         t1 = time.perf_counter()
         stages: dict = {}
         scene = _scene(ctx, tile)
-        irr = evaluate_passes(passes, seg, geometry, _radiation(ctx.data_dir, ctx.year),
+        irr = evaluate_passes(passes, _segments(ctx.data_dir), geometry,
+                              _radiation(ctx.data_dir, ctx.year),
                               scene, IrradianceCfg(**ctx.irradiance),
                               ground_albedo=ctx.ground_albedo,
                               packed=_packed_geometry(ctx, tile, geometry, scene), timings=stages)
@@ -533,8 +587,8 @@ def run_partition(ctx: RunContext, tile: str, month: str,
         irr = pd.DataFrame({c: np.zeros(0, np.float32) for c in COMPONENTS})
     t2 = time.perf_counter()
     if fused is not None:
-        groups, bins = fused
-        trip, segm, hourly = partition_tables(passes, None, int(month[5:7]), ctx,
+        groups, bins, _ = fused
+        trip, segm, hourly = partition_tables(None, None, int(month[5:7]), ctx,
                                               groups=groups, bins=bins)
     else:
         trip, segm, hourly = partition_tables(passes, irr, int(month[5:7]), ctx)

@@ -330,18 +330,66 @@ def iter_passes(data_dir, tile: str, month, year: int | None = None,
         sorted by service date, trip and time. A pass belongs to the month of its service
         date (see module doc). Only this month and this tile are ever held in memory.
     """
-    period = _parse_month(month, year)
-    gdir = DataDir(data_dir).gtfs.root.resolve()
-    stamp = _stamp(gdir, _GTFS_TABLES)
-    pat = _tile_patterns(str(gdir), tile, stamp)
-    if pat.empty:
-        return _empty_passes()
-    runs = _month_runs(str(gdir), str(period), None if routes is None else
-                       tuple(sorted(str(r) for r in routes)), stamp)
-    runs = runs[runs["pattern_id"].isin(pat.attrs["pattern_ids"])]
-    if runs.empty:
-        return _empty_passes()
-    return _expand(runs, pat)
+    return PassChunks(data_dir, tile, month, year, routes).all()
+
+
+#: passes of one :class:`PassChunks` chunk at most, unless one service day has more (a
+#: chunk's passes take ~100 bytes each through the irradiance kernel)
+PASS_CHUNK = 1 << 21
+
+
+class PassChunks:
+    """The passes of :func:`iter_passes` in chunks of whole service days, in order.
+
+    Iterating gives DataFrames (columns and order as :func:`iter_passes`) of consecutive
+    service days, each of at most *max_passes* passes unless one day alone has more; their
+    concatenation is :func:`iter_passes`'s frame.  ``n`` is the number of passes of all
+    chunks, known before any is made.  A (trip, service date) is never split over two chunks.
+    """
+
+    def __init__(self, data_dir, tile: str, month, year: int | None = None, routes=None,
+                 max_passes: int = PASS_CHUNK):
+        period = _parse_month(month, year)
+        self.max_passes = int(max_passes)
+        gdir = DataDir(data_dir).gtfs.root.resolve()
+        stamp = _stamp(gdir, _GTFS_TABLES)
+        self._pat = _tile_patterns(str(gdir), tile, stamp)
+        self._runs = None
+        if not self._pat.empty:
+            runs = _month_runs(str(gdir), str(period), None if routes is None else
+                               tuple(sorted(str(r) for r in routes)), stamp)
+            runs = runs[runs["pattern_id"].isin(self._pat.attrs["pattern_ids"])]
+            if not runs.empty:
+                self._runs = runs
+        self._per_run = np.zeros(0, np.int64)
+        if self._runs is not None:
+            uniq, count = np.unique(self._pat["pattern_id"].to_numpy(), return_counts=True)
+            self._per_run = count[np.searchsorted(uniq, self._runs["pattern_id"].to_numpy())]
+        self.n = int(self._per_run.sum())
+
+    def all(self) -> pd.DataFrame:
+        """Every pass in one frame (:func:`iter_passes`)."""
+        return _empty_passes() if self._runs is None else _expand(self._runs, self._pat)
+
+    def bounds(self) -> list[tuple[int, int]]:
+        """The chunks' run ranges ``[a, b)`` (rows of the month's runs, sorted by date)."""
+        if self._runs is None:
+            return []
+        dates = self._runs["service_date"].to_numpy()
+        day0 = np.flatnonzero(np.r_[True, dates[1:] != dates[:-1]])
+        per_day = np.add.reduceat(self._per_run, day0)
+        out, a, held = [], 0, 0
+        for k, n in enumerate(per_day.tolist()):
+            if held and held + n > self.max_passes:
+                out.append((a, int(day0[k])))
+                a, held = int(day0[k]), 0
+            held += n
+        out.append((a, len(self._runs)))
+        return out
+
+    def __iter__(self):
+        for a, b in self.bounds():
+            yield _expand(self._runs.iloc[a:b], self._pat)
 
 
 def clear_caches() -> None:
