@@ -452,3 +452,15 @@ def test_reingest_replaces_gtfs_folder_as_a_whole(tmp_path):
     assert not stale.exists()
     assert json.loads((tmp_path / "gtfs" / "feed.json").read_text())["counts"] == before
     assert sorted(p.name for p in tmp_path.iterdir()) == ["gtfs"]
+
+
+def test_month_labels_are_strftime_of_each_date():
+    """Months formatted once per distinct date are those of each row's strftime, with the
+    same string dtype, missing where the date is."""
+    from vipvflow.inputs.gtfs.schedule import month_labels
+
+    dates = pd.Series(pd.to_datetime(["2024-03-31", "2024-04-01", None, "2024-03-31", "2023-12-31"]))
+    want = dates.dt.strftime("%Y-%m")
+    got = pd.Series(month_labels(dates))
+    pd.testing.assert_series_equal(got, want)
+    assert got.isna().tolist() == [False, False, True, False, False]

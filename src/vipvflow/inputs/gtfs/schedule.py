@@ -586,11 +586,12 @@ def block_timeline(data_dir, year: int, months=None, routes=None, depot=None,
                    else int(dp.mode().iloc[0]) if len(dp) else -1)
     idle, n_buses = _idle_buses(bd, year, months, fleet_depot, tz)
     iv = pd.concat([am.assign(buses=1), lay.assign(buses=1), pm.assign(buses=1), idle], ignore_index=True)
+    del am, lay, pm, idle
     iv = iv[iv["t1_utc"] > iv["t0_utc"]]
     iv = iv.sort_values(_BLOCK_DAY + ["t0_utc"], kind="stable").reset_index(drop=True)
     iv = iv.rename(columns={"date": "service_date"}).astype({"point_id": np.int64, "after_trip": np.int64,
                                                              "buses": np.int64})
-    iv["month"] = iv["service_date"].dt.strftime("%Y-%m")
+    iv["month"] = month_labels(iv["service_date"])
     bd = _block_day_totals(bd, runs, over, iv)
     trip_runs = pd.DataFrame({"trip_id": runs["trip_id"].astype(str), "service_date": runs["date"],
                               "block_id": runs["block_id"].astype(str), "position": pos})
@@ -599,6 +600,15 @@ def block_timeline(data_dir, year: int, months=None, routes=None, depot=None,
 
 #: the columns that name a block-day
 _BLOCK_DAY = ["block_id", "date"]
+
+
+def month_labels(dates):
+    """``YYYY-MM`` of each of *dates*, as ``Series.dt.strftime("%Y-%m")`` gives it (a string
+    array, missing where a date is), formatted once per distinct date: a network's millions
+    of rows share a few hundred dates, and a string object each cost ~0.3 GB."""
+    codes, uniq = pd.factorize(pd.DatetimeIndex(pd.to_datetime(dates)))
+    labels = pd.Series(uniq).dt.strftime("%Y-%m").array
+    return labels.take(codes, allow_fill=True)
 
 
 def _block_trips(data_dir, routes):
@@ -649,6 +659,11 @@ def _timeline_points(data_dir, trips, ends, depot, depot_shading: str):
     return pts, stop_point, depot_point
 
 
+#: the trips' columns of the timeline's runs (:func:`_block_runs`)
+_RUN_COLUMNS = ["trip_id", "service_id", "block_id", "first_stop_id", "last_stop_id", "start_s",
+                "end_s"]
+
+
 def _block_runs(data_dir, trips, year: int, months):
     """(runs of the year's months and of the day before each, in block, date and time order,
     with UTC times ``t0, t1`` and the service day ``day0, day1``; the feed's time zone)."""
@@ -658,14 +673,15 @@ def _block_runs(data_dir, trips, year: int, months):
     in_run = sd["date"].dt.month.isin(list(months)) if months is not None else pd.Series(True, sd.index)
     before = (sd["date"] + pd.Timedelta(days=1)).dt.month.isin(list(months)) if months is not None else in_run
     sd = sd.assign(in_run=in_run)[in_run | (before & (sd["date"] + pd.Timedelta(days=1)).dt.year.eq(year))]
-    runs = trips.merge(sd, on="service_id")
+    # a trip's columns repeat on each of its days: only those the timeline uses
+    runs = trips[_RUN_COLUMNS].merge(sd, on="service_id").drop(columns="service_id")
     tz = _feed_info(data_dir)["timezone"]
     udates = np.unique(runs["date"].to_numpy()) if len(runs) else np.zeros(0, "datetime64[ns]")
     origin = service_day_origin_utc(udates, tz)
     next_origin = service_day_origin_utc(udates + np.timedelta64(1, "D"), tz)
     k = np.searchsorted(udates, runs["date"].to_numpy())
-    runs = runs.assign(t0=origin[k] + runs["start_s"].to_numpy(float),
-                       t1=origin[k] + runs["end_s"].to_numpy(float),
+    runs = runs.assign(t0=origin[k] + runs.pop("start_s").to_numpy(float),
+                       t1=origin[k] + runs.pop("end_s").to_numpy(float),
                        day0=origin[k], day1=next_origin[k])
     runs = runs.sort_values(["block_id", "date", "t0", "trip_id"], kind="stable").reset_index(drop=True)
     return runs, tz
@@ -691,14 +707,21 @@ def _block_days(runs):
 def _layovers(runs, stop_point: dict):
     """Layovers from a trip's arrival to the next trip's departure of the same block-day;
     (layovers, overlaps of trips that run into the next, trip positions in the block-day)."""
-    same = ((runs["block_id"].to_numpy()[1:] == runs["block_id"].to_numpy()[:-1])
-            & (runs["date"].to_numpy()[1:] == runs["date"].to_numpy()[:-1]))
+    # the runs come sorted by block-day: a block-day's runs are consecutive (the blocks'
+    # codes compared, not their strings as Python objects: millions of them at network scale)
+    block = pd.factorize(runs["block_id"])[0]
+    date = runs["date"].to_numpy()
+    same = (block[1:] == block[:-1]) & (date[1:] == date[:-1])
+    del block
     a = np.flatnonzero(same)
-    pos = runs.groupby(_BLOCK_DAY, sort=False).cumcount().to_numpy()
+    idx = np.arange(len(runs))
+    pos = idx - np.maximum.accumulate(np.where(np.r_[True, ~same], idx, 0)) if len(runs) else idx
+    del idx
     gap = runs["t0"].to_numpy()[a + 1] - runs["t1"].to_numpy()[a]
-    lay = pd.DataFrame({"block_id": runs["block_id"].to_numpy()[a], "date": runs["date"].to_numpy()[a],
+    stop, stops = pd.factorize(runs["last_stop_id"], use_na_sentinel=False)
+    lay = pd.DataFrame({"block_id": runs["block_id"].array[a], "date": date[a],
                         "kind": "layover", "after_trip": pos[a],
-                        "point_id": runs["last_stop_id"].map(stop_point).to_numpy()[a],
+                        "point_id": stops.map(stop_point).to_numpy()[stop[a]],
                         "t0_utc": runs["t1"].to_numpy()[a], "t1_utc": runs["t0"].to_numpy()[a + 1]})
     over = pd.DataFrame({"block_id": lay["block_id"], "date": lay["date"],
                          "overlap_s": np.maximum(-gap, 0.0)})
@@ -727,10 +750,14 @@ def _block_day_totals(bd, runs, over, iv):
     bd["driving_s"] = driving.to_numpy()
     bd["overlap_s"] = over.groupby(key, sort=True)["overlap_s"].sum().reindex(
         pd.MultiIndex.from_frame(bd[key]), fill_value=0.0).to_numpy() if len(over) else 0.0
-    own = iv[iv["block_id"] != IDLE_BLOCK].assign(s=iv["t1_utc"] - iv["t0_utc"])
+    # per kind the rows of the buses in service (a mask, not a copy of the intervals)
+    own = (iv["block_id"] != IDLE_BLOCK).to_numpy(bool)
+    s = iv["t1_utc"] - iv["t0_utc"]
+    days = pd.MultiIndex.from_frame(bd[key])
     for kind in TIMELINE_KINDS:
-        bd[f"{kind}_s"] = own[own["kind"] == kind].groupby(["block_id", "service_date"])["s"].sum().reindex(
-            pd.MultiIndex.from_frame(bd[key]), fill_value=0.0).to_numpy()
+        m = own & (iv["kind"] == kind).to_numpy(bool)
+        bd[f"{kind}_s"] = s[m].groupby([iv["block_id"][m], iv["service_date"][m]]).sum().reindex(
+            days, fill_value=0.0).to_numpy()
     bd = bd.rename(columns={"date": "service_date"}).drop(columns=["day0", "day1", "first_stop_id"])
-    bd["month"] = bd["service_date"].dt.strftime("%Y-%m")
+    bd["month"] = month_labels(bd["service_date"])
     return bd
