@@ -518,7 +518,7 @@ def block_day_table(cfg: Config, run_dir: Path, trip: pd.DataFrame, vehicle, pla
     month's mean temperature through the battery's discharge efficiency; the PV of layovers
     and parking counts only when ``fleet.harvest`` evaluates it.
     """
-    from ..inputs.gtfs.schedule import IDLE_BLOCK
+    from ..inputs.gtfs.schedule import IDLE_BLOCK, month_labels
 
     run = RunDir(run_dir)
     tl = pd.read_parquet(run.timeline_table("block_days"))
@@ -540,7 +540,7 @@ def block_day_table(cfg: Config, run_dir: Path, trip: pd.DataFrame, vehicle, pla
     # the buses in service: the columns summed below
     st = st.loc[~idle_rows, key + ["kind", "after_trip", "pv_kwh", "pv_kwh_clear"]]
     del idle_rows
-    idle["month"] = pd.to_datetime(idle["service_date"]).dt.strftime("%Y-%m")
+    idle["month"] = month_labels(idle["service_date"])
     idle["pv_kwh_curtailed"] = idle["pv_kwh"]            # an idle bus's battery is full
 
     bd = tl[key + ["month", "trips", "window_start_utc", "window_end_utc", "first_departure_utc",
@@ -572,7 +572,7 @@ def block_day_table(cfg: Config, run_dir: Path, trip: pd.DataFrame, vehicle, pla
     hand_back_memory()
     lay = lay.merge(pd.read_parquet(run.timeline_table("points"), columns=["point_id", "stop_id"]),
                     on="point_id", how="left").drop(columns="point_id")
-    lit = st[st["kind"].astype(str) == "layover"].groupby(key + ["after_trip"])["pv_kwh"].sum()
+    lit = st[st["kind"] == "layover"].groupby(key + ["after_trip"])["pv_kwh"].sum()
     lay["pv_kwh"] = lit.reindex(pd.MultiIndex.from_frame(lay[key + ["after_trip"]])).fillna(0.0).to_numpy()
     lay["seconds"] = (lay["t1_utc"] - lay["t0_utc"]).to_numpy(float)
     parked = parked.assign(seconds=(parked["t1_utc"] - parked["t0_utc"]).to_numpy(float))
@@ -886,6 +886,8 @@ def _trip_outputs(cfg: Config, year: int, run_dir: Path, totals: pd.DataFrame, p
     *totals*: the joins here keep their rows' order) and per block-day (driving, layovers,
     parked; the battery's share); writes ``trip_energy.parquet``.  Returns the trips, the
     block-days and the idle buses' days."""
+    from ..inputs.gtfs.schedule import month_labels
+
     meta = trips_meta.reindex(columns=["trip_id", "route_id", "route_short_name", "route_long_name",
                                        "trip_headsign", "direction_id", "shape_id", "service_id",
                                        "block_id", "pattern_id", "start_s"])
@@ -895,7 +897,7 @@ def _trip_outputs(cfg: Config, year: int, run_dir: Path, totals: pd.DataFrame, p
                if pd.api.types.is_string_dtype(meta[c].dtype)}
     trip = totals.merge(meta.astype({c: "category" for c in strings}), on="trip_id", how="left",
                         validate="many_to_one")
-    trip["month"] = pd.to_datetime(trip["service_date"]).dt.strftime("%Y-%m")
+    trip["month"] = month_labels(trip["service_date"])
     cons = trip_consumption(cfg, Path(cfg.data_dir), year, trip["pattern_id"].unique(),
                             vecto_dir=RunDir(run_dir).vecto, say=say, made=consumption)
     trip = trip.merge(cons, on=["pattern_id", "month"], how="left", validate="many_to_one")
