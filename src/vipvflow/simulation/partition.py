@@ -493,7 +493,9 @@ def _fused_sums(ctx: RunContext, tile: str, chunks, geometry: pd.DataFrame, timi
     totals = dict(seg_s=np.zeros(len(seg_ids)), hour_s=np.zeros(24),
                   seg_n=np.zeros(len(seg_ids), np.int64), hour_n=np.zeros(24, np.int64))
     seg_bins = np.zeros((n_bins, len(passkernel.BLOCK_COLUMNS)))
-    per_run: dict = {"trip_code": [], "day": [], "run_s": [], "bins": []}
+    # each run's trip, day, seconds and bins, chunk after chunk (from empty: no chunk, no run)
+    per_run = {"trip_code": [np.zeros(0, np.int64)], "day": [np.zeros(0, np.int64)],
+               "run_s": [np.zeros(0)], "bins": [np.zeros((0, seg_bins.shape[1]))]}
     stages: dict = {}
     clock = {"passes_s": 0.0, "reduce_s": 0.0, "irradiance_s": time.perf_counter() - t0}
     n, uniques, chunks = 0, None, iter(chunks)
@@ -528,9 +530,6 @@ def _fused_sums(ctx: RunContext, tile: str, chunks, geometry: pd.DataFrame, timi
         timings[k] = timings.get(k, 0.0) + v
     timings.update({f"irradiance_{k}": v for k, v in stages.items()})
     order = [passkernel.BLOCK_COLUMNS.index(c) for c in COMPONENTS]
-    if not per_run["bins"]:
-        per_run = {"trip_code": [np.zeros(0, np.int64)], "day": [np.zeros(0, np.int64)],
-                   "run_s": [np.zeros(0)], "bins": [np.zeros((0, seg_bins.shape[1]))]}
     groups = {k: np.concatenate(v) for k, v in per_run.items() if k != "bins"}
     groups.update(seg_ids=seg_ids, trip_uniques=uniques if uniques is not None else pd.Index([]),
                   **totals)

@@ -334,7 +334,7 @@ def iter_passes(data_dir, tile: str, month, year: int | None = None,
 
 
 #: passes of one :class:`PassChunks` chunk at most, unless one service day has more (a
-#: chunk's passes take ~100 bytes each through the irradiance kernel)
+#: chunk's passes take ~160 bytes each at the irradiance kernel's peak)
 PASS_CHUNK = 1 << 21
 
 
