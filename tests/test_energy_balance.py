@@ -7,6 +7,7 @@ import re
 
 import numpy as np
 import pandas as pd
+import pyarrow as pa
 import pyarrow.parquet as pq
 import pytest
 
@@ -202,3 +203,41 @@ def test_the_battery_in_chunks_is_the_battery_at_once(small_run, small_config, m
         pd.testing.assert_series_equal(trips_c["soc_at_departure"], trips["soc_at_departure"], check_exact=True)
         pd.testing.assert_frame_equal(traces_c, traces, check_exact=True)
     assert set(traces["which"]) == {"worst", "typical"}
+
+
+def test_block_day_rows_are_those_of_the_string_and_date_keys():
+    """Each row's block-day by integer codes (:class:`BlockDayRows`) is its row found by the
+    (block, date) pair, as strings or as categories; a block or a date of none of the
+    block-days, or a missing block, is -1; the sums spread per block-day are the groupby's."""
+    from vipvflow.simulation.reduce import BlockDayRows
+
+    rng = np.random.default_rng(7)
+    blocks = np.array(["b10", "b2", "a", "z 9", "b1"])
+    days = pd.date_range("2024-02-27", periods=5, freq="D")
+    bd = (pd.DataFrame([(b, d) for b in blocks for d in days if rng.random() < 0.7],
+                       columns=["block_id", "service_date"])
+          .sort_values(["block_id", "service_date"]).reset_index(drop=True))
+    n = 400
+    frame = pd.DataFrame({
+        "block_id": rng.choice(np.r_[blocks, ["nope"]], n).astype(object),
+        "service_date": pd.DatetimeIndex(rng.choice(np.r_[days, pd.DatetimeIndex(["2024-03-09"])], n)),
+        "v": rng.random(n)})
+    frame.loc[3, "block_id"] = None
+    expect = (pd.Series(np.arange(len(bd)), index=pd.MultiIndex.from_frame(bd))
+              .reindex(pd.MultiIndex.from_frame(frame[["block_id", "service_date"]]))
+              .to_numpy(dtype=float, na_value=np.nan))
+    expect = np.where(np.isfinite(expect), expect, -1).astype(np.int64)
+    rows = BlockDayRows(bd)
+    assert (expect >= 0).sum() > n // 3 and (expect < 0).sum() > n // 10
+    np.testing.assert_array_equal(rows.of(frame), expect)
+    as_cat = frame.astype({"block_id": pd.CategoricalDtype(["zz", *blocks[::-1], "nope"])})
+    np.testing.assert_array_equal(rows.of(as_cat), expect)
+    as_read = pa.Table.from_pandas(frame).to_pandas()          # Arrow-backed strings, as read
+    assert isinstance(as_read["block_id"].array, pd.arrays.ArrowStringArray)
+    np.testing.assert_array_equal(rows.of(as_read), expect)
+    sums = rows.spread(frame["v"].groupby(rows.of(frame)).sum(), 0.0)
+    by_key = (frame.groupby(["block_id", "service_date"])["v"].sum()
+              .reindex(pd.MultiIndex.from_frame(bd), fill_value=0.0).to_numpy())
+    np.testing.assert_array_equal(sums, by_key)
+    with pytest.raises(ValueError, match="sorted"):
+        BlockDayRows(bd.iloc[::-1])

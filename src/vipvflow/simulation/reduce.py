@@ -525,7 +525,7 @@ def block_day_table(cfg: Config, run_dir: Path, trip: pd.DataFrame, vehicle, pla
     key = ["block_id", "service_date"]
     if len(placed) != len(trip):
         raise ValueError("the trips' blocks are not row by row with the trips")
-    trip = trip.assign(block_id=placed["block_id"].to_numpy())
+    trip = trip.assign(block_id=placed["block_id"].array)   # as read: no Python string per row
     position = placed["position"].to_numpy(np.int64)
     # the standing intervals' columns used here (not their irradiation: a third of the
     # memory of a network's reduce)
@@ -546,21 +546,23 @@ def block_day_table(cfg: Config, run_dir: Path, trip: pd.DataFrame, vehicle, pla
     bd = tl[key + ["month", "trips", "window_start_utc", "window_end_utc", "first_departure_utc",
                    "last_arrival_utc", "driving_s", "layover_s", "parked_s", "overlap_s"]
             ].sort_values(key).reset_index(drop=True)
-    idx = pd.MultiIndex.from_frame(bd[key])
-    first = trip.groupby(key)["start_s"].min()
-    drive = trip.groupby(key)[["pv_kwh", "pv_kwh_clear", "consumption_kwh"]].sum()
+    rows = BlockDayRows(bd)
+    trip_at = rows.of(trip)
+    first = trip["start_s"].groupby(trip_at).min()
+    drive = trip[["pv_kwh", "pv_kwh_clear", "consumption_kwh"]].groupby(trip_at).sum()
     for c in ("pv_kwh", "pv_kwh_clear", "consumption_kwh"):
-        bd[c] = drive[c].reindex(idx, fill_value=0.0).to_numpy()
-    bd["first_departure_s"] = first.reindex(idx).to_numpy()
+        bd[c] = rows.spread(drive[c], 0.0)
+    bd["first_departure_s"] = rows.spread(first, np.nan)
     bd["pv_kwh_driving"] = bd["pv_kwh"]
     bd["seconds_driving"] = bd.pop("driving_s")
+    st_at = rows.of(st)
     for kind in ("layover", "parked"):
         # the time from the timeline (whatever fleet.harvest evaluates), the PV from the
         # standing partitions (0 where not evaluated)
-        part = st[st["kind"] == kind].groupby(key)[["pv_kwh", "pv_kwh_clear"]].sum()
-        part = part.reindex(idx, fill_value=0.0)
-        bd[f"pv_kwh_{kind}"] = part["pv_kwh"].to_numpy()
-        bd[f"pv_kwh_clear_{kind}"] = part["pv_kwh_clear"].to_numpy()
+        mine = (st["kind"] == kind).to_numpy(bool)
+        part = st.loc[mine, ["pv_kwh", "pv_kwh_clear"]].groupby(st_at[mine]).sum()
+        bd[f"pv_kwh_{kind}"] = rows.spread(part["pv_kwh"], 0.0)
+        bd[f"pv_kwh_clear_{kind}"] = rows.spread(part["pv_kwh_clear"], 0.0)
         bd[f"seconds_{kind}"] = bd.pop(f"{kind}_s")
     bd["pv_kwh_whole_day"] = bd["pv_kwh_driving"] + bd["pv_kwh_layover"] + bd["pv_kwh_parked"]
     bd["window_s"] = bd["window_end_utc"] - bd["window_start_utc"]
@@ -572,11 +574,17 @@ def block_day_table(cfg: Config, run_dir: Path, trip: pd.DataFrame, vehicle, pla
     hand_back_memory()
     lay = lay.merge(pd.read_parquet(run.timeline_table("points"), columns=["point_id", "stop_id"]),
                     on="point_id", how="left").drop(columns="point_id")
-    lit = st[st["kind"] == "layover"].groupby(key + ["after_trip"])["pv_kwh"].sum()
-    lay["pv_kwh"] = lit.reindex(pd.MultiIndex.from_frame(lay[key + ["after_trip"]])).fillna(0.0).to_numpy()
+    # each layover's PV: the standing rows of its block-day and trip before it
+    lay_at = rows.of(lay)
+    mine = (st["kind"] == "layover").to_numpy(bool) & (st_at >= 0)
+    after = st["after_trip"].to_numpy(np.int64)[mine]
+    width = int(max(after.max(initial=0), lay["after_trip"].max() if len(lay) else 0)) + 2
+    lit = st.loc[mine, "pv_kwh"].groupby(st_at[mine] * width + (after + 1)).sum()
+    lay_key = lay_at * width + (lay["after_trip"].to_numpy(np.int64) + 1)
+    lay["pv_kwh"] = lit.reindex(np.where(lay_at >= 0, lay_key, -1)).fillna(0.0).to_numpy()
     lay["seconds"] = (lay["t1_utc"] - lay["t0_utc"]).to_numpy(float)
     parked = parked.assign(seconds=(parked["t1_utc"] - parked["t0_utc"]).to_numpy(float))
-    del st, lit                          # the standing rows are summed: not held through the battery's day
+    del st, st_at, lit, mine, after, lay_key   # the standing rows are summed: not held through the battery's day
     hand_back_memory()
 
     # the layovers' auxiliaries (kWh from the battery) at the month's temperature
@@ -588,11 +596,11 @@ def block_day_table(cfg: Config, run_dir: Path, trip: pd.DataFrame, vehicle, pla
                 / 3600.0 / vehicle.discharge_efficiency)
 
     lay["aux_kwh"] = aux_kwh(lay["service_date"], lay["seconds"])
-    bd["layover_aux_kwh"] = (lay.groupby(key)["aux_kwh"].sum().reindex(idx, fill_value=0.0)
-                             .to_numpy())
+    bd["layover_aux_kwh"] = rows.spread(lay["aux_kwh"].groupby(lay_at).sum(), 0.0)
     # the battery's demand in service: the trips and the layovers' auxiliaries
     bd["demand_kwh"] = bd["consumption_kwh"] + bd["layover_aux_kwh"]
-    balance = _battery_day(cfg, run_dir, bd, idx, trip, position, lay, parked, vehicle)
+    balance = _battery_day(cfg, run_dir, bd, rows, trip, trip_at, position, lay, lay_at, parked,
+                           vehicle)
     for c, v in balance.items():
         if c not in ("soc_at_departure", "traces"):
             bd[c] = v
@@ -628,12 +636,68 @@ def _service_intervals(path: Path, kinds: tuple, columns: list) -> list:
 BATTERY_ROWS = 8192
 
 
-def _battery_day(cfg: Config, run_dir: Path, bd: pd.DataFrame, idx, trip: pd.DataFrame,
-                 position: np.ndarray, lay: pd.DataFrame, parked: pd.DataFrame, vehicle) -> dict:
+class BlockDayRows:
+    """The rows of a block-day table (*bd*: ``block_id, service_date``, sorted by them, each
+    pair once) that other tables' rows belong to, as integers: the block-days' sums are then
+    grouped by an integer rather than by a (string, date) pair (a network's 4.7 M trips and
+    4.9 M intervals were grouped and re-indexed by their strings several times over)."""
+
+    def __init__(self, bd: pd.DataFrame):
+        self.n = len(bd)
+        self._blocks = pd.Index(pd.unique(bd["block_id"].astype(str).to_numpy()))
+        self._blocks_pa = pa.array(self._blocks.to_numpy(object), pa.large_string())
+        days = self._days(bd)
+        self._d0 = int(days.min()) if len(days) else 0
+        self._span = int(days.max()) - self._d0 + 1 if len(days) else 1
+        self._key = self._keys(bd)
+        if len(self._key) and not (np.diff(self._key) > 0).all():
+            raise ValueError("the block-days must be sorted by block and date, each once")
+
+    @staticmethod
+    def _days(frame: pd.DataFrame) -> np.ndarray:
+        return frame["service_date"].to_numpy("datetime64[D]").astype(np.int64)
+
+    def _keys(self, frame: pd.DataFrame) -> np.ndarray:
+        """Each row's (block, day) as one integer, ordered like the block-days; -1 where the
+        block or the day is none of theirs."""
+        import pyarrow.compute as pc
+
+        block = frame["block_id"]
+        if isinstance(block.dtype, pd.CategoricalDtype):     # its categories, looked up once
+            code = self._blocks.get_indexer(block.cat.categories.astype(str))[block.cat.codes.to_numpy()]
+            code[block.cat.codes.to_numpy() < 0] = -1
+        else:                       # looked up in Arrow: no Python string per row
+            values = pa.array(block.array if pd.api.types.is_string_dtype(block.dtype)
+                              else block.astype(str).array, from_pandas=True)
+            code = pc.fill_null(pc.index_in(values.cast(pa.large_string()),
+                                            value_set=self._blocks_pa), -1).to_numpy()
+        day = self._days(frame) - self._d0
+        ok = (code >= 0) & (day >= 0) & (day < self._span)
+        return np.where(ok, code.astype(np.int64) * self._span + day, -1)
+
+    def of(self, frame: pd.DataFrame) -> np.ndarray:
+        """Each row's block-day (its row of *bd*; -1: none)."""
+        key = self._keys(frame)
+        at = np.searchsorted(self._key, key)
+        hit = (key >= 0) & (at < self.n)
+        hit[hit] = self._key[at[hit]] == key[hit]
+        return np.where(hit, at, -1)
+
+    def spread(self, sums: pd.Series, fill: float) -> np.ndarray:
+        """Per block-day (row of *bd*) the values of *sums* (indexed by row, as grouped by
+        :meth:`of`'s rows), *fill* where a block-day has none."""
+        return sums.reindex(np.arange(self.n), fill_value=fill).to_numpy()
+
+
+def _battery_day(cfg: Config, run_dir: Path, bd: pd.DataFrame, rows: BlockDayRows,
+                 trip: pd.DataFrame, trip_at: np.ndarray, position: np.ndarray, lay: pd.DataFrame,
+                 lay_at: np.ndarray, parked: pd.DataFrame, vehicle) -> dict:
     """The block-days' battery under the charging plan, with PV and without
     (:func:`vipvflow.models.charging.block_day_soc`, :data:`BATTERY_ROWS` block-days at a
-    time), from their trips, layovers (*lay*) and parked time (*parked*): the columns of
-    ``block_day`` it gives, and ``soc_at_departure`` row by row with *trip*."""
+    time), from their trips, layovers (*lay*) and parked time (*parked*), each row's
+    block-day given by *rows* (*trip_at*, *lay_at*: :meth:`BlockDayRows.of` of *trip* and
+    *lay*): the columns of ``block_day`` it gives, and ``soc_at_departure`` row by row with
+    *trip*."""
     import json
 
     from ..inputs.gtfs.schedule import service_day_origin_utc
@@ -642,18 +706,10 @@ def _battery_day(cfg: Config, run_dir: Path, bd: pd.DataFrame, idx, trip: pd.Dat
     plan = cfg.charging
     tz = json.loads(DataDir(cfg.data_dir).gtfs.feed_json.read_text())["timezone"]
     n, K = len(bd), max(int(bd["trips"].max()) if len(bd) else 1, 1)
-    row = pd.Series(np.arange(n), index=idx)
-    key = ["block_id", "service_date"]
-
-    def rows_of(frame) -> np.ndarray:
-        """Each row's block-day (its row of *bd*; -1: none)."""
-        r = row.reindex(pd.MultiIndex.from_frame(frame[key])).to_numpy(dtype=float, na_value=np.nan)
-        return np.where(np.isfinite(r), r, -1).astype(np.int64)
 
     t0 = (service_day_origin_utc(trip["service_date"].to_numpy(), tz)
           + trip["start_s"].to_numpy(float))
     t1 = t0 + trip["seconds"].to_numpy(float)
-    trip_at, lay_at = rows_of(trip), rows_of(lay)
     if (trip_at < 0).any():              # the timeline places every trip in a block-day
         raise ValueError(f"{int((trip_at < 0).sum())} trips have no block-day in the run's timeline")
     lpos = lay["after_trip"].to_numpy(np.int64)
@@ -677,8 +733,7 @@ def _battery_day(cfg: Config, run_dir: Path, bd: pd.DataFrame, idx, trip: pd.Dat
                   - pd.to_datetime(parked["t0_utc"], unit="s")).total_seconds().to_numpy()
         hours_s = window_overlap_s(parked["t0_utc"].to_numpy(float) + offset,
                                    parked["t1_utc"].to_numpy(float) + offset, *plan.depot.hours)
-    depot_hours = (pd.Series(hours_s, index=pd.MultiIndex.from_frame(parked[key]))
-                   .groupby(level=[0, 1]).sum().reindex(idx, fill_value=0.0).to_numpy())
+    depot_hours = rows.spread(pd.Series(hours_s).groupby(rows.of(parked)).sum(), 0.0)
     parked_pv = bd["pv_kwh_parked"].to_numpy()
     car = Vehicle(vehicle.battery_kwh, vehicle.soc_min, vehicle.soc_max)
     depot = Charger(plan.depot.power_kw, plan.depot.efficiency,
