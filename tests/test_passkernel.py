@@ -204,6 +204,44 @@ def test_a_tile_task_leaves_no_packed_geometry_no_task_can_find(small_run, small
     part._PACKED.clear()
 
 
+def test_a_tile_task_keeps_the_packed_geometry_and_writes_what_the_whole_table_gives(
+        small_run, small_config, tmp_path):
+    """A tile task holds, of the geometry table it read, only the segments' ids and radiation
+    locations with the packed geometry (the rest of the table let go), and writes the
+    partition files the whole table gives, bit for bit."""
+    import shutil
+
+    import pyarrow.parquet as pq
+
+    from vipvflow.config import load_config
+    from vipvflow.simulation import partition as part
+
+    cfg = load_config(small_config)
+    ctxs = {}
+    for name in ("held", "whole"):
+        run_dir = tmp_path / name
+        shutil.copytree(small_run / "parts" / "geometry", run_dir / "parts" / "geometry")
+        ctxs[name] = part.RunContext(
+            data_dir=str(cfg.data_dir), run_dir=str(run_dir), year=2024,
+            irradiance=IrradianceCfg(**cfg.irradiance.model_dump()).model_dump(),
+            pv_system=cfg.pv_system().model_dump(), pv_mode="paper",
+            monthly_temperature_c=(15.0,) * 12, wind_speed_mps=2.0, timezone="Europe/Luxembourg")
+    tiles = sorted(p.name[5:-8] for p in (tmp_path / "held" / "parts" / "geometry").glob("tile=*.parquet"))
+    tile = max(tiles, key=lambda t: len(part.tile_geometry(ctxs["whole"], t)))
+    whole = part.tile_geometry(ctxs["whole"], tile)
+    held = part._held_geometry(ctxs["held"], tile, part.tile_geometry(ctxs["held"], tile))
+    assert list(held.columns) == [c for c in ("segment_id", "rad_location") if c in whole.columns]
+    assert part._PACKED[(ctxs["held"].run_dir, tile)][0] is held
+    part._PACKED.clear()
+    assert part.tile_task(ctxs["held"], tile, ["2024-06"])[0]["passes"]
+    assert part.run_partition(ctxs["whole"], tile, "2024-06", whole)["passes"]
+    part._PACKED.clear()
+    files = sorted(p.relative_to(tmp_path / "whole") for p in (tmp_path / "whole" / "parts").rglob("month=*.parquet"))
+    assert len(files) >= 2
+    for f in files:
+        assert pq.read_table(tmp_path / "held" / f).equals(pq.read_table(tmp_path / "whole" / f)), f
+
+
 def test_block_columns_are_the_components():
     assert passkernel.BLOCK_COLUMNS == tuple(COMPONENTS) + ("ghi", "ghi_clear")
 

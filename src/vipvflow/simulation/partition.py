@@ -145,6 +145,10 @@ def _packed_geometry(ctx: RunContext, tile: str, geometry: pd.DataFrame, scene) 
         _PACKED.move_to_end(key)
         return hit[2]
     geo = pack_geometry(geometry, IrradianceCfg(**ctx.irradiance), ctx.ground_albedo, scene)
+    if "group_p_local" in geo:
+        # the rays start from the scene's frame (float32): the world's float64 sample points
+        # are not used here (~85 MB for a network's largest tile)
+        del geo["group_p"]
     _PACKED[key] = (geometry, scene, geo)
     while len(_PACKED) > max(1, ctx.bvh_cache_size):
         _PACKED.popitem(last=False)
@@ -220,8 +224,13 @@ def tile_task(ctx: RunContext, tile: str, months: list[str],
     geometry table never leaves the worker, and the scheduler (in the command's process on a
     LocalCluster) handles 12 times fewer tasks: the line-year's 492 partitions as 41 tasks
     took ~2 s of a core off the command's process."""
-    frame = geometry.frame if geometry is not None else tile_geometry(ctx, tile)
-    done = [run_partition(ctx, tile, month, frame) for month in months]
+    frame = geometry.frame if geometry is not None else _held_geometry(ctx, tile, tile_geometry(ctx, tile))
+    done = []
+    for month in months:
+        done.append(run_partition(ctx, tile, month, frame))
+        # a month's passes freed, before the next (a few ms): what the worker holds between
+        # them is what it keeps, ~0.25 GB less on a network's largest tile
+        hand_back_memory()
     if geometry is None:
         # the packed geometry of a table made here: no other task can find it (the cache
         # holds it for the table it was made from), ~70 MB a tile of a network
@@ -230,6 +239,26 @@ def tile_task(ctx: RunContext, tile: str, months: list[str],
             del _PACKED[(ctx.run_dir, tile)]
     hand_back_memory()
     return done
+
+
+def _held_geometry(ctx: RunContext, tile: str, frame: pd.DataFrame) -> pd.DataFrame:
+    """What a tile task holds of the tile's geometry *frame* through its months.  With the
+    fused kernel (``paper``) the partitions read the geometry packed (:func:`_packed_geometry`,
+    made here) and of the table only the segments' ids and radiation locations: the table
+    (~150 MB for a network's largest tile) is then let go, and the packed geometry is kept
+    for the slim table returned.  Otherwise *frame* itself."""
+    from ..models import passkernel
+
+    if ctx.pv_mode != "paper" or not len(frame):
+        return frame
+    hand_back_memory()          # the table's read (its Arrow copy) before the packing
+    scene = _scene(ctx, tile)
+    geo = _packed_geometry(ctx, tile, frame, scene)
+    if not passkernel.usable(geo, scene):
+        return frame
+    slim = frame[[c for c in ("segment_id", "rad_location") if c in frame.columns]].copy()
+    _PACKED[(ctx.run_dir, tile)] = (slim, scene, geo)
+    return slim
 
 
 def pv_energy_kwh(poa_wm2: np.ndarray, dt_s: np.ndarray, speed_mps: np.ndarray, month: int,
