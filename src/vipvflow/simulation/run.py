@@ -23,7 +23,7 @@ from .cluster import (bound_dashboard, check_scheduler, close_client, local_clus
                       make_client)
 from .manifest import claim_run_dir, write_manifest
 from .network import selected_network
-from .partition import RunContext, partition_done, worker_bvh_builds
+from .partition import RunContext, hand_back_memory, partition_done, worker_bvh_builds
 from .standing import standing_done, write_timeline
 from .tasks import collect_map, submit_standing, submit_tiles
 
@@ -143,6 +143,9 @@ def _run(cfg: Config, year: int, scheduler, n_workers, say, max_partitions, forc
         ctx = dataclasses.replace(ctx, ray_threads=ray_threads)
         say(_dashboard_line(client, cluster, cfg.dask.dashboard_port))
         warm.join()
+        # what the ingest and the radiation table's load freed here goes back to the system
+        # before the map (~150 MB of the radiation's temporaries alone, kept by the heap)
+        hand_back_memory()
         # what this process holds by now (the libraries, the inputs' tables) outlives the
         # run: the cyclic collector leaves it alone until the run is done (each of its full
         # passes walked ~300,000 objects, ~0.15 s, while the scheduler and the reduce work
