@@ -52,6 +52,8 @@ class PeakRSS:
         self.at_peak_mb: list[int] = []           # each process's RSS then (MB, largest first)
         self.samples = 0
         self.series: list[tuple] = []             # each sample: s, total MB, each process's bytes
+        self.pids: list[list[int]] = []           # each sample's processes, in the order of its bytes
+        self.procs: dict[int, str] = {}            # each child's parent pid and command line
         self._t0 = time.perf_counter()
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._poll, daemon=True, name="peak-rss")
@@ -67,7 +69,7 @@ class PeakRSS:
         total = own
         children = root.children(recursive=True)
         self.by_pid[root.pid] = max(self.by_pid.get(root.pid, 0.0), own / 2**20)
-        now = [own]
+        now, pids = [own], [root.pid]
         for child in children:
             try:
                 rss = child.memory_info().rss
@@ -75,8 +77,15 @@ class PeakRSS:
                 continue
             total += rss
             now.append(rss)
+            pids.append(child.pid)
+            if child.pid not in self.procs:
+                try:
+                    self.procs[child.pid] = f"{child.ppid()} " + " ".join(child.cmdline())[-100:]
+                except psutil.Error:
+                    pass
             self.by_pid[child.pid] = max(self.by_pid.get(child.pid, 0.0), rss / 2**20)
         self.series.append((time.perf_counter() - self._t0, total / 2**20, now))
+        self.pids.append(pids)
         if total / 2**20 > self.peak_mb:
             self.peak_mb = total / 2**20
             self.peak_at_s = time.perf_counter() - self._t0
@@ -111,6 +120,12 @@ class PeakRSS:
         if self.pid == os.getpid():
             self.peak_self_mb = max(self.peak_self_mb,
                                     resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024)
+        out = os.environ.get("VIPVFLOW_BENCH_RSS_SERIES")
+        if out:         # every sample: s after the start, each process's pid and MB
+            rows = [[round(s, 2), {p: round(b / 2**20) for p, b in zip(pids, now)}]
+                    for (s, _, now), pids in zip(self.series, self.pids)]
+            with open(out, "a") as f:       # one line per sampler (a benchmark may run several)
+                f.write(json.dumps({"root": self.pid, "processes": self.procs, "samples": rows}) + "\n")
 
 
 def _quiet(*_args, **_kw) -> None:
