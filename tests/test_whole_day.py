@@ -446,3 +446,19 @@ def test_a_large_timeline_is_cut_in_a_process_of_its_own(small_run, small_config
     bad = load_config(small_config, overrides={"data_dir": str(tmp_path / "data")})
     with pytest.raises(FileNotFoundError, match="pattern_stops"):
         standing.write_timeline(bad, 2024, tmp_path / "bad")
+
+
+def test_a_tiles_intervals_read_in_batches_are_those_of_the_whole_table(small_run, monkeypatch):
+    """The intervals at some points, read a few rows at a time (a standing task's), are the
+    harvested intervals of the whole table at those points, in order and renumbered."""
+    from vipvflow.simulation import standing
+    from vipvflow.store import RunDir
+
+    run = RunDir(small_run)
+    whole = standing.harvested_intervals(run)
+    points = np.unique(whole["point_id"].to_numpy())[::2]
+    expect = whole[whole["point_id"].isin(points)].reset_index(drop=True)
+    assert 0 < len(expect) < len(whole)
+    monkeypatch.setattr(standing, "INTERVAL_BATCH", 7)
+    got = standing.harvested_intervals(run, points=points)
+    pd.testing.assert_frame_equal(got, expect, check_exact=True)

@@ -147,8 +147,7 @@ def run_standing(ctx, tile: str) -> dict:
     run = RunDir(ctx.run_dir)
     points = pd.read_parquet(run.timeline_table("points"))
     points = points[points["tile"] == tile]
-    iv = harvested_intervals(run)
-    iv = iv[iv["point_id"].isin(points["point_id"])].reset_index(drop=True)
+    iv = harvested_intervals(run, points=points["point_id"].to_numpy(np.int64))
     cfg = IrradianceCfg(**ctx.irradiance)
     dark = tile == "covered" or not len(iv)
     timings = {"standing_load_s": time.perf_counter() - t_start}
@@ -161,7 +160,10 @@ def run_standing(ctx, tile: str) -> dict:
         geom = point_geometry(scene, points, cfg, **street_options(ctx))
         timings["standing_geometry_s"] = time.perf_counter() - t
     t_eval = time.perf_counter()
-    parts = []
+    # each month's sums into its rows of one array (iv is numbered from 0), not a frame per
+    # month joined and re-indexed: a copy less of the largest tile's 0.9 M intervals each
+    res = interval_integrals(iv.iloc[:0], None, None, None, cfg, None, dark=True)
+    values = np.zeros((len(iv), res.shape[1]))
     for month, group in iv.groupby("month", sort=True):
         m = int(month[5:7])
 
@@ -169,15 +171,16 @@ def run_standing(ctx, tile: str) -> dict:
             return pv_energy_kwh(poa, dt, np.zeros(len(poa)), m, ctx)
 
         if dark:
-            parts.append(interval_integrals(group, None, None, None, cfg, energy, dark=True))
+            part = interval_integrals(group, None, None, None, cfg, energy, dark=True)
         else:
-            parts.append(interval_integrals(group, geom, _radiation(ctx.data_dir, ctx.year), scene, cfg,
-                                            energy, ground_albedo=ctx.ground_albedo))
-    res = (pd.concat(parts).reindex(iv.index) if parts
-           else interval_integrals(iv, None, None, None, cfg, None, dark=True))
+            part = interval_integrals(group, geom, _radiation(ctx.data_dir, ctx.year), scene, cfg,
+                                      energy, ground_albedo=ctx.ground_albedo)
+        values[group.index.to_numpy()] = part[res.columns].to_numpy(np.float64)
+        del part, group
     timings["standing_eval_s"] = time.perf_counter() - t_eval
     # idle rows stand for several buses: their sums are per bus times the buses
-    res = res.mul(iv["buses"].to_numpy(np.float64), axis=0)
+    values *= iv["buses"].to_numpy(np.float64)[:, None]
+    res = pd.DataFrame(values, index=iv.index, columns=res.columns, copy=False)
     table = pd.concat([iv[["block_id", "service_date", "kind", "after_trip", "point_id", "t0_utc",
                            "t1_utc", "buses"]].astype({"block_id": str, "kind": str}), res], axis=1)
     table["tile"] = tile
@@ -276,17 +279,48 @@ def _write_timeline_tables(cfg, year: int, run_dir, routes=None) -> None:
                   run.timeline_table("points"))
 
 
-def harvested_intervals(run: RunDir, columns=None) -> pd.DataFrame:
+def harvested_intervals(run: RunDir, columns=None, points=None) -> pd.DataFrame:
     """The timeline's intervals whose light ``fleet.harvest`` counts (a timeline written
-    before the ``harvested`` column: all of its intervals)."""
+    before the ``harvested`` column: all of its intervals).  *points*: only the intervals
+    at these ``point_id``, read a batch at a time and renumbered from 0 (a standing task
+    held the whole network's 4.9 M intervals to keep its tile's)."""
     import pyarrow.parquet as pq
 
     path = run.timeline_table("intervals")
     has = "harvested" in pq.read_schema(path).names
     cols = None if columns is None else list(columns) + (["harvested"] if has else [])
+    if points is not None:
+        return _intervals_at(path, cols, has, np.asarray(points, np.int64))
     iv = pd.read_parquet(path, columns=cols)
     if has:
         iv = iv[iv.pop("harvested").to_numpy(bool)]
+    return iv
+
+
+#: rows of the timeline's intervals read at a time for one tile's points
+INTERVAL_BATCH = 1 << 18
+
+
+def _intervals_at(path, cols, has: bool, points: np.ndarray) -> pd.DataFrame:
+    import pyarrow as pa
+    import pyarrow.compute as pc
+    import pyarrow.parquet as pq
+
+    with pq.ParquetFile(path) as pf:
+        schema = pf.schema_arrow
+        names = schema.names if cols is None else [c for c in schema.names if c in cols]
+        wanted = pa.array(points, pa.int64())
+        kept = []
+        for batch in pf.iter_batches(batch_size=INTERVAL_BATCH, columns=names, use_threads=False):
+            mask = pc.is_in(batch.column("point_id").cast(pa.int64()), value_set=wanted)
+            if has:
+                mask = pc.and_(mask, pc.fill_null(batch.column("harvested"), False))
+            kept.append(batch.filter(mask))
+        table = pa.Table.from_batches(kept, schema=pa.schema([schema.field(c) for c in names],
+                                                             metadata=schema.metadata))
+    iv = table.to_pandas().reset_index(drop=True)
+    if has:
+        iv = iv.drop(columns="harvested")
     return iv
 
 
