@@ -208,12 +208,14 @@ def test_a_tile_task_keeps_the_packed_geometry_and_writes_what_the_whole_table_g
         small_run, small_config, tmp_path):
     """A tile task holds, of the geometry table it read, only the segments' ids and radiation
     locations with the packed geometry (the rest of the table let go), and writes the
-    partition files the whole table gives, bit for bit."""
+    partition files the whole table gives, bit for bit, even when the tile's scene was
+    dropped from the cache and built again in between."""
     import shutil
 
     import pyarrow.parquet as pq
 
     from vipvflow.config import load_config
+    from vipvflow.models import shading
     from vipvflow.simulation import partition as part
 
     cfg = load_config(small_config)
@@ -232,8 +234,12 @@ def test_a_tile_task_keeps_the_packed_geometry_and_writes_what_the_whole_table_g
     held = part._held_geometry(ctxs["held"], tile, part.tile_geometry(ctxs["held"], tile))
     assert list(held.columns) == [c for c in ("segment_id", "rad_location") if c in whole.columns]
     assert part._PACKED[(ctxs["held"].run_dir, tile)][0] is held
+    # the tile's BVH dropped from the scenes' cache meanwhile (other tiles' tasks): its
+    # scene built again, the packing kept
+    shading._cache.clear()
+    assert part.run_partition(ctxs["held"], tile, "2024-06", held)["passes"]
+    assert part._PACKED[(ctxs["held"].run_dir, tile)][1] is part._scene(ctxs["held"], tile)
     part._PACKED.clear()
-    assert part.tile_task(ctxs["held"], tile, ["2024-06"])[0]["passes"]
     assert part.run_partition(ctxs["whole"], tile, "2024-06", whole)["passes"]
     part._PACKED.clear()
     files = sorted(p.relative_to(tmp_path / "whole") for p in (tmp_path / "whole" / "parts").rglob("month=*.parquet"))

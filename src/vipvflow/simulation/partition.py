@@ -141,7 +141,13 @@ def _packed_geometry(ctx: RunContext, tile: str, geometry: pd.DataFrame, scene) 
 
     key = (ctx.run_dir, tile)
     hit = _PACKED.get(key)
-    if hit is not None and hit[0] is geometry and hit[1] is scene:
+    if hit is not None and hit[0] is geometry and (
+            hit[1] is scene or np.array_equal(hit[2].get("scene_origin"), getattr(scene, "origin", None))):
+        # the same table; the same scene, or the tile's scene built again (its BVH dropped
+        # from the cache meanwhile) in the same frame: the packing holds (a tile task keeps
+        # only the packed geometry and the table's ids, _held_geometry)
+        if hit[1] is not scene:
+            _PACKED[key] = (geometry, scene, hit[2])
         _PACKED.move_to_end(key)
         return hit[2]
     geo = pack_geometry(geometry, IrradianceCfg(**ctx.irradiance), ctx.ground_albedo, scene)
