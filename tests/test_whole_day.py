@@ -462,3 +462,5 @@ def test_a_tiles_intervals_read_in_batches_are_those_of_the_whole_table(small_ru
     monkeypatch.setattr(standing, "INTERVAL_BATCH", 7)
     got = standing.harvested_intervals(run, points=points)
     pd.testing.assert_frame_equal(got, expect, check_exact=True)
+    some = standing.harvested_intervals(run, columns=["t0_utc", "t1_utc"], points=points)
+    pd.testing.assert_frame_equal(some, expect[["t0_utc", "t1_utc"]], check_exact=True)

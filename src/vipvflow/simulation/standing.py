@@ -311,11 +311,12 @@ def _intervals_at(path, cols, has: bool, points: np.ndarray) -> pd.DataFrame:
         names = schema.names if cols is None else [c for c in schema.names if c in cols]
         wanted = pa.array(points, pa.int64())
         kept = []
-        for batch in pf.iter_batches(batch_size=INTERVAL_BATCH, columns=names, use_threads=False):
+        for batch in pf.iter_batches(batch_size=INTERVAL_BATCH, columns=list(dict.fromkeys(
+                [*names, "point_id"])), use_threads=False):
             mask = pc.is_in(batch.column("point_id").cast(pa.int64()), value_set=wanted)
             if has:
                 mask = pc.and_(mask, pc.fill_null(batch.column("harvested"), False))
-            kept.append(batch.filter(mask))
+            kept.append(batch.filter(mask).select(names))
         table = pa.Table.from_batches(kept, schema=pa.schema([schema.field(c) for c in names],
                                                              metadata=schema.metadata))
     iv = table.to_pandas().reset_index(drop=True)
