@@ -100,3 +100,20 @@ def test_passes_over_the_file_write_the_files_of_one_pass(small_run, tmp_path, m
             got = written[rows_per_pass][f]
             assert got.schema.equals(table.schema, check_metadata=True), f
             assert got.equals(table), f
+
+
+def test_rows_of_a_tile_without_segments_are_refused_with_the_file_named(small_run, tmp_path):
+    import pyarrow as pa
+
+    run = tmp_path / "run"
+    run.mkdir()
+    for name in ("segments.parquet", "segment_month.parquet"):
+        shutil.copy(Path(small_run) / name, run / name)
+    table = pq.read_table(run / "segment_month.parquet")
+    tiles = table.column("tile").to_pylist()
+    tiles[len(tiles) // 2] = "E9999N9999"
+    i = table.schema.get_field_index("tile")
+    pq.write_table(table.set_column(i, table.schema.field(i), pa.array(tiles, table.schema.field(i).type)),
+                   run / "segment_month.parquet")
+    with pytest.raises(ValueError, match=r"segment_month\.parquet: rows of tiles without segments"):
+        write_datasets(run)
