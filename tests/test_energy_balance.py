@@ -241,3 +241,47 @@ def test_block_day_rows_are_those_of_the_string_and_date_keys():
     np.testing.assert_array_equal(sums, by_key)
     with pytest.raises(ValueError, match="sorted"):
         BlockDayRows(bd.iloc[::-1])
+
+
+def test_standing_rows_read_a_file_at_a_time_are_those_of_the_whole_table(tmp_path):
+    """The standing partitions read a file at a time (:func:`_standing_rows`) give the rows
+    picked from all files read whole: the buses in service row by row (block-day, kind,
+    trip before, PV), the idle buses' rows with their place among all rows; an empty file
+    and rows of no block-day, of a missing block or kind, are taken as they come."""
+    from vipvflow.inputs.gtfs.schedule import IDLE_BLOCK
+    from vipvflow.simulation.reduce import BlockDayRows, _part_table, _standing_rows
+    from vipvflow.store import RunDir, write_parquet
+
+    rng = np.random.default_rng(11)
+    days = pd.date_range("2024-05-01", periods=4, freq="D")
+    bd = pd.DataFrame([(b, d) for b in ("b1", "b2", "c") for d in days[:3]],
+                      columns=["block_id", "service_date"])
+    whole = []
+    for tile, n in (("E1", 50), ("E2", 0), ("E3", 80), ("E4", 30)):
+        frame = pd.DataFrame({
+            "block_id": rng.choice(["b1", "b2", "c", "x", IDLE_BLOCK], n).astype(object),
+            "service_date": pd.DatetimeIndex(rng.choice(days, n)),
+            "kind": rng.choice(["layover", "parked"], n).astype(object),
+            "after_trip": rng.integers(-1, 6, n), "point_id": rng.integers(0, 9, n),
+            "buses": np.ones(n, np.int64), "seconds": rng.random(n) * 600,
+            "pv_kwh": rng.random(n), "pv_kwh_clear": rng.random(n), "h_total": rng.random(n)})
+        if n:
+            frame.loc[2, "block_id"] = None
+            frame.loc[4, "kind"] = None
+        write_parquet(frame, RunDir(tmp_path).part("standing", tile, "all"))
+        whole.append(frame)
+    rows = BlockDayRows(bd)
+    busy, idle = _standing_rows(tmp_path, rows)
+
+    st = _part_table(tmp_path, "standing").to_pandas()
+    off = (st["block_id"] == IDLE_BLOCK).to_numpy(bool)
+    on = st.loc[~off]
+    assert 10 < len(idle) == off.sum() and len(busy["at"]) == len(on) > 100
+    np.testing.assert_array_equal(busy["at"], rows.of(on))
+    assert (busy["at"] < 0).sum() > 10 and (busy["at"] >= 0).sum() > 50
+    for kind in ("layover", "parked"):
+        np.testing.assert_array_equal(busy[kind], (on["kind"] == kind).to_numpy(bool))
+    for c in ("after_trip", "pv_kwh", "pv_kwh_clear"):
+        np.testing.assert_array_equal(busy[c], on[c].to_numpy())
+    names = ["block_id", "service_date", "kind", "after_trip", "buses", "seconds", "pv_kwh", "pv_kwh_clear"]
+    pd.testing.assert_frame_equal(idle, st.loc[off, names], check_exact=True)

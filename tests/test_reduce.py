@@ -11,7 +11,7 @@ import pyarrow.parquet as pq
 import pytest
 
 from vipvflow.errors import InputError
-from vipvflow.simulation.reduce import (_join_months, _months_frame, _read_parts, _trip_totals,
+from vipvflow.simulation.reduce import (_join_months, _months_frame, _part_table, _trip_totals,
                                        forget_and_hand_back, segment_month_part, sum_trips)
 from vipvflow.store import HOURLY_METADATA, RunDir, write_parquet, write_parquet_parts
 
@@ -127,7 +127,7 @@ def test_files_with_different_schemas_are_promoted(tmp_path):
     b = pd.DataFrame({"segment_id": np.array([3], np.int32), "h_total": np.array([3.0], np.float32)})
     write_parquet(a, RunDir(tmp_path).part("segment_month", "a", "2024-01"))
     write_parquet(b, RunDir(tmp_path).part("segment_month", "b", "2024-01"))
-    got = _read_parts(tmp_path, "segment_month")
+    got = _part_table(tmp_path, "segment_month").to_pandas()
     assert got["segment_id"].tolist() == [1, 2, 3]
     assert got["h_total"].tolist() == [1.0, 2.0, 3.0]
 

@@ -67,17 +67,6 @@ def _part_table(run_dir: Path, kind: str, pattern: str = "tile=*/month=*.parquet
     return _read_files(RunDir(run_dir).part_files(kind, pattern), columns)
 
 
-def _read_parts(run_dir: Path, kind: str, columns: list[str] | None = None) -> pd.DataFrame:
-    """Every partition file of *kind*, in path order, as one DataFrame (with *columns*, only
-    those); the read's Arrow buffers handed back (twice the frame's size on a network's
-    standing intervals)."""
-    table = _part_table(run_dir, kind, columns=columns)
-    frame = pd.DataFrame() if table is None else table.to_pandas()
-    del table
-    hand_back_memory()
-    return frame
-
-
 # --- the partial sums, computed where the partitions are (Dask tasks on the run's workers)
 
 #: trip partition files summed by one task: bounds a task's memory (a network-year month has
@@ -518,7 +507,7 @@ def block_day_table(cfg: Config, run_dir: Path, trip: pd.DataFrame, vehicle, pla
     month's mean temperature through the battery's discharge efficiency; the PV of layovers
     and parking counts only when ``fleet.harvest`` evaluates it.
     """
-    from ..inputs.gtfs.schedule import IDLE_BLOCK, month_labels
+    from ..inputs.gtfs.schedule import month_labels
 
     run = RunDir(run_dir)
     tl = pd.read_parquet(run.timeline_table("block_days"))
@@ -527,26 +516,13 @@ def block_day_table(cfg: Config, run_dir: Path, trip: pd.DataFrame, vehicle, pla
         raise ValueError("the trips' blocks are not row by row with the trips")
     trip = trip.assign(block_id=placed["block_id"].array)   # as read: no Python string per row
     position = placed["position"].to_numpy(np.int64)
-    # the standing intervals' columns used here (not their irradiation: a third of the
-    # memory of a network's reduce)
-    kept = (("block_id", object), ("service_date", "datetime64[ns]"), ("kind", object),
-            ("after_trip", np.int64), ("buses", np.int64), ("seconds", float), ("pv_kwh", float),
-            ("pv_kwh_clear", float))
-    st = _read_parts(run_dir, "standing", columns=[c for c, _ in kept])
-    if st.empty:
-        st = pd.DataFrame({c: pd.Series(dtype=t) for c, t in kept})
-    idle_rows = (st["block_id"] == IDLE_BLOCK).to_numpy(bool)
-    idle = st.loc[idle_rows]
-    # the buses in service: the columns summed below
-    st = st.loc[~idle_rows, key + ["kind", "after_trip", "pv_kwh", "pv_kwh_clear"]]
-    del idle_rows
-    idle["month"] = month_labels(idle["service_date"])
-    idle["pv_kwh_curtailed"] = idle["pv_kwh"]            # an idle bus's battery is full
-
     bd = tl[key + ["month", "trips", "window_start_utc", "window_end_utc", "first_departure_utc",
                    "last_arrival_utc", "driving_s", "layover_s", "parked_s", "overlap_s"]
             ].sort_values(key).reset_index(drop=True)
     rows = BlockDayRows(bd)
+    st, idle = _standing_rows(run_dir, rows)
+    idle["month"] = month_labels(idle["service_date"])
+    idle["pv_kwh_curtailed"] = idle["pv_kwh"]            # an idle bus's battery is full
     trip_at = rows.of(trip)
     first = trip["start_s"].groupby(trip_at).min()
     drive = trip[["pv_kwh", "pv_kwh_clear", "consumption_kwh"]].groupby(trip_at).sum()
@@ -555,12 +531,12 @@ def block_day_table(cfg: Config, run_dir: Path, trip: pd.DataFrame, vehicle, pla
     bd["first_departure_s"] = rows.spread(first, np.nan)
     bd["pv_kwh_driving"] = bd["pv_kwh"]
     bd["seconds_driving"] = bd.pop("driving_s")
-    st_at = rows.of(st)
+    st_at = st["at"]
     for kind in ("layover", "parked"):
         # the time from the timeline (whatever fleet.harvest evaluates), the PV from the
         # standing partitions (0 where not evaluated)
-        mine = (st["kind"] == kind).to_numpy(bool)
-        part = st.loc[mine, ["pv_kwh", "pv_kwh_clear"]].groupby(st_at[mine]).sum()
+        mine = st[kind]
+        part = pd.DataFrame({c: st[c][mine] for c in ("pv_kwh", "pv_kwh_clear")}).groupby(st_at[mine]).sum()
         bd[f"pv_kwh_{kind}"] = rows.spread(part["pv_kwh"], 0.0)
         bd[f"pv_kwh_clear_{kind}"] = rows.spread(part["pv_kwh_clear"], 0.0)
         bd[f"seconds_{kind}"] = bd.pop(f"{kind}_s")
@@ -576,10 +552,10 @@ def block_day_table(cfg: Config, run_dir: Path, trip: pd.DataFrame, vehicle, pla
                     on="point_id", how="left").drop(columns="point_id")
     # each layover's PV: the standing rows of its block-day and trip before it
     lay_at = rows.of(lay)
-    mine = (st["kind"] == "layover").to_numpy(bool) & (st_at >= 0)
-    after = st["after_trip"].to_numpy(np.int64)[mine]
+    mine = st["layover"] & (st_at >= 0)
+    after = st["after_trip"][mine]
     width = int(max(after.max(initial=0), lay["after_trip"].max() if len(lay) else 0)) + 2
-    lit = st.loc[mine, "pv_kwh"].groupby(st_at[mine] * width + (after + 1)).sum()
+    lit = pd.Series(st["pv_kwh"][mine]).groupby(st_at[mine] * width + (after + 1)).sum()
     lay_key = lay_at * width + (lay["after_trip"].to_numpy(np.int64) + 1)
     lay["pv_kwh"] = lit.reindex(np.where(lay_at >= 0, lay_key, -1)).fillna(0.0).to_numpy()
     lay["seconds"] = (lay["t1_utc"] - lay["t0_utc"]).to_numpy(float)
@@ -607,6 +583,50 @@ def block_day_table(cfg: Config, run_dir: Path, trip: pd.DataFrame, vehicle, pla
     trip["soc_at_departure"] = balance["soc_at_departure"]
     bd["pv_kwh_usable"] = bd["pv_kwh_whole_day"] - bd["pv_kwh_curtailed"]
     return bd, idle, trip, balance["traces"]
+
+
+#: the standing partitions' columns of the idle buses' rows (:func:`_standing_rows`)
+IDLE_COLUMNS = (("block_id", object), ("service_date", "datetime64[ns]"), ("kind", object),
+                ("after_trip", np.int64), ("buses", np.int64), ("seconds", float), ("pv_kwh", float),
+                ("pv_kwh_clear", float))
+
+
+def _standing_rows(run_dir: Path, rows: "BlockDayRows") -> tuple[dict, pd.DataFrame]:
+    """The standing partitions' rows (every file, in path order), read a file at a time: of
+    the buses in service, as arrays (``at``: the row's block-day, :meth:`BlockDayRows.of`;
+    ``layover``, ``parked``: its kind; ``after_trip``, ``pv_kwh``, ``pv_kwh_clear``); of
+    the idle buses' block, a DataFrame of :data:`IDLE_COLUMNS` indexed by the row's place
+    among all rows.  A network's 4.9 M rows were held whole, with their block ids and kinds
+    as strings, to pick these columns (0.6 GB at the reduce's peak)."""
+    import pyarrow.compute as pc
+
+    from ..inputs.gtfs.schedule import IDLE_BLOCK
+
+    names = [c for c, _ in IDLE_COLUMNS]
+    busy = {"at": [], "layover": [], "parked": [], "after_trip": [], "pv_kwh": [], "pv_kwh_clear": []}
+    idle, offset = [], 0
+    for f in RunDir(run_dir).part_files("standing"):
+        t = _read_file(f, names)
+        if not t.num_rows:
+            continue
+        on_duty = pc.fill_null(pc.not_equal(t.column("block_id"), IDLE_BLOCK), True)
+        if not pc.all(on_duty).as_py():
+            off = t.filter(pc.invert(on_duty)).to_pandas()
+            off.index = offset + np.flatnonzero(~on_duty.to_numpy(zero_copy_only=False))
+            idle.append(off)
+        t = t.filter(on_duty)
+        busy["at"].append(rows.of(t.select(["block_id", "service_date"]).to_pandas()))
+        for kind in ("layover", "parked"):
+            busy[kind].append(pc.fill_null(pc.equal(t.column("kind"), kind), False).to_numpy(zero_copy_only=False))
+        for c, dtype in (("after_trip", np.int64), ("pv_kwh", float), ("pv_kwh_clear", float)):
+            busy[c].append(t.column(c).to_numpy().astype(dtype, copy=False))
+        offset += len(on_duty)
+    empty = {"at": np.int64, "layover": bool, "parked": bool, "after_trip": np.int64,
+             "pv_kwh": float, "pv_kwh_clear": float}
+    busy = {c: np.concatenate(v) if v else np.zeros(0, empty[c]) for c, v in busy.items()}
+    idle = (pd.concat(idle) if idle else
+            pd.DataFrame({c: pd.Series(dtype=t) for c, t in IDLE_COLUMNS}))
+    return busy, idle
 
 
 def _service_intervals(path: Path, kinds: tuple, columns: list) -> list:
