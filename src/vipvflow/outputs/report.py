@@ -564,10 +564,16 @@ def map_figure(run_dir: str, data_dir: str | None, name: str):
     """The map *name* (:data:`MAPS`) of the run's ``segments.parquet`` over the building
     footprints of the city model in *data_dir* (none without)."""
     import geopandas as gpd
+    import pyarrow.parquet as pq
 
     from ..inputs.city.footprints import building_footprints
 
-    segments = _mapped(gpd.read_parquet(RunDir(run_dir).output("segments.parquet")))
+    # the columns drawn (a network's 39 columns read whole were twice the memory of these)
+    path = RunDir(run_dir).output("segments.parquet")
+    column = MAPS[name][1]
+    have = set(pq.read_schema(path).names)
+    segments = _mapped(gpd.read_parquet(path, columns=[c for c in dict.fromkeys(
+        ["geometry", "tile", "n_passes", "svf", "shading_loss", column]) if c in have]))
     footprints = []
     if data_dir is not None:
         xmin, ymin, xmax, ymax = segments.total_bounds
@@ -623,20 +629,22 @@ FIGURE_ORDER = ("monthly_yield", "battery_month", "soc_day", "ranking", "map_yie
 
 
 def write_report(run_dir: Path, summary: dict, figures: list[tuple[str, str, bytes]], cfg=None,
-                 segments=None, model: dict | None = None) -> Path:
+                 segments=None, model: dict | None = None, crs=None) -> Path:
     """Write ``report.html`` and ``figures/*.png``.
 
     *figures*: :meth:`Figures.results` (:func:`add_maps`, :func:`add_hourly`,
     :func:`add_routes`, :func:`add_charts`).  *segments*:
-    the run's ``segments.parquet`` frame (each segment's year); read from *run_dir* when not
-    given. *cfg*: the run's configuration (its inputs are listed). *model*: the extras of the
-    run's ``city.glb`` (:func:`vipvflow.outputs.gltf.write_gltf`), linked with its counts."""
+    the run's ``segments.parquet`` frame (each segment's year; its lines are not used);
+    read from *run_dir* when not given. *crs*: the segments' CRS (that of *segments* when
+    not given). *cfg*: the run's configuration (its inputs are listed). *model*: the extras
+    of the run's ``city.glb`` (:func:`vipvflow.outputs.gltf.write_gltf`), linked with its
+    counts."""
     import geopandas as gpd
 
     if segments is None:
         segments = gpd.read_parquet(run_dir / "segments.parquet")
     mapped = _mapped(segments)
-    crs = crs_label(mapped.crs)
+    crs = crs_label(crs if crs is not None else getattr(mapped, "crs", None))
     tiles = sorted(mapped["tile"].unique()) if "tile" in mapped else None
     shown = {name: (title, png) for name, title, png in figures}
     parts = []

@@ -875,8 +875,8 @@ def reduce_run(cfg: Config, year: int, run_dir: Path, say=print, client=None, cl
     placed = _placed_trips(run_dir, totals)
     n_buses = int(placed.groupby("service_date")["block_id"].nunique().max())
     # the segments first: the workers draw the maps while the trips are joined here
-    segments, sums = _segment_outputs(cfg, run_dir, parts.pop("segment_month"), parts["geometry"],
-                                      totals, n_buses, trips_meta)
+    segments, crs, sums = _segment_outputs(cfg, run_dir, parts.pop("segment_month"), parts["geometry"],
+                                           totals, n_buses, trips_meta)
     report.add_maps(figures, run_dir, cfg)
     # beside the figures, from the files just written: city.glb and the GeoParquet datasets
     model = _Aside(client, "city-glb", gltf.write_gltf, str(run_dir),
@@ -908,7 +908,7 @@ def reduce_run(cfg: Config, year: int, run_dir: Path, say=print, client=None, cl
     clock("figures")
     if cluster_done is not None:
         cluster_done()
-    report.write_report(run_dir, summary, drawn, cfg=cfg, segments=segments, model=glb)
+    report.write_report(run_dir, summary, drawn, cfg=cfg, segments=segments, model=glb, crs=crs)
     clock("report")
     return summary
 
@@ -994,9 +994,9 @@ def _segment_outputs(cfg: Config, run_dir: Path, sm: pd.DataFrame, geo: pd.DataF
     """Per segment and month (GeoParquet for maps) and per segment over the run (geometry
     factors and year) of the shapes of the trips in *totals* (:func:`_trip_totals`) run by
     *n_buses*; writes ``segment_month.parquet`` and ``segments.parquet``.  Returns the
-    segments and the sums over them the fleet-year's summary takes (:class:`_SegmentSums`;
-    not the per segment-month table: a network's is hundreds of MB the trips' step does not
-    need)."""
+    segments (a DataFrame, without their lines), their CRS and the sums over them the
+    fleet-year's summary takes (:class:`_SegmentSums`; not the per segment-month table: a
+    network's is hundreds of MB the trips' step does not need)."""
     from . import annual
 
     data_dir = Path(cfg.data_dir)
@@ -1018,7 +1018,9 @@ def _segment_outputs(cfg: Config, run_dir: Path, sm: pd.DataFrame, geo: pd.DataF
     segments = annual.segment_year(segments.merge(shape_route, on="shape_id", how="left"), geo, sm,
                                    cfg.pv_system().kwp, hours_per_bus)
     write_parquet(segments, RunDir(run_dir).output("segments.parquet"))
-    return segments, _SegmentSums.of(sm, segments)
+    # held on through the trips' step without their lines (a network's 300,000 shapely
+    # lines and strings were ~0.3 GB of the command's peak): the report takes their CRS
+    return pd.DataFrame(segments.drop(columns="geometry")), segments.crs, _SegmentSums.of(sm, segments)
 
 
 def _segment_month_rows(segments: gpd.GeoDataFrame, sm: pd.DataFrame, shape_route: pd.DataFrame):
