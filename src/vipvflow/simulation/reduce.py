@@ -874,14 +874,10 @@ def reduce_run(cfg: Config, year: int, run_dir: Path, say=print, client=None, cl
     totals = _trip_totals(run_dir, parts.pop("trip"))     # the Arrow sums not held on
     placed = _placed_trips(run_dir, totals)
     n_buses = int(placed.groupby("service_date")["block_id"].nunique().max())
-    # the segments first: the workers draw the maps while the trips are joined here
+    # the segments first (their files are what the maps, city.glb and the datasets are made of)
     segments, crs, sums = _segment_outputs(cfg, run_dir, parts.pop("segment_month"), parts["geometry"],
                                            totals, n_buses, trips_meta)
-    report.add_maps(figures, run_dir, cfg)
-    # beside the figures, from the files just written: city.glb and the GeoParquet datasets
-    model = _Aside(client, "city-glb", gltf.write_gltf, str(run_dir),
-                   str(RunDir(run_dir).output("city.glb")), str(cfg.data_dir))
-    datasets = _Aside(client, "geoparquet-datasets", write_datasets, str(run_dir))
+    del parts
     clock("segments")
     trip, bd, idle, traces = _trip_outputs(cfg, year, run_dir, totals, placed, trips_meta, say,
                                            consumption)
@@ -901,7 +897,15 @@ def reduce_run(cfg: Config, year: int, run_dir: Path, say=print, client=None, cl
     write_parquet(monthly, RunDir(run_dir).output("monthly.parquet"))
     write_json(summary, RunDir(run_dir).output("summary.json"))
     report.add_charts(figures, summary, monthly)
+    # the trips' and block-days' tables are written and summed: not held while the maps,
+    # city.glb and the GeoParquet datasets are made on the workers from the segments' files
+    # (made beside the trips' step, they added ~0.7 GB per worker to the run's peak)
+    del trip, bd, idle, traces, rm, ranking, monthly, totals, placed, trips_meta, hp
     clock("fleet")
+    report.add_maps(figures, run_dir, cfg)
+    model = _Aside(client, "city-glb", gltf.write_gltf, str(run_dir),
+                   str(RunDir(run_dir).output("city.glb")), str(cfg.data_dir))
+    datasets = _Aside(client, "geoparquet-datasets", write_datasets, str(run_dir))
     drawn = figures.results()
     glb = model.result()
     datasets.result()
