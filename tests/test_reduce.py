@@ -248,3 +248,31 @@ def test_the_service_intervals_are_each_kind_of_the_buses_in_service_in_file_ord
         for got, kind in ((lay, "layover"), (parked, "parked")):
             want = iv[(iv["block_id"] != IDLE_BLOCK) & (iv["kind"] == kind)][cols].reset_index(drop=True)
             pd.testing.assert_frame_equal(got, want)
+
+
+def test_trips_placed_by_their_keys_are_those_of_the_left_join(tmp_path):
+    """Each trip-day's block and position (:func:`_placed_trips`, keys looked up in Arrow)
+    is what the left join on (trip, date) gives, row by row with the trips: with every trip
+    in the timeline, and with some in none (missing, as the join leaves them); a key given
+    twice is refused."""
+    from vipvflow.simulation.reduce import _placed_trips, _rows_of_trip_days
+
+    rng = np.random.default_rng(5)
+    days = pd.date_range("2024-03-30", periods=4, freq="D")
+    runs = pd.DataFrame([(f"t{i}", d) for i in range(60) for d in days if rng.random() < 0.8],
+                        columns=["trip_id", "service_date"]).sample(frac=1.0, random_state=1)
+    runs["block_id"] = rng.choice(["b1", "b 2", "x"], len(runs))
+    runs["position"] = rng.integers(0, 9, len(runs))
+    write_parquet(runs, RunDir(tmp_path).timeline_table("trip_runs"))
+    runs = pd.read_parquet(RunDir(tmp_path).timeline_table("trip_runs"))
+    for totals in (runs[["trip_id", "service_date"]].sample(frac=0.7, random_state=2),
+                   pd.concat([runs[["trip_id", "service_date"]].iloc[:30],
+                              pd.DataFrame({"trip_id": ["t3", "nope"],
+                                            "service_date": pd.to_datetime(["2024-05-01", "2024-03-31"])})])):
+        totals = totals.reset_index(drop=True).astype({"trip_id": object})
+        want = (totals.merge(runs, on=["trip_id", "service_date"], how="left", validate="one_to_one")
+                [["service_date", "block_id", "position"]])
+        pd.testing.assert_frame_equal(_placed_trips(tmp_path, totals), want, check_exact=True)
+    assert (_rows_of_trip_days(runs, totals) < 0).sum() == 2
+    with pytest.raises(ValueError, match="twice"):
+        _rows_of_trip_days(pd.concat([runs, runs.iloc[:1]]), totals)

@@ -953,9 +953,45 @@ def _placed_trips(run_dir: Path, totals: pd.DataFrame) -> pd.DataFrame:
     (:func:`block_day_table`) take the trips' blocks from it."""
     runs = pd.read_parquet(RunDir(run_dir).timeline_table("trip_runs"),
                            columns=["trip_id", "service_date", "block_id", "position"])
-    placed = totals[["trip_id", "service_date"]].merge(runs, on=["trip_id", "service_date"],
-                                                      how="left", validate="one_to_one")
-    return placed[["service_date", "block_id", "position"]]
+    at = _rows_of_trip_days(runs, totals)
+    if (at >= 0).all():
+        placed = runs[["block_id", "position"]].take(at)
+    else:                       # the rows of no run: missing, as a left join leaves them
+        placed = runs[["block_id", "position"]].reindex(at)
+    placed.index = pd.RangeIndex(len(totals))
+    placed.insert(0, "service_date", totals["service_date"].to_numpy())
+    return placed
+
+
+def _rows_of_trip_days(table: pd.DataFrame, frame: pd.DataFrame) -> np.ndarray:
+    """Each row's of *frame* row of *table* with its ``trip_id`` and ``service_date`` (-1:
+    none), each pair once in both (else ``ValueError``).  The trip ids are looked up in
+    Arrow: a network's 4.7 M trip-days joined by their string keys took 1 GB for a moment."""
+    import pyarrow.compute as pc
+
+    def ids(df):
+        col = df["trip_id"]
+        return pa.array(col.array if pd.api.types.is_string_dtype(col.dtype) else col.astype(str).array,
+                        from_pandas=True).cast(pa.large_string())
+
+    known = pc.unique(ids(table))
+    days = [df["service_date"].to_numpy("datetime64[D]").astype(np.int64) for df in (table, frame)]
+    d0 = min((int(d.min()) for d in days if len(d)), default=0)
+    span = max((int(d.max()) for d in days if len(d)), default=0) - d0 + 1
+    keys = []
+    for df, day in zip((table, frame), days):
+        code = pc.fill_null(pc.index_in(ids(df), value_set=known), -1).to_numpy()
+        keys.append(np.where(code >= 0, code.astype(np.int64) * span + (day - d0), -1))
+    want, have = keys[1], keys[0]
+    order = np.argsort(have, kind="stable")
+    ranked = have[order]
+    for k in (ranked[ranked >= 0], np.sort(want[want >= 0])):
+        if len(k) > 1 and (k[1:] == k[:-1]).any():
+            raise ValueError("a trip and service date is given twice: the join is not one to one")
+    at = np.searchsorted(ranked, want)
+    hit = (want >= 0) & (at < len(ranked))
+    hit[hit] = ranked[at[hit]] == want[hit]
+    return np.where(hit, order[np.minimum(at, len(order) - 1)], -1)
 
 
 def _trip_outputs(cfg: Config, year: int, run_dir: Path, totals: pd.DataFrame, placed: pd.DataFrame,
