@@ -237,6 +237,17 @@ def test_timeline_partitions_every_block_day(small_feed):
     year = block_timeline(small_feed, 2024)["block_days"]
     year = year[year["service_date"].dt.month.isin([3, 10])].reset_index(drop=True)
     pd.testing.assert_frame_equal(bd.reset_index(drop=True), year)
+    # the ids are strings (held as categories inside), each table in the order of its strings
+    for name, keys in (("block_days", ["block_id", "service_date"]),
+                       ("intervals", ["block_id", "service_date", "t0_utc"]),
+                       ("trip_runs", ["block_id", "service_date", "position"])):
+        t = tl[name]
+        for c in ("block_id", "trip_id"):
+            if c in t:
+                assert pd.api.types.is_string_dtype(t[c].dtype), (name, c, t[c].dtype)
+                assert not isinstance(t[c].dtype, pd.CategoricalDtype), (name, c)
+        pd.testing.assert_frame_equal(t.reset_index(drop=True),
+                                      t.sort_values(keys, kind="stable").reset_index(drop=True))
 
 
 def test_small_run_splits_every_block_day(small_run, small_config):

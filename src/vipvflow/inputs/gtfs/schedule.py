@@ -576,7 +576,7 @@ def block_timeline(data_dir, year: int, months=None, routes=None, depot=None,
     runs, tz = _block_runs(data_dir, trips, year, months)
     bd, runs = _block_days(runs)
     lay, over, pos = _layovers(runs, stop_point)
-    dp = bd["first_stop_id"].map(depot_point) if depot is None else pd.Series(
+    dp = bd["first_stop_id"].astype(str).map(depot_point) if depot is None else pd.Series(
         depot_point["depot"], index=bd.index)
     am = pd.DataFrame({"block_id": bd["block_id"], "date": bd["date"], "kind": "parked", "after_trip": -1,
                        "point_id": dp, "t0_utc": bd["window_start_utc"], "t1_utc": bd["first_departure_utc"]})
@@ -586,7 +586,11 @@ def block_timeline(data_dir, year: int, months=None, routes=None, depot=None,
     fleet_depot = (depot_point["depot"] if depot is not None
                    else int(dp.mode().iloc[0]) if len(dp) else -1)
     idle, n_buses = _idle_buses(bd, year, months, fleet_depot, tz)
-    iv = pd.concat([am.assign(buses=1), lay.assign(buses=1), pm.assign(buses=1), idle], ignore_index=True)
+    # the blocks as one set of sorted categories (the idle buses' too): the intervals sort
+    # as by the strings, which they are given once sorted
+    blocks = pd.CategoricalDtype(pd.Index(sorted({*bd["block_id"].cat.categories, IDLE_BLOCK}), dtype=str))
+    iv = pd.concat([f.astype({"block_id": blocks}) for f in (am.assign(buses=1), lay.assign(buses=1),
+                                                             pm.assign(buses=1), idle)], ignore_index=True)
     del am, lay, pm, idle
     iv = iv[iv["t1_utc"] > iv["t0_utc"]]
     iv = iv.sort_values(_BLOCK_DAY + ["t0_utc"], kind="stable").reset_index(drop=True)
@@ -594,13 +598,24 @@ def block_timeline(data_dir, year: int, months=None, routes=None, depot=None,
                                                              "buses": np.int64})
     iv["month"] = month_labels(iv["service_date"])
     bd = _block_day_totals(bd, runs, over, iv)
-    trip_runs = pd.DataFrame({"trip_id": runs["trip_id"].astype(str), "service_date": runs["date"],
-                              "block_id": runs["block_id"].astype(str), "position": pos})
+    iv["block_id"] = _strings(iv["block_id"])
+    trip_runs = pd.DataFrame({"trip_id": _strings(runs["trip_id"]), "service_date": runs["date"],
+                              "block_id": _strings(runs["block_id"]), "position": pos})
     return {"block_days": bd, "intervals": iv, "points": pts, "trip_runs": trip_runs, "buses": n_buses}
 
 
 #: the columns that name a block-day
 _BLOCK_DAY = ["block_id", "date"]
+
+
+def _strings(values: pd.Series) -> pd.Series:
+    """A categorical Series of strings as the strings, taken from its categories by their
+    codes (in Arrow: no Python string per row, where ``astype(str)`` made one for each of a
+    network's millions of rows)."""
+    codes = values.cat.codes.to_numpy()
+    if (codes < 0).any() or not pd.api.types.is_string_dtype(values.cat.categories.dtype):
+        return values.astype(str)
+    return pd.Series(values.cat.categories.take(codes), index=values.index, name=values.name)
 
 
 def month_labels(dates):
@@ -663,6 +678,8 @@ def _timeline_points(data_dir, trips, ends, depot, depot_shading: str):
 #: the trips' columns of the timeline's runs (:func:`_block_runs`)
 _RUN_COLUMNS = ["trip_id", "service_id", "block_id", "first_stop_id", "last_stop_id", "start_s",
                 "end_s"]
+#: the runs' columns held as categories
+_RUN_STRINGS = ["trip_id", "block_id", "first_stop_id", "last_stop_id"]
 
 
 def _block_runs(data_dir, trips, year: int, months):
@@ -674,8 +691,11 @@ def _block_runs(data_dir, trips, year: int, months):
     in_run = sd["date"].dt.month.isin(list(months)) if months is not None else pd.Series(True, sd.index)
     before = (sd["date"] + pd.Timedelta(days=1)).dt.month.isin(list(months)) if months is not None else in_run
     sd = sd.assign(in_run=in_run)[in_run | (before & (sd["date"] + pd.Timedelta(days=1)).dt.year.eq(year))]
-    # a trip's columns repeat on each of its days: only those the timeline uses
-    runs = trips[_RUN_COLUMNS].merge(sd, on="service_id").drop(columns="service_id")
+    # a trip's columns repeat on each of its days: only those the timeline uses, its strings
+    # as categories (sorted: the runs sort as by the strings; a network's 4.7 M trip-days
+    # held four strings each, 0.9 GB)
+    runs = (trips[_RUN_COLUMNS].astype({c: "category" for c in _RUN_STRINGS})
+            .merge(sd, on="service_id").drop(columns="service_id"))
     tz = _feed_info(data_dir)["timezone"]
     udates = np.unique(runs["date"].to_numpy()) if len(runs) else np.zeros(0, "datetime64[ns]")
     origin = service_day_origin_utc(udates, tz)
@@ -719,10 +739,11 @@ def _layovers(runs, stop_point: dict):
     pos = idx - np.maximum.accumulate(np.where(np.r_[True, ~same], idx, 0)) if len(runs) else idx
     del idx
     gap = runs["t0"].to_numpy()[a + 1] - runs["t1"].to_numpy()[a]
-    stop, stops = pd.factorize(runs["last_stop_id"], use_na_sentinel=False)
+    stop, stops = pd.factorize(runs["last_stop_id"].array[a], use_na_sentinel=False)
+    stops = pd.Index(np.asarray(stops, dtype=object))
     lay = pd.DataFrame({"block_id": runs["block_id"].array[a], "date": date[a],
                         "kind": "layover", "after_trip": pos[a],
-                        "point_id": stops.map(stop_point).to_numpy()[stop[a]],
+                        "point_id": stops.map(stop_point).to_numpy()[stop],
                         "t0_utc": runs["t1"].to_numpy()[a], "t1_utc": runs["t0"].to_numpy()[a + 1]})
     over = pd.DataFrame({"block_id": lay["block_id"], "date": lay["date"],
                          "overlap_s": np.maximum(-gap, 0.0)})
@@ -751,14 +772,17 @@ def _block_day_totals(bd, runs, over, iv):
     bd["driving_s"] = driving.to_numpy()
     bd["overlap_s"] = over.groupby(key, sort=True)["overlap_s"].sum().reindex(
         pd.MultiIndex.from_frame(bd[key]), fill_value=0.0).to_numpy() if len(over) else 0.0
-    # per kind the rows of the buses in service (a mask, not a copy of the intervals)
-    own = (iv["block_id"] != IDLE_BLOCK).to_numpy(bool)
-    s = iv["t1_utc"] - iv["t0_utc"]
-    days = pd.MultiIndex.from_frame(bd[key])
+    # per kind the rows of the buses in service, each interval's block-day as its row of
+    # *bd* (-1: none; not a copy of the intervals' strings per kind)
+    at = pd.MultiIndex.from_frame(bd[key].astype({"block_id": iv["block_id"].dtype})).get_indexer(
+        pd.MultiIndex.from_arrays([iv["block_id"], iv["service_date"]]))
+    own = (iv["block_id"] != IDLE_BLOCK).to_numpy(bool) & (at >= 0)
+    s = (iv["t1_utc"] - iv["t0_utc"]).to_numpy()
     for kind in TIMELINE_KINDS:
         m = own & (iv["kind"] == kind).to_numpy(bool)
-        bd[f"{kind}_s"] = s[m].groupby([iv["block_id"][m], iv["service_date"][m]]).sum().reindex(
-            days, fill_value=0.0).to_numpy()
+        bd[f"{kind}_s"] = pd.Series(s[m]).groupby(at[m]).sum().reindex(
+            np.arange(len(bd)), fill_value=0.0).to_numpy()
     bd = bd.rename(columns={"date": "service_date"}).drop(columns=["day0", "day1", "first_stop_id"])
+    bd["block_id"] = _strings(bd["block_id"])
     bd["month"] = month_labels(bd["service_date"])
     return bd
