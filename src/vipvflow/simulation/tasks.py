@@ -47,7 +47,8 @@ def submit_tiles(client, ctx: RunContext, todo: list[tuple[str, str]]) -> list:
     ``irradiance-<TILE>`` task per tile computes its months (:func:`tile_task`), in the order
     of *todo* (the run's: largest tiles first); on a cluster with many task slots for the
     tiles, a tile's months are split over several ``irradiance-<TILE>-<first month>`` tasks
-    after one ``geometry-<TILE>`` task (:func:`tile_tasks`)."""
+    after one ``geometry-<TILE>`` task (:func:`tile_tasks`).  *ctx*: the run's context, or
+    its future (scattered once to the workers)."""
     slots = sum(w.get("nthreads", 1) for w in client.scheduler_info()["workers"].values())
     tasks = tile_tasks(todo, slots)
     geometry = {t: client.submit(geometry_task, ctx, t, key=f"geometry-{t}")
@@ -59,7 +60,8 @@ def submit_tiles(client, ctx: RunContext, todo: list[tuple[str, str]]) -> list:
 def submit_standing(client, ctx: RunContext, standing: list[str]) -> list:
     """Submit the standing points of the tiles *standing* (:func:`run_standing`); their
     futures.  A few large tasks, submitted once the timeline is written (after the tiles'
-    tasks): they go ahead of the tiles' tasks still waiting for a slot."""
+    tasks): they go ahead of the tiles' tasks still waiting for a slot.  *ctx*: as
+    :func:`submit_tiles`'s."""
     return [client.submit(run_standing, ctx, tile, key=f"standing-{tile}", priority=1)
             for tile in standing]
 
