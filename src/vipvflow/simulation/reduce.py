@@ -964,8 +964,8 @@ def _placed_trips(run_dir: Path, totals: pd.DataFrame) -> pd.DataFrame:
 
 
 def _rows_of_trip_days(table: pd.DataFrame, frame: pd.DataFrame) -> np.ndarray:
-    """Each row's of *frame* row of *table* with its ``trip_id`` and ``service_date`` (-1:
-    none), each pair once in both (else ``ValueError``).  The trip ids are looked up in
+    """For each row of *frame*, the row of *table* with the same ``trip_id`` and
+    ``service_date`` (-1: none); each pair must be once in both (else ``ValueError``).  The trip ids are looked up in
     Arrow: a network's 4.7 M trip-days joined by their string keys took 1 GB for a moment."""
     import pyarrow.compute as pc
 
