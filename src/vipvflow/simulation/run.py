@@ -178,7 +178,7 @@ def _run(cfg: Config, year: int, scheduler, n_workers, say, max_partitions, forc
 
         consumption = consumption_tasks(client, cfg, year, run_dir, say=say)
         # what the timeline's and the patterns' reads freed, handed back before the map's
-        # long wait (a network's ~0.35 GB, else held by this process through the reduce)
+        # long wait (a network's ~0.15 GB, else held by this process through the reduce)
         hand_back_memory()
         results = collect_map(client, futures, n_todo)
         timings["map_s"] = time.perf_counter() - t_map
