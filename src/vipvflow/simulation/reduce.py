@@ -656,52 +656,77 @@ def _service_intervals(path: Path, kinds: tuple, columns: list) -> list:
 BATTERY_ROWS = 8192
 
 
-class BlockDayRows:
-    """The rows of a block-day table (*bd*: ``block_id, service_date``, sorted by them, each
-    pair once) that other tables' rows belong to, as integers: the block-days' sums are then
-    grouped by an integer rather than by a (string, date) pair (a network's 4.7 M trips and
-    4.9 M intervals were grouped and re-indexed by their strings several times over)."""
+class DayRows:
+    """The rows of a *table* whose rows are each named by an id (its *column*: a block, a
+    trip) and a service date, each pair once, that other tables' rows have, as integers:
+    the ids are looked up in Arrow (no Python string per row) and the pairs compared as one
+    integer, not joined or grouped by (string, date) pairs (a network's 4.7 M trips and
+    4.9 M intervals were, several times over)."""
 
-    def __init__(self, bd: pd.DataFrame):
-        self.n = len(bd)
-        self._blocks = pd.Index(pd.unique(bd["block_id"].astype(str).to_numpy()))
-        self._blocks_pa = pa.array(self._blocks.to_numpy(object), pa.large_string())
-        days = self._days(bd)
+    def __init__(self, table: pd.DataFrame, column: str):
+        import pyarrow.compute as pc
+
+        self.n, self._column = len(table), column
+        self._known = pc.drop_null(pc.unique(self._arrow(table[column])))
+        self._index = pd.Index(self._known.to_numpy(zero_copy_only=False))
+        days = self._days(table)
         self._d0 = int(days.min()) if len(days) else 0
         self._span = int(days.max()) - self._d0 + 1 if len(days) else 1
-        self._key = self._keys(bd)
-        if len(self._key) and not (np.diff(self._key) > 0).all():
-            raise ValueError("the block-days must be sorted by block and date, each once")
+        self._key = self._keys(table)
+        self._check()
+        self._order = np.argsort(self._key, kind="stable")
+        self._sorted = self._key[self._order]
+
+    def _check(self) -> None:
+        key = np.sort(self._key[self._key >= 0])
+        if len(key) > 1 and (key[1:] == key[:-1]).any():
+            raise ValueError(f"a {self._column} and service date is given twice: the rows are not "
+                             "one per pair")
+
+    @staticmethod
+    def _arrow(values: pd.Series) -> pa.Array:
+        return pa.array(values.array if pd.api.types.is_string_dtype(values.dtype)
+                        else values.astype(str).array, from_pandas=True).cast(pa.large_string())
 
     @staticmethod
     def _days(frame: pd.DataFrame) -> np.ndarray:
         return frame["service_date"].to_numpy("datetime64[D]").astype(np.int64)
 
     def _keys(self, frame: pd.DataFrame) -> np.ndarray:
-        """Each row's (block, day) as one integer, ordered like the block-days; -1 where the
-        block or the day is none of theirs."""
+        """Each row's (id, day) as one integer; -1 where the id or the day is none of the
+        table's."""
         import pyarrow.compute as pc
 
-        block = frame["block_id"]
-        if isinstance(block.dtype, pd.CategoricalDtype):     # its categories, looked up once
-            code = self._blocks.get_indexer(block.cat.categories.astype(str))[block.cat.codes.to_numpy()]
-            code[block.cat.codes.to_numpy() < 0] = -1
-        else:                       # looked up in Arrow: no Python string per row
-            values = pa.array(block.array if pd.api.types.is_string_dtype(block.dtype)
-                              else block.astype(str).array, from_pandas=True)
-            code = pc.fill_null(pc.index_in(values.cast(pa.large_string()),
-                                            value_set=self._blocks_pa), -1).to_numpy()
+        ids = frame[self._column]
+        if isinstance(ids.dtype, pd.CategoricalDtype):     # its categories, looked up once
+            code = self._index.get_indexer(ids.cat.categories.astype(str))[ids.cat.codes.to_numpy()]
+            code[ids.cat.codes.to_numpy() < 0] = -1
+        else:
+            code = pc.fill_null(pc.index_in(self._arrow(ids), value_set=self._known), -1).to_numpy()
         day = self._days(frame) - self._d0
         ok = (code >= 0) & (day >= 0) & (day < self._span)
         return np.where(ok, code.astype(np.int64) * self._span + day, -1)
 
     def of(self, frame: pd.DataFrame) -> np.ndarray:
-        """Each row's block-day (its row of *bd*; -1: none)."""
+        """Each row's row of the table (-1: none)."""
         key = self._keys(frame)
-        at = np.searchsorted(self._key, key)
+        at = np.searchsorted(self._sorted, key)
         hit = (key >= 0) & (at < self.n)
-        hit[hit] = self._key[at[hit]] == key[hit]
-        return np.where(hit, at, -1)
+        hit[hit] = self._sorted[at[hit]] == key[hit]
+        return np.where(hit, self._order[np.minimum(at, max(self.n - 1, 0))], -1)
+
+
+class BlockDayRows(DayRows):
+    """The rows of a block-day table (*bd*: ``block_id, service_date``, sorted by them, each
+    pair once) that other tables' rows belong to (:class:`DayRows`): the block-days' sums are
+    grouped by that integer and spread back over *bd* (:meth:`spread`)."""
+
+    def __init__(self, bd: pd.DataFrame):
+        super().__init__(bd, "block_id")
+
+    def _check(self) -> None:
+        if len(self._key) and not (np.diff(self._key) > 0).all():
+            raise ValueError("the block-days must be sorted by block and date, each once")
 
     def spread(self, sums: pd.Series, fill: float) -> np.ndarray:
         """Per block-day (row of *bd*) the values of *sums* (indexed by row, as grouped by
@@ -965,33 +990,14 @@ def _placed_trips(run_dir: Path, totals: pd.DataFrame) -> pd.DataFrame:
 
 def _rows_of_trip_days(table: pd.DataFrame, frame: pd.DataFrame) -> np.ndarray:
     """For each row of *frame*, the row of *table* with the same ``trip_id`` and
-    ``service_date`` (-1: none); each pair must be once in both (else ``ValueError``).  The trip ids are looked up in
-    Arrow: a network's 4.7 M trip-days joined by their string keys took 1 GB for a moment."""
-    import pyarrow.compute as pc
-
-    def ids(df):
-        col = df["trip_id"]
-        return pa.array(col.array if pd.api.types.is_string_dtype(col.dtype) else col.astype(str).array,
-                        from_pandas=True).cast(pa.large_string())
-
-    known = pc.unique(ids(table))
-    days = [df["service_date"].to_numpy("datetime64[D]").astype(np.int64) for df in (table, frame)]
-    d0 = min((int(d.min()) for d in days if len(d)), default=0)
-    span = max((int(d.max()) for d in days if len(d)), default=0) - d0 + 1
-    keys = []
-    for df, day in zip((table, frame), days):
-        code = pc.fill_null(pc.index_in(ids(df), value_set=known), -1).to_numpy()
-        keys.append(np.where(code >= 0, code.astype(np.int64) * span + (day - d0), -1))
-    want, have = keys[1], keys[0]
-    order = np.argsort(have, kind="stable")
-    ranked = have[order]
-    for k in (ranked[ranked >= 0], np.sort(want[want >= 0])):
-        if len(k) > 1 and (k[1:] == k[:-1]).any():
-            raise ValueError("a trip and service date is given twice: the join is not one to one")
-    at = np.searchsorted(ranked, want)
-    hit = (want >= 0) & (at < len(ranked))
-    hit[hit] = ranked[at[hit]] == want[hit]
-    return np.where(hit, order[np.minimum(at, len(order) - 1)], -1)
+    ``service_date`` (-1: none; :class:`DayRows`); each pair must be once in both (else
+    ``ValueError``): a network's 4.7 M trip-days joined by their string keys took 1 GB for
+    a moment."""
+    at = DayRows(table, "trip_id").of(frame)
+    found = np.sort(at[at >= 0])
+    if len(found) > 1 and (found[1:] == found[:-1]).any():
+        raise ValueError("a trip and service date is given twice: the join is not one to one")
+    return at
 
 
 def _trip_outputs(cfg: Config, year: int, run_dir: Path, totals: pd.DataFrame, placed: pd.DataFrame,
