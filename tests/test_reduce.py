@@ -218,12 +218,14 @@ def test_segment_month_is_written_in_parts_as_the_whole_merge_was(tmp_path, monk
     one = write_parquet_parts(rows, tmp_path / "one" / "segment_month.parquet", geo)
     assert one.read_bytes() == at_once.read_bytes()
 
-    monkeypatch.setattr(R, "ROW_GROUP_ROWS", 3)
+    # parts of 2 rows in row groups of 3: a row group made of parts, a part split by one
+    monkeypatch.setattr(R, "SEGMENT_MONTH_PART_ROWS", 2)
     rows, geo = R._segment_month_rows(segments, sm, shape_route)
-    parts = write_parquet_parts(rows, tmp_path / "parts" / "segment_month.parquet", geo)
+    parts = write_parquet_parts(rows, tmp_path / "parts" / "segment_month.parquet", geo, row_group_rows=3)
     a, b = pq.read_table(at_once), pq.read_table(parts)
     assert b.schema.equals(a.schema, check_metadata=True) and b.equals(a)
-    assert pq.ParquetFile(parts).metadata.num_row_groups == 3
+    file = pq.ParquetFile(parts).metadata
+    assert [file.row_group(i).num_rows for i in range(file.num_row_groups)] == [3, 3, 1]
     assert b.column("segment_id").to_pylist() == [7, 7, 3, 3, 5, 5, 9]
 
 

@@ -366,19 +366,22 @@ def write_parquet(df, path: str | Path, pandas_dtypes: bool = False, compact: bo
     return path
 
 
-#: pyarrow's row group (rows): parts of this size written one by one (:func:`write_parquet_parts`)
-#: give a file the row groups of the whole written at once
+#: pyarrow's row group (rows): the row groups :func:`write_parquet_parts` gives a file, as
+#: a whole written at once has them
 ROW_GROUP_ROWS = 1 << 20
 
 
-def write_parquet_parts(parts, path: str | Path, metadata: dict | None = None) -> Path:
+def write_parquet_parts(parts, path: str | Path, metadata: dict | None = None,
+                        row_group_rows: int = ROW_GROUP_ROWS) -> Path:
     """Write the frames *parts* (consecutive slices of one DataFrame or GeoDataFrame, in
-    order) to *path* atomically as one file, as :func:`write_parquet` writes their
-    concatenation, holding one part at a time: each converted the same way and written as
-    its own row groups (parts of :data:`ROW_GROUP_ROWS` rows give the file the whole's).
-    *metadata* replaces the entries of the file's key-value metadata that describe the
-    whole rather than a part (a GeoParquet's ``geo``: the bounding box and geometry types
-    of all rows).  A part whose schema differs from the first's is an error."""
+    order, of any length) to *path* atomically as one file, as :func:`write_parquet` writes
+    their concatenation: each part converted the same way, and the converted parts written
+    as row groups of *row_group_rows* rows (the whole's), so what is held is one part and
+    the Arrow columns of one row group.  *metadata* replaces the entries of the file's
+    key-value metadata that describe the whole rather than a part (a GeoParquet's ``geo``:
+    the bounding box and geometry types of all rows).  A part whose schema differs from the
+    first's is an error."""
+    import pyarrow as pa
     import pyarrow.parquet as pq
 
     from .simulation.dictionary import OUTPUTS, annotate
@@ -386,7 +389,14 @@ def write_parquet_parts(parts, path: str | Path, metadata: dict | None = None) -
     path = Path(path)
     output = path.stem if path.suffix == ".parquet" and path.stem in OUTPUTS else None
     with atomic_path(path) as tmp:
-        writer = None
+        writer, pending, n = None, [], 0
+
+        def write(table):
+            nonlocal writer
+            if writer is None:
+                writer = pq.ParquetWriter(tmp, table.schema)
+            writer.write_table(table, row_group_size=row_group_rows)
+
         try:
             for part in parts:
                 table = _plain_table(part)
@@ -394,9 +404,18 @@ def write_parquet_parts(parts, path: str | Path, metadata: dict | None = None) -
                 if metadata:
                     table = table.replace_schema_metadata({**(table.schema.metadata or {}), **metadata})
                 table = annotate(table, output) if output else table
-                if writer is None:
-                    writer = pq.ParquetWriter(tmp, table.schema)
-                writer.write_table(table)
+                if pending and not table.schema.equals(pending[0].schema, check_metadata=True):
+                    raise ValueError(f"{path}: a part's schema differs from the first's")
+                pending.append(table)
+                n += table.num_rows
+                while n >= row_group_rows:      # a whole row group: written, its columns let go
+                    whole = pa.concat_tables(pending)
+                    write(whole.slice(0, row_group_rows))
+                    rest = whole.slice(row_group_rows)
+                    del whole
+                    pending, n = ([rest] if rest.num_rows else []), rest.num_rows
+            if pending and (n or writer is None):
+                write(pa.concat_tables(pending))
         finally:
             if writer is not None:
                 writer.close()

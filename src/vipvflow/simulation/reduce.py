@@ -75,6 +75,9 @@ def _part_table(run_dir: Path, kind: str, pattern: str = "tile=*/month=*.parquet
 TRIP_FILES_PER_TASK = 64
 #: trip partition files a task reads at once (:func:`sum_trips`)
 TRIP_READ_FILES = 8
+#: rows of segment_month.parquet made into a frame at a time (an eighth of a row group: a
+#: network's parts of a whole row group took 0.5 GB more each, their frame and its Arrow copy)
+SEGMENT_MONTH_PART_ROWS = ROW_GROUP_ROWS // 8
 
 
 def _tile_of(path: Path) -> str:
@@ -1060,7 +1063,7 @@ def _segment_outputs(cfg: Config, run_dir: Path, sm: pd.DataFrame, geo: pd.DataF
     shape_route = shape_routes(trips_meta[trips_meta["trip_id"].isin(totals["trip_id"].unique())])
     shape_route = shape_route[["shape_id", "route_short_name", "direction_id"]]
     parts, geo_meta = _segment_month_rows(segments, sm, shape_route)
-    write_parquet_parts(parts, RunDir(run_dir).output("segment_month.parquet"), geo_meta)
+    write_parquet_parts(parts, RunDir(run_dir).output("segment_month.parquet"), geo_meta, ROW_GROUP_ROWS)
     hours_per_bus = annual.service_hours_per_bus(float(totals["seconds"].sum()), n_buses,
                                                  12.0 / len(cfg.run.months))
     segments = annual.segment_year(segments.merge(shape_route, on="shape_id", how="left"), geo, sm,
@@ -1075,9 +1078,9 @@ def _segment_month_rows(segments: gpd.GeoDataFrame, sm: pd.DataFrame, shape_rout
     """The rows of ``segment_month.parquet``: each row of *sm* whose segment is one of
     *segments*, with the segment's ``shape_id`` and line and the shape's routes
     (*shape_route*), in the order of ``segments.merge(sm).merge(shape_route, how="left")``,
-    as GeoDataFrames of :data:`ROW_GROUP_ROWS` rows (a network's whole, 3.7 M rows, took
-    1.3 GB more than *sm*); and the GeoParquet metadata of all rows (the lines' bounding box
-    and types), for :func:`write_parquet_parts`."""
+    as GeoDataFrames of :data:`SEGMENT_MONTH_PART_ROWS` rows (a network's whole, 3.7 M
+    rows, took 1.3 GB more than *sm*); and the GeoParquet metadata of all rows (the lines'
+    bounding box and types), for :func:`write_parquet_parts`."""
     from geopandas.io.arrow import _geopandas_to_arrow
 
     seg = segments[["segment_id", "shape_id", "geometry"]].reset_index(drop=True)
@@ -1092,8 +1095,8 @@ def _segment_month_rows(segments: gpd.GeoDataFrame, sm: pd.DataFrame, shape_rout
                                             index=False).schema.metadata[b"geo"]}
 
     def parts():
-        for start in range(0, max(len(rows), 1), ROW_GROUP_ROWS):
-            take = rows[start:start + ROW_GROUP_ROWS]
+        for start in range(0, max(len(rows), 1), SEGMENT_MONTH_PART_ROWS):
+            take = rows[start:start + SEGMENT_MONTH_PART_ROWS]
             left = seg.iloc[at[take]].reset_index(drop=True)
             right = routes.reindex(left["shape_id"].to_numpy()).reset_index(drop=True)
             yield gpd.GeoDataFrame(pd.concat([left, sums.iloc[take].reset_index(drop=True), right], axis=1),
