@@ -278,3 +278,26 @@ def test_trips_placed_by_their_keys_are_those_of_the_left_join(tmp_path):
     assert (_rows_of_trip_days(runs, totals) < 0).sum() == 2
     with pytest.raises(ValueError, match="twice"):
         _rows_of_trip_days(pd.concat([runs, runs.iloc[:1]]), totals)
+
+
+def test_segment_sums_take_the_road_without_the_segments_inside_buildings():
+    """The fleet-year's light sums: every segment-month row for the roofs' light; for the
+    shading statistics only the road's (a segment inside a building footprint left out, a
+    segment the flags do not know taken as road); the passes and each segment's sums."""
+    from vipvflow.simulation import reduce as R
+
+    segments = pd.DataFrame({"segment_id": [4, 1, 2], "length_m": [10.0, 10.0, 5.0],
+                             "in_city_model": [True, True, False], "in_building": [False, True, False]})
+    sm = pd.DataFrame({"segment_id": [1, 4, 2, 1, 4, 9],
+                       "n_passes": [1, 2, 3, 4, 5, 6],
+                       "seconds": [1.0] * 6, "pv_kwh": [0.5] * 6,
+                       "h_direct": [1.0, 2.0, 4.0, 8.0, 16.0, 32.0],
+                       "h_diffuse": [0.5, 0.25, 0.125, 1.0, 2.0, 4.0],
+                       "h_total_unshaded": [10.0, 20.0, 30.0, 40.0, 50.0, 60.0]})
+    s = R._SegmentSums.of(sm, segments)
+    assert s.light.to_dict() == {"h_direct": 63.0, "h_diffuse": 7.875, "h_total_unshaded": 210.0}
+    # segment 1 (inside a building) left out of the road; segment 9 (unknown) kept
+    assert s.road.to_dict() == {"h_direct": 54.0, "h_diffuse": 6.375, "h_total_unshaded": 160.0}
+    assert s.passes == 21
+    assert s.per_segment.loc[1, "h_direct"] == 9.0 and s.per_segment.loc[9, "seconds"] == 1.0
+    assert bool(s.flags.loc[1, "in_building"]) and not s.flags.loc[2, "in_city_model"]

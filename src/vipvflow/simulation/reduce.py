@@ -1122,8 +1122,12 @@ class _SegmentSums(NamedTuple):
         # the light on the roofs: every segment; the shading statistics: the road, without
         # the segments inside building footprints (they take a nearby street's light)
         flags = _segment_flags(segments)
-        street = ~sm["segment_id"].map(flags["in_building"]).fillna(False).to_numpy(bool)
-        return cls(light=sm[h_cols].sum(), road=sm.loc[street, h_cols].sum(),
+        at = flags.index.get_indexer(sm["segment_id"])
+        street = ~np.where(at >= 0, flags["in_building"].to_numpy(bool)[at], False)
+        # column by column (the road's rows of all columns at once were a 0.4 GB copy; each
+        # column's sum is the same)
+        return cls(light=pd.Series({c: sm[c].sum() for c in h_cols}, dtype=float),
+                   road=pd.Series({c: sm.loc[street, c].sum() for c in h_cols}, dtype=float),
                    passes=int(sm["n_passes"].sum()),
                    per_segment=sm.groupby("segment_id")[["seconds", "pv_kwh", "h_direct", "h_diffuse",
                                                          "h_total_unshaded"]].sum(),
