@@ -301,3 +301,21 @@ def test_segment_sums_take_the_road_without_the_segments_inside_buildings():
     assert s.passes == 21
     assert s.per_segment.loc[1, "h_direct"] == 9.0 and s.per_segment.loc[9, "seconds"] == 1.0
     assert bool(s.flags.loc[1, "in_building"]) and not s.flags.loc[2, "in_city_model"]
+
+
+def test_layover_pv_is_the_join_of_the_standing_rows_sums_with_the_layovers():
+    """Each layover's PV: the standing rows of its block-day and the trip before it summed,
+    as a join of their (block-day, trip) sums with the layovers gives it; 0 for a layover of
+    no block-day, or after a trip no standing row follows (beyond the rows' last)."""
+    from vipvflow.simulation import reduce as R
+
+    rng = np.random.default_rng(8)
+    n = 4000
+    st = pd.DataFrame({"at": rng.integers(0, 60, n), "after": rng.integers(-1, 6, n), "pv": rng.random(n)})
+    lay = pd.DataFrame({"at": rng.integers(-1, 70, 900), "after": rng.integers(-1, 9, 900)})
+    sums = st.groupby(["at", "after"], as_index=False)["pv"].sum()
+    want = lay.merge(sums, on=["at", "after"], how="left")["pv"].fillna(0.0).to_numpy()
+    got = R._LayoverPV(st["at"].to_numpy(), st["after"].to_numpy(), st["pv"].to_numpy()).of(
+        lay["at"].to_numpy(), lay["after"].to_numpy())
+    assert (lay["after"] > st["after"].max()).any() and (lay["at"] < 0).any()
+    assert np.array_equal(got, want) and (got > 0).sum() > 400

@@ -548,6 +548,13 @@ def block_day_table(cfg: Config, run_dir: Path, trip: pd.DataFrame, vehicle, pla
     bd["pv_kwh_whole_day"] = bd["pv_kwh_driving"] + bd["pv_kwh_layover"] + bd["pv_kwh_parked"]
     bd["window_s"] = bd["window_end_utc"] - bd["window_start_utc"]
     del tl
+    # each layover's PV: the standing rows of its block-day and the trip before it, summed
+    # per (block-day, trip) pair as one integer before the layovers are read (the standing
+    # rows held beside them were a network's 0.2 GB)
+    mine = st["layover"] & (st_at >= 0)
+    lit = _LayoverPV(st_at[mine], st["after_trip"][mine], st["pv_kwh"][mine])
+    del st, st_at, mine                 # the standing rows are summed: not held through the battery's day
+    hand_back_memory()
 
     # the layovers (every one, with its terminal and PV) and the parked time at the depot
     lay, parked = _service_intervals(run.timeline_table("intervals"), ("layover", "parked"), [
@@ -555,18 +562,11 @@ def block_day_table(cfg: Config, run_dir: Path, trip: pd.DataFrame, vehicle, pla
     hand_back_memory()
     lay = lay.merge(pd.read_parquet(run.timeline_table("points"), columns=["point_id", "stop_id"]),
                     on="point_id", how="left").drop(columns="point_id")
-    # each layover's PV: the standing rows of its block-day and trip before it
     lay_at = rows.of(lay)
-    mine = st["layover"] & (st_at >= 0)
-    after = st["after_trip"][mine]
-    width = int(max(after.max(initial=0), lay["after_trip"].max() if len(lay) else 0)) + 2
-    lit = pd.Series(st["pv_kwh"][mine]).groupby(st_at[mine] * width + (after + 1)).sum()
-    lay_key = lay_at * width + (lay["after_trip"].to_numpy(np.int64) + 1)
-    lay["pv_kwh"] = lit.reindex(np.where(lay_at >= 0, lay_key, -1)).fillna(0.0).to_numpy()
+    lay["pv_kwh"] = lit.of(lay_at, lay["after_trip"].to_numpy(np.int64))
     lay["seconds"] = (lay["t1_utc"] - lay["t0_utc"]).to_numpy(float)
     parked = parked.assign(seconds=(parked["t1_utc"] - parked["t0_utc"]).to_numpy(float))
-    del st, st_at, lit, mine, after, lay_key   # the standing rows are summed: not held through the battery's day
-    hand_back_memory()
+    del lit
 
     # the layovers' auxiliaries (kWh from the battery) at the month's temperature
     temps = np.asarray(cfg.monthly_temperature_c(), float)
@@ -588,6 +588,23 @@ def block_day_table(cfg: Config, run_dir: Path, trip: pd.DataFrame, vehicle, pla
     trip["soc_at_departure"] = balance["soc_at_departure"]
     bd["pv_kwh_usable"] = bd["pv_kwh_whole_day"] - bd["pv_kwh_curtailed"]
     return bd, idle, trip, balance["traces"]
+
+
+class _LayoverPV:
+    """The standing rows' PV at layovers summed per layover: per block-day row (*at*) and
+    trip before it (*after*, -1: before the first), the pair as one integer (not a join of
+    the standing rows with the layovers)."""
+
+    def __init__(self, at: np.ndarray, after: np.ndarray, pv: np.ndarray):
+        after = np.asarray(after, np.int64)
+        self._width = int(after.max(initial=0)) + 2
+        self._sums = pd.Series(pv).groupby(np.asarray(at, np.int64) * self._width + (after + 1)).sum()
+
+    def of(self, at: np.ndarray, after: np.ndarray) -> np.ndarray:
+        """Each layover's PV (kWh; 0 where no standing row is of its block-day and trip)."""
+        after = np.asarray(after, np.int64) + 1
+        key = np.where((at >= 0) & (after >= 0) & (after < self._width), at * self._width + after, -1)
+        return self._sums.reindex(key).fillna(0.0).to_numpy()
 
 
 #: the standing partitions' columns of the idle buses' rows (:func:`_standing_rows`)
