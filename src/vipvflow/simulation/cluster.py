@@ -189,17 +189,14 @@ def close_client(client, cluster) -> None:
         cluster.close()
 
 
-def fresh_workers(client, timeout_s: float = 120.0) -> None:
+def fresh_workers(client) -> None:
     """Restart the workers of this run's own LocalCluster (their nannies start new ones, from
     the preloaded forkserver: ~1.5 s) and wait for them; what the old ones held is handed back
-    to the system.  Workers slow to come back (a loaded machine) are not waited for beyond
-    *timeout_s* once one is back.  The nannies' notice of each restart is not shown."""
+    to the system.  The nannies' notice of each restart is not shown to the user."""
     nanny = logging.getLogger("distributed.nanny")
     level = nanny.level
     nanny.setLevel(logging.ERROR)
     try:
-        client.restart(timeout=timeout_s)
-    except TimeoutError:
-        client.wait_for_workers(1, timeout=timeout_s)
+        client.restart()
     finally:
         nanny.setLevel(level)
