@@ -187,16 +187,3 @@ def close_client(client, cluster) -> None:
     client.close()
     if cluster is not None:
         cluster.close()
-
-
-def fresh_workers(client) -> None:
-    """Restart the workers of this run's own LocalCluster (their nannies start new ones, from
-    the preloaded forkserver: ~1.5 s) and wait for them; what the old ones held is handed back
-    to the system.  The nannies' notice of each restart is not shown to the user."""
-    nanny = logging.getLogger("distributed.nanny")
-    level = nanny.level
-    nanny.setLevel(logging.ERROR)
-    try:
-        client.restart()
-    finally:
-        nanny.setLevel(level)

@@ -429,21 +429,12 @@ class Consumption:
 
     def __init__(self, futures: list, vmod: dict):
         self.futures, self.vmod = futures, vmod
-        self._fetched: dict | None = None
 
     def results(self) -> dict:
-        if self._fetched is not None:
-            return self._fetched
         out = {}
         for part in (f.result() for f in self.futures):
             out.update(part)
         return out
-
-    def fetch(self) -> None:
-        """Bring the results into this process and let go of the futures (the cluster's
-        workers may be restarted then)."""
-        self._fetched = self.results()
-        self.futures = []
 
 
 def consumption_tasks(client, cfg: Config, year: int, run_dir: Path, say=print) -> Consumption:

@@ -19,8 +19,8 @@ from ..config import Config
 from ..errors import InputError
 from ..progress import FolderProgress
 from ..store import DataDir, FolderLock, data_dir_lock, folder_path, lock_for_writing, run_dir_lock
-from .cluster import (bound_dashboard, check_scheduler, close_client, fresh_workers,
-                      local_cluster_size, make_client)
+from .cluster import (bound_dashboard, check_scheduler, close_client, local_cluster_size,
+                      make_client)
 from .manifest import claim_run_dir, write_manifest
 from .network import selected_network
 from .partition import RunContext, hand_back_memory, partition_done, worker_bvh_builds
@@ -188,14 +188,6 @@ def _run(cfg: Config, year: int, scheduler, n_workers, say, max_partitions, forc
                 and all(standing_done(run_dir, t) for t in standing)):
             say("stopped before all partitions were computed; run the same command again to resume")
             return run_dir
-        if cluster is not None:
-            # the reduce on fresh workers of this run's own cluster (not a scheduler's given
-            # to it): what the map left in its workers' heaps beyond its caches (~0.13 GB
-            # each at network scale) is not held through the reduce, whose peak it was part of
-            t_fresh = time.perf_counter()
-            consumption.fetch()
-            fresh_workers(client)
-            timings["fresh_workers_s"] = time.perf_counter() - t_fresh
         # the partitions are read and summed by tasks on the cluster; the joins and the
         # outputs are made here
         t_red = time.perf_counter()
