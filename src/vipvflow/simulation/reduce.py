@@ -918,16 +918,18 @@ def reduce_run(cfg: Config, year: int, run_dir: Path, say=print, client=None, cl
     hp = _hourly_pattern(parts["hourly"])
     report.add_hourly(figures, hp)
     trips_meta = pd.read_parquet(DataDir(cfg.data_dir).gtfs.trips)
-    totals = _trip_totals(run_dir, parts.pop("trip"))     # the Arrow sums not held on
-    placed = _placed_trips(run_dir, totals)
-    n_buses = int(placed.groupby("service_date")["block_id"].nunique().max())
+    parts["totals"] = _trip_totals(run_dir, parts.pop("trip"))     # the Arrow sums not held on
+    parts["placed"] = _placed_trips(run_dir, parts["totals"])
+    n_buses = int(parts["placed"].groupby("service_date")["block_id"].nunique().max())
     # the segments first (their files are what the maps, city.glb and the datasets are made of)
     segments, crs, sums = _segment_outputs(cfg, run_dir, parts.pop("segment_month"), parts["geometry"],
-                                           totals, n_buses, trips_meta)
-    del parts
+                                           parts["totals"], n_buses, trips_meta)
     clock("segments")
-    trip, bd, idle, traces = _trip_outputs(cfg, year, run_dir, totals, placed, trips_meta, say,
-                                           consumption)
+    # the trip sums and their blocks handed over: the trips' step lets them go once they are
+    # joined into its table
+    trip, bd, idle, traces = _trip_outputs(cfg, year, run_dir, parts.pop("totals"), parts.pop("placed"),
+                                           trips_meta, say, consumption)
+    del parts
     clock("trips")
     rm = _route_month(trip, bd)
     # the fleet's coverage (summary.json's: annual scaling cancels) beside the routes'
@@ -947,7 +949,7 @@ def reduce_run(cfg: Config, year: int, run_dir: Path, say=print, client=None, cl
     # the trips' and block-days' tables are written and summed: not held while the maps,
     # city.glb and the GeoParquet datasets are made on the workers from the segments' files
     # (made beside the trips' step, they added ~0.7 GB per worker to the run's peak)
-    del trip, bd, idle, traces, rm, ranking, monthly, totals, placed, trips_meta, hp
+    del trip, bd, idle, traces, rm, ranking, monthly, trips_meta, hp
     clock("fleet")
     report.add_maps(figures, run_dir, cfg)
     model = _Aside(client, "city-glb", gltf.write_gltf, str(run_dir),
@@ -1040,6 +1042,7 @@ def _trip_outputs(cfg: Config, year: int, run_dir: Path, totals: pd.DataFrame, p
                if pd.api.types.is_string_dtype(meta[c].dtype)}
     trip = totals.merge(meta.astype({c: "category" for c in strings}), on="trip_id", how="left",
                         validate="many_to_one")
+    del totals          # joined (the caller hands it over)
     trip["month"] = month_labels(trip["service_date"])
     cons = trip_consumption(cfg, Path(cfg.data_dir), year, trip["pattern_id"].unique(),
                             vecto_dir=RunDir(run_dir).vecto, say=say, made=consumption)
@@ -1052,6 +1055,7 @@ def _trip_outputs(cfg: Config, year: int, run_dir: Path, totals: pd.DataFrame, p
     # vehicle block per day: driving, layovers, parked; the battery's share (sets the
     # trips' block_id to the timeline's: the GTFS block or the inferred one)
     bd, idle, trip, traces = block_day_table(cfg, run_dir, trip, cfg.vehicle_params(), placed)
+    del placed
     trip = trip.astype({c: t for c, t in strings.items() if isinstance(trip[c].dtype, pd.CategoricalDtype)})
     write_parquet(trip, RunDir(run_dir).output("trip_energy.parquet"))
     return trip, bd, idle, traces
