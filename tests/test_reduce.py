@@ -319,3 +319,27 @@ def test_layover_pv_is_the_join_of_the_standing_rows_sums_with_the_layovers():
         lay["at"].to_numpy(), lay["after"].to_numpy())
     assert (lay["after"] > st["after"].max()).any() and (lay["at"] < 0).any()
     assert np.array_equal(got, want) and (got > 0).sum() > 400
+
+
+def test_trips_share_of_their_block_days_is_that_of_the_join_by_block_and_date():
+    """Each trip's share of its block-day's values by its time among the block-day's trips:
+    what joining the block-days by block and date and grouping the trips by them gave, value
+    for value; NaN for a trip of no block-day."""
+    from vipvflow.simulation import reduce as R
+
+    rng = np.random.default_rng(4)
+    blocks = [f"b{i}" for i in range(30)]
+    days = pd.to_datetime(["2024-06-01", "2024-06-02", "2024-06-03"])
+    bd = pd.DataFrame([(b, d) for b in blocks for d in days], columns=["block_id", "service_date"])
+    bd["usable"], bd["grid"] = rng.random(len(bd)), rng.random(len(bd))
+    n = 2000
+    trip = pd.DataFrame({"block_id": rng.choice(blocks + ["nowhere"], n),
+                         "service_date": days[rng.integers(0, 3, n)], "seconds": rng.random(n) * 3600})
+    key = ["block_id", "service_date"]
+    share = trip["seconds"] / trip.groupby(key)["seconds"].transform("sum")
+    want = trip[key].join(bd.set_index(key)[["usable", "grid"]], on=key).drop(columns=key).mul(share, axis=0)
+    got = R._shared_by_time(trip, bd, ["usable", "grid"])
+    no_day = (trip["block_id"] == "nowhere").to_numpy()
+    assert no_day.any() and got.loc[no_day].isna().all().all()
+    pd.testing.assert_frame_equal(got[["usable", "grid"]], want, check_exact=True)
+    np.testing.assert_array_equal(got["share"].to_numpy()[~no_day], share.to_numpy()[~no_day])
