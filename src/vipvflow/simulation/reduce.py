@@ -153,10 +153,17 @@ def _months_frame(parts: list) -> pd.DataFrame:
         table = pa.concat_tables(parts)
         parts.clear()
         # the strings copied: pandas keeps Arrow's string columns as they are, and each
-        # received column is a view of its whole message, which it would keep alive
+        # received column is a view of its whole message, which it would keep alive; the
+        # tiles and months (a few values on every row: a network's 0.12 GB as strings) as
+        # categories, written as the strings they are (_segment_month_rows)
+        import pyarrow.compute as pc
+
         for i, field in enumerate(table.schema):
             if not (pa.types.is_floating(field.type) or pa.types.is_integer(field.type)):
-                table = table.set_column(i, field, pa.chunked_array([table.column(i).combine_chunks()]))
+                column = table.column(i).combine_chunks()
+                if field.name in ("tile", "month"):
+                    column = pc.dictionary_encode(column)
+                table = table.set_column(i, pa.field(field.name, column.type), pa.chunked_array([column]))
         return table.to_pandas(self_destruct=True)
     frames = [p.to_pandas() if isinstance(p, pa.Table) else p for p in parts]
     return pd.concat(frames, ignore_index=True) if frames else pd.DataFrame()
@@ -1111,6 +1118,7 @@ def _segment_month_rows(segments: gpd.GeoDataFrame, sm: pd.DataFrame, shape_rout
     rows = rows[np.argsort(at[rows], kind="stable")]
     routes = shape_route.set_index("shape_id")
     sums = sm.drop(columns="segment_id")
+    strings = {c: "str" for c in sums.columns if isinstance(sums[c].dtype, pd.CategoricalDtype)}
     used = np.unique(at[rows])
     geo_meta = {b"geo": _geopandas_to_arrow(gpd.GeoDataFrame(seg.iloc[used][["geometry"]], crs=segments.crs),
                                             index=False).schema.metadata[b"geo"]}
@@ -1120,7 +1128,8 @@ def _segment_month_rows(segments: gpd.GeoDataFrame, sm: pd.DataFrame, shape_rout
             take = rows[start:start + SEGMENT_MONTH_PART_ROWS]
             left = seg.iloc[at[take]].reset_index(drop=True)
             right = routes.reindex(left["shape_id"].to_numpy()).reset_index(drop=True)
-            yield gpd.GeoDataFrame(pd.concat([left, sums.iloc[take].reset_index(drop=True), right], axis=1),
+            rows_sums = sums.iloc[take].reset_index(drop=True).astype(strings)
+            yield gpd.GeoDataFrame(pd.concat([left, rows_sums, right], axis=1),
                                    geometry="geometry", crs=segments.crs)
 
     return parts(), geo_meta
