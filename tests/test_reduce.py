@@ -346,3 +346,18 @@ def test_trips_share_of_their_block_days_is_that_of_the_join_by_block_and_date()
     assert no_day.any() and got.loc[no_day].isna().all().all()
     pd.testing.assert_frame_equal(got[["usable", "grid"]], want, check_exact=True)
     np.testing.assert_array_equal(got["share"].to_numpy()[~no_day], share.to_numpy()[~no_day])
+
+
+def test_parts_typed_apart_by_their_values_are_refused_and_leave_no_file(tmp_path):
+    """Parts whose values give a column another type (a nullable integer column with a gap
+    in one part only) are refused with PartSchemaError (the trips' writer then writes the
+    whole at once), and no file or temporary file is left."""
+    from vipvflow.store import PartSchemaError
+
+    parts = [pd.DataFrame({"direction_id": pd.array([0, 1], dtype="Int32"), "x": [1.0, 2.0]}),
+             pd.DataFrame({"direction_id": pd.array([1, None], dtype="Int32"), "x": [3.0, 4.0]})]
+    with pytest.raises(PartSchemaError):
+        write_parquet_parts(iter(parts), tmp_path / "t.parquet", row_group_rows=1)
+    assert list(tmp_path.iterdir()) == []
+    whole = write_parquet(pd.concat(parts, ignore_index=True), tmp_path / "t.parquet")
+    assert pq.read_table(whole).num_rows == 4

@@ -366,6 +366,11 @@ def write_parquet(df, path: str | Path, pandas_dtypes: bool = False, compact: bo
     return path
 
 
+class PartSchemaError(ValueError):
+    """A part given to :func:`write_parquet_parts` converts to another schema than the first
+    (its values decide a column's type: a nullable integer column with a gap, say)."""
+
+
 #: pyarrow's row group (rows): the row groups :func:`write_parquet_parts` gives a file, as
 #: a whole written at once has them
 ROW_GROUP_ROWS = 1 << 20
@@ -389,7 +394,7 @@ def write_parquet_parts(parts, path: str | Path, metadata: dict | None = None,
     path = Path(path)
     output = path.stem if path.suffix == ".parquet" and path.stem in OUTPUTS else None
     with atomic_path(path) as tmp:
-        writer, pending, n = None, [], 0
+        writer, pending, n, first = None, [], 0, None
 
         def write(table):
             nonlocal writer
@@ -404,8 +409,9 @@ def write_parquet_parts(parts, path: str | Path, metadata: dict | None = None,
                 if metadata:
                     table = table.replace_schema_metadata({**(table.schema.metadata or {}), **metadata})
                 table = annotate(table, output) if output else table
-                if pending and not table.schema.equals(pending[0].schema, check_metadata=True):
-                    raise ValueError(f"{path}: a part's schema differs from the first's")
+                first = table.schema if first is None else first
+                if not table.schema.equals(first, check_metadata=True):
+                    raise PartSchemaError(f"{path}: a part's schema differs from the first's")
                 pending.append(table)
                 n += table.num_rows
                 while n >= row_group_rows:      # a whole row group: written, its columns let go

@@ -22,8 +22,8 @@ import pyarrow.parquet as pq
 from ..config import Config
 from ..errors import InputError
 from ..models.irradiance import shading_loss
-from ..store import (HOURLY_METADATA, ROW_GROUP_ROWS, DataDir, RunDir, write_json, write_parquet,
-                     write_parquet_parts)
+from ..store import (HOURLY_METADATA, ROW_GROUP_ROWS, DataDir, PartSchemaError, RunDir, write_json,
+                     write_parquet, write_parquet_parts)
 from .partition import hand_back_memory
 
 log = logging.getLogger(__name__)
@@ -78,6 +78,8 @@ TRIP_READ_FILES = 8
 #: rows of segment_month.parquet made into a frame at a time (an eighth of a row group: a
 #: network's parts of a whole row group took 0.5 GB more each, their frame and its Arrow copy)
 SEGMENT_MONTH_PART_ROWS = ROW_GROUP_ROWS // 8
+#: rows of trip_energy.parquet converted at a time (:func:`_trip_outputs`)
+TRIP_PART_ROWS = ROW_GROUP_ROWS // 8
 
 
 def _tile_of(path: Path) -> str:
@@ -1063,9 +1065,16 @@ def _trip_outputs(cfg: Config, year: int, run_dir: Path, totals: pd.DataFrame, p
     # trips' block_id to the timeline's: the GTFS block or the inferred one)
     bd, idle, trip, traces = block_day_table(cfg, run_dir, trip, cfg.vehicle_params(), placed)
     del placed
-    trip = trip.astype({c: t for c, t in strings.items() if isinstance(trip[c].dtype, pd.CategoricalDtype)})
-    write_parquet(trip, RunDir(run_dir).output("trip_energy.parquet"))
-    return trip, bd, idle, traces
+    back = {c: t for c, t in strings.items() if isinstance(trip[c].dtype, pd.CategoricalDtype)}
+    path = RunDir(run_dir).output("trip_energy.parquet")
+    try:
+        # a slice at a time, each with its names as strings (the whole table's Arrow copy
+        # beside it was the top of a network's trips' step)
+        write_parquet_parts((trip.iloc[i:i + TRIP_PART_ROWS].astype(back)
+                             for i in range(0, max(len(trip), 1), TRIP_PART_ROWS)), path)
+    except PartSchemaError:     # slices typed apart by their values: the whole at once
+        write_parquet(trip.astype(back), path)
+    return trip.astype(back), bd, idle, traces
 
 
 def _segment_outputs(cfg: Config, run_dir: Path, sm: pd.DataFrame, geo: pd.DataFrame | None,
