@@ -191,14 +191,14 @@ def test_the_battery_in_chunks_is_the_battery_at_once(small_run, small_config, m
         monkeypatch.setattr(reduce, "BATTERY_ROWS", rows)
         return reduce.block_day_table(cfg, small_run, trip.copy(), cfg.vehicle_params(), placed)
 
-    bd, idle, trips, traces = table(1 << 20)
+    bd, idle, trips, traces, _ = table(1 << 20)
     assert len(bd) > 7
     pd.testing.assert_series_equal(trips["soc_at_departure"], written["soc_at_departure"])
     ran = pd.read_parquet(small_run / "block_day.parquet")
     for c in ("soc_start", "soc_lowest_pv", "soc_lowest_nopv", "grid_kwh_avoided", "pv_kwh_curtailed"):
         pd.testing.assert_series_equal(bd[c], ran[c], check_exact=True)
     for rows in (3, 7):
-        bd_c, _, trips_c, traces_c = table(rows)
+        bd_c, _, trips_c, traces_c, _ = table(rows)
         pd.testing.assert_frame_equal(bd_c, bd, check_exact=True)
         pd.testing.assert_series_equal(trips_c["soc_at_departure"], trips["soc_at_departure"], check_exact=True)
         pd.testing.assert_frame_equal(traces_c, traces, check_exact=True)

@@ -341,7 +341,7 @@ def test_trips_share_of_their_block_days_is_that_of_the_join_by_block_and_date()
     key = ["block_id", "service_date"]
     share = trip["seconds"] / trip.groupby(key)["seconds"].transform("sum")
     want = trip[key].join(bd.set_index(key)[["usable", "grid"]], on=key).drop(columns=key).mul(share, axis=0)
-    got = R._shared_by_time(trip, bd, ["usable", "grid"])
+    got = R.TripShares(R.BlockDayRows(bd).of(trip), trip["seconds"]).of(bd, ["usable", "grid"], trip.index)
     no_day = (trip["block_id"] == "nowhere").to_numpy()
     assert no_day.any() and got.loc[no_day].isna().all().all()
     pd.testing.assert_frame_equal(got[["usable", "grid"]], want, check_exact=True)

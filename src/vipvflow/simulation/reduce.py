@@ -517,7 +517,8 @@ def block_day_table(cfg: Config, run_dir: Path, trip: pd.DataFrame, vehicle, pla
     Also the idle buses' parked days (their battery is full: their PV is curtailed), and
     *trip* (the reduce's per-trip table: ``pv_kwh``, ``consumption_kwh``) with the
     timeline's ``block_id`` (the GTFS block, or the inferred one) and each trip's SoC at
-    departure.  The layovers' auxiliaries draw the vehicle's base load and HVAC at the
+    departure, and each trip's row of the block-days (-1: none; :meth:`BlockDayRows.of`).
+    The layovers' auxiliaries draw the vehicle's base load and HVAC at the
     month's mean temperature through the battery's discharge efficiency; the PV of layovers
     and parking counts only when ``fleet.harvest`` evaluates it.
     """
@@ -596,7 +597,7 @@ def block_day_table(cfg: Config, run_dir: Path, trip: pd.DataFrame, vehicle, pla
             bd[c] = v
     trip["soc_at_departure"] = balance["soc_at_departure"]
     bd["pv_kwh_usable"] = bd["pv_kwh_whole_day"] - bd["pv_kwh_curtailed"]
-    return bd, idle, trip, balance["traces"]
+    return bd, idle, trip, balance["traces"], trip_at
 
 
 class _LayoverPV:
@@ -936,18 +937,18 @@ def reduce_run(cfg: Config, year: int, run_dir: Path, say=print, client=None, cl
     clock("segments")
     # the trip sums and their blocks handed over: the trips' step lets them go once they are
     # joined into its table
-    trip, bd, idle, traces = _trip_outputs(cfg, year, run_dir, parts.pop("totals"), parts.pop("placed"),
+    trip, bd, idle, traces, shares = _trip_outputs(cfg, year, run_dir, parts.pop("totals"), parts.pop("placed"),
                                            trips_meta, say, consumption)
     del parts
     clock("trips")
-    rm = _route_month(trip, bd)
+    rm = _route_month(trip, bd, shares)
     # the fleet's coverage (summary.json's: annual scaling cancels) beside the routes'
     coverage = float(bd["pv_kwh_usable"].sum() / bd["demand_kwh"].sum()) if len(bd) else None
     report.add_routes(figures, rm, coverage)
     report.add_battery(figures, traces, cfg.vehicle_params().soc_min)
     write_parquet(rm, RunDir(run_dir).output("route_month.parquet"))
     write_parquet(bd, RunDir(run_dir).output("block_day.parquet"))
-    ranking = _ranking(cfg, bd, trip, 12.0 / len(cfg.run.months))
+    ranking = _ranking(cfg, bd, trip, shares, 12.0 / len(cfg.run.months))
     write_parquet(ranking, RunDir(run_dir).output("ranking.parquet"))
     report.add_ranking(figures, ranking)
     write_parquet(hp, RunDir(run_dir).output("hourly_pattern.parquet"))
@@ -1039,7 +1040,8 @@ def _trip_outputs(cfg: Config, year: int, run_dir: Path, totals: pd.DataFrame, p
     the vehicle model's consumption; the timeline's block of each, *placed*, row by row with
     *totals*: the joins here keep their rows' order) and per block-day (driving, layovers,
     parked; the battery's share); writes ``trip_energy.parquet``.  Returns the trips, the
-    block-days and the idle buses' days."""
+    block-days, the idle buses' days, the batteries' traces and the trips' shares of their
+    block-days (:class:`TripShares`)."""
     from ..inputs.gtfs.schedule import month_labels
 
     meta = trips_meta.reindex(columns=["trip_id", "route_id", "route_short_name", "route_long_name",
@@ -1063,8 +1065,10 @@ def _trip_outputs(cfg: Config, year: int, run_dir: Path, totals: pd.DataFrame, p
     strings.update(later)
     # vehicle block per day: driving, layovers, parked; the battery's share (sets the
     # trips' block_id to the timeline's: the GTFS block or the inferred one)
-    bd, idle, trip, traces = block_day_table(cfg, run_dir, trip, cfg.vehicle_params(), placed)
+    bd, idle, trip, traces, trip_at = block_day_table(cfg, run_dir, trip, cfg.vehicle_params(), placed)
     del placed
+    shares = TripShares(trip_at, trip["seconds"])
+    del trip_at
     back = {c: t for c, t in strings.items() if isinstance(trip[c].dtype, pd.CategoricalDtype)}
     path = RunDir(run_dir).output("trip_energy.parquet")
     try:
@@ -1074,7 +1078,7 @@ def _trip_outputs(cfg: Config, year: int, run_dir: Path, totals: pd.DataFrame, p
                              for i in range(0, max(len(trip), 1), TRIP_PART_ROWS)), path)
     except PartSchemaError:     # slices typed apart by their values: the whole at once
         write_parquet(trip.astype(back), path)
-    return trip.astype(back), bd, idle, traces
+    return trip.astype(back), bd, idle, traces, shares
 
 
 def _segment_outputs(cfg: Config, run_dir: Path, sm: pd.DataFrame, geo: pd.DataFrame | None,
@@ -1188,28 +1192,35 @@ def shape_routes(trips: pd.DataFrame) -> pd.DataFrame:
     return out.reset_index()
 
 
-def _shared_by_time(trip: pd.DataFrame, bd: pd.DataFrame, columns: list) -> pd.DataFrame:
-    """Each trip's share of its block-day's *columns* (*bd*'s, sorted by block and date), by
-    its time among the block-day's trips, row by row with *trip*, and the share itself
-    (``share``); NaN for a trip of no block-day.  The trips' block-days are found as
-    :class:`BlockDayRows` (not joined or grouped by block and date strings: a network's 4.7 M
-    trips took 0.3 GB for it, twice, at the reduce's peak)."""
-    at = BlockDayRows(bd).of(trip)
-    seconds = trip["seconds"].to_numpy(float)
-    share = seconds / pd.Series(seconds).groupby(at).transform("sum").to_numpy()
-    share[at < 0] = np.nan
-    out = pd.DataFrame({c: np.where(at >= 0, bd[c].to_numpy(float)[np.maximum(at, 0)], np.nan) * share
-                        for c in columns}, index=trip.index)
-    out["share"] = share
-    return out
+class TripShares:
+    """Each trip's share of its block-day by its time among the block-day's trips (*at*: the
+    trips' rows of the block-days, :meth:`BlockDayRows.of`, -1 for none; *seconds*: their
+    time), found once for the routes and the ranking (not by joining or grouping by block
+    and date strings: a network's 4.7 M trips took 0.3 GB for it, twice, at the reduce's
+    peak).  ``share``: row by row with the trips, NaN for a trip of no block-day."""
+
+    def __init__(self, at: np.ndarray, seconds):
+        self.at = np.asarray(at, np.int64)
+        seconds = np.asarray(seconds, float)
+        self.share = seconds / pd.Series(seconds).groupby(self.at).transform("sum").to_numpy()
+        self.share[self.at < 0] = np.nan
+
+    def of(self, bd: pd.DataFrame, columns: list, index=None) -> pd.DataFrame:
+        """The trips' shares of their block-days' *columns* (*bd*'s, the rows *at* is of),
+        and the share itself (``share``), indexed by *index* (the trips')."""
+        at, has = np.maximum(self.at, 0), self.at >= 0
+        out = pd.DataFrame({c: np.where(has, bd[c].to_numpy(float)[at], np.nan) * self.share
+                            for c in columns}, index=index)
+        out["share"] = self.share
+        return out
 
 
-def _route_month(trip: pd.DataFrame, bd: pd.DataFrame) -> pd.DataFrame:
+def _route_month(trip: pd.DataFrame, bd: pd.DataFrame, shares: TripShares) -> pd.DataFrame:
     """Per route, direction and month: trips, time, kWh, consumption, coverage, shading loss,
     and the block-days' PV at layovers, parked, curtailed and taken by the batteries, shared
     among the routes by their trips' time in each block-day."""
-    shared = _shared_by_time(trip, bd, ["pv_kwh_layover", "pv_kwh_parked", "pv_kwh_curtailed",
-                                        "pv_kwh_usable"]).drop(columns="share")
+    shared = shares.of(bd, ["pv_kwh_layover", "pv_kwh_parked", "pv_kwh_curtailed", "pv_kwh_usable"],
+                       trip.index).drop(columns="share")
     trip = pd.concat([trip.drop(columns=[c for c in shared.columns if c in trip]), shared], axis=1)
     trip = trip.assign(pv_kwh_driving=trip["pv_kwh"])
     kwh_cols = [c for c in trip.columns if c.startswith("pv_kwh")] + ["seconds"]
@@ -1230,7 +1241,8 @@ def _route_month(trip: pd.DataFrame, bd: pd.DataFrame) -> pd.DataFrame:
     return rm
 
 
-def _ranking(cfg: Config, bd: pd.DataFrame, trip: pd.DataFrame, annualise: float) -> pd.DataFrame:
+def _ranking(cfg: Config, bd: pd.DataFrame, trip: pd.DataFrame, shares: TripShares,
+             annualise: float) -> pd.DataFrame:
     """Which buses to equip first: the blocks (a bus's daily duty) and the routes ranked by
     the grid energy PV avoids per installed kWp and year, with the simple payback of one
     bus's system on it.  A block's year is its block-days in the run (scaled to a year); a
@@ -1256,7 +1268,7 @@ def _ranking(cfg: Config, bd: pd.DataFrame, trip: pd.DataFrame, annualise: float
                            "block_days": blk["block_days"].to_numpy(),
                            "grid_kwh_avoided_per_year": blk["grid"].to_numpy() * annualise,
                            "pv_kwh_usable_per_year": blk["usable"].to_numpy() * annualise})
-    per = _shared_by_time(trip, bd, ["grid_kwh_avoided", "pv_kwh_usable"])
+    per = shares.of(bd, ["grid_kwh_avoided", "pv_kwh_usable"], trip.index)
     t = trip[["route_id", "route_short_name"]].assign(grid=per["grid_kwh_avoided"], usable=per["pv_kwh_usable"],
                                                       bus_days=per["share"])
     rt = t.groupby("route_id").agg(name=("route_short_name", "first"), bus_days=("bus_days", "sum"),
