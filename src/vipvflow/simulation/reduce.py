@@ -1078,7 +1078,10 @@ def _trip_outputs(cfg: Config, year: int, run_dir: Path, totals: pd.DataFrame, p
                              for i in range(0, max(len(trip), 1), TRIP_PART_ROWS)), path)
     except PartSchemaError:     # slices typed apart by their values: the whole at once
         write_parquet(trip.astype(back), path)
-    return trip.astype(back), bd, idle, traces, shares
+    # the trips go on with their names as categories: the routes', the ranking's and the
+    # months' tables take them back to their values (a network's table as strings was
+    # 0.45 GB more, at the trips' and the fleet's steps)
+    return trip, bd, idle, traces, shares
 
 
 def _segment_outputs(cfg: Config, run_dir: Path, sm: pd.DataFrame, geo: pd.DataFrame | None,
@@ -1192,6 +1195,15 @@ def shape_routes(trips: pd.DataFrame) -> pd.DataFrame:
     return out.reset_index()
 
 
+def _as_values(frame: pd.DataFrame) -> pd.DataFrame:
+    """*frame* with its categorical columns as the values they stand for (their categories'
+    own dtype: the trips' names are held as categories through the reduce, their tables'
+    keys written as the strings they are)."""
+    cats = {c: frame[c].cat.categories.dtype for c in frame.columns
+            if isinstance(frame[c].dtype, pd.CategoricalDtype)}
+    return frame.astype(cats) if cats else frame
+
+
 class TripShares:
     """Each trip's share of its block-day by its time among the block-day's trips (*at*: the
     trips' rows of the block-days, :meth:`BlockDayRows.of`, -1 for none; *seconds*: their
@@ -1225,15 +1237,15 @@ def _route_month(trip: pd.DataFrame, bd: pd.DataFrame, shares: TripShares) -> pd
     trip = trip.assign(pv_kwh_driving=trip["pv_kwh"])
     kwh_cols = [c for c in trip.columns if c.startswith("pv_kwh")] + ["seconds"]
     key = ["route_id", "route_short_name", "direction_id", "month"]
-    rm = (trip.groupby(key, sort=True, dropna=False)
+    rm = (trip.groupby(key, sort=True, dropna=False, observed=True)
           .agg(trips=("trip_id", "size"), **{c: (c, "sum") for c in kwh_cols + ["consumption_kwh"]})
           .reset_index())
     # the route's long name and the direction's most frequent headsign
-    names = (trip.groupby(key[:3], sort=True, dropna=False)
+    names = (trip.groupby(key[:3], sort=True, dropna=False, observed=True)
              .agg(route_long_name=("route_long_name", "first"),
                   trip_headsign=("trip_headsign", lambda v: v.mode().iloc[0] if v.notna().any() else pd.NA))
              .reset_index())
-    rm = rm.merge(names, on=key[:3], how="left")
+    rm = _as_values(rm.merge(names, on=key[:3], how="left"))
     rm.insert(2, "route_long_name", rm.pop("route_long_name").astype("string"))
     rm.insert(4, "trip_headsign", rm.pop("trip_headsign").astype("string"))
     rm["coverage"] = rm["pv_kwh"] / rm["consumption_kwh"]
@@ -1271,7 +1283,7 @@ def _ranking(cfg: Config, bd: pd.DataFrame, trip: pd.DataFrame, shares: TripShar
     per = shares.of(bd, ["grid_kwh_avoided", "pv_kwh_usable"], trip.index)
     t = trip[["route_id", "route_short_name"]].assign(grid=per["grid_kwh_avoided"], usable=per["pv_kwh_usable"],
                                                       bus_days=per["share"])
-    rt = t.groupby("route_id").agg(name=("route_short_name", "first"), bus_days=("bus_days", "sum"),
+    rt = t.groupby("route_id", observed=True).agg(name=("route_short_name", "first"), bus_days=("bus_days", "sum"),
                                    grid=("grid", "sum"), usable=("usable", "sum"))
     buses = rt["bus_days"] / period_days       # buses the route keeps busy, on average
     routes = pd.DataFrame({"kind": "route", "id": rt.index.astype(str), "name": rt["name"].astype(str).to_numpy(),
@@ -1394,13 +1406,13 @@ def _monthly(cfg: Config, trip: pd.DataFrame, bd: pd.DataFrame, idle: pd.DataFra
     from ..models import economics
 
     pv, vehicle = cfg.pv_system(), cfg.vehicle_params()
-    monthly = (trip.groupby("month", sort=True)
-               .agg(trips=("trip_id", "size"), pv_kwh=("pv_kwh", "sum"), pv_kwh_clear=("pv_kwh_clear", "sum"),
-                    pv_kwh_unshaded=("pv_kwh_unshaded", "sum"),
-                    pv_kwh_clear_unshaded=("pv_kwh_clear_unshaded", "sum"),
-                    pv_kwh_direct=("pv_kwh_direct", "sum"), pv_kwh_diffuse=("pv_kwh_diffuse", "sum"),
-                    pv_kwh_reflected=("pv_kwh_reflected", "sum"),
-                    consumption_kwh=("consumption_kwh", "sum")).reset_index())
+    months = trip.groupby("month", sort=True, observed=True)
+    monthly = _as_values(months.agg(
+        trips=("trip_id", "size"), pv_kwh=("pv_kwh", "sum"), pv_kwh_clear=("pv_kwh_clear", "sum"),
+        pv_kwh_unshaded=("pv_kwh_unshaded", "sum"), pv_kwh_clear_unshaded=("pv_kwh_clear_unshaded", "sum"),
+        pv_kwh_direct=("pv_kwh_direct", "sum"), pv_kwh_diffuse=("pv_kwh_diffuse", "sum"),
+        pv_kwh_reflected=("pv_kwh_reflected", "sum"), consumption_kwh=("consumption_kwh", "sum")
+    ).reset_index())
     monthly["shading_loss"] = shading_loss(monthly["pv_kwh_direct"], monthly["pv_kwh_diffuse"],
                                            monthly["pv_kwh_unshaded"])
     bd = bd.assign(infeasible=~bd["feasible"].to_numpy(bool),
