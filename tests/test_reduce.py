@@ -209,10 +209,20 @@ def test_segment_month_is_written_in_parts_as_the_whole_merge_was(tmp_path, monk
     sm = pd.DataFrame({"segment_id": [5, 3, 11, 7, 5, 3, 9, 7],
                        "month": ["2024-01"] * 4 + ["2024-02"] * 4,
                        "n_passes": rng.integers(1, 50, 8), "pv_kwh": rng.random(8)})
+    for c in ("h_direct", "h_diffuse", "h_reflected", "h_total_unshaded", "h_direct_clear",
+              "h_diffuse_clear", "h_total_clear_unshaded"):
+        sm[c] = rng.random(8) * 1000.0
+    sm.loc[2, "h_total_unshaded"] = 0.0           # no light: no loss or gain
     shape_route = pd.DataFrame({"shape_id": ["a", "b"],
                                 "route_short_name": pd.array(["1", "2, 3"], dtype="string"),
                                 "direction_id": pd.array([0, pd.NA], dtype="Int32")})
-    whole = segments[["segment_id", "shape_id", "geometry"]].merge(sm, on="segment_id", how="inner")
+    # with the losses of each row (made a part at a time)
+    unshaded = sm["h_total_unshaded"].where(sm["h_total_unshaded"] > 0)
+    losses = sm.assign(shading_loss=1.0 - (sm["h_direct"] + sm["h_diffuse"]) / unshaded,
+                       shading_loss_clear=1.0 - (sm["h_direct_clear"] + sm["h_diffuse_clear"])
+                       / sm["h_total_clear_unshaded"],
+                       reflection_gain=sm["h_reflected"] / unshaded)
+    whole = segments[["segment_id", "shape_id", "geometry"]].merge(losses, on="segment_id", how="inner")
     whole = gpd.GeoDataFrame(whole.merge(shape_route, on="shape_id", how="left"), geometry="geometry",
                              crs=segments.crs)
     at_once = write_parquet(whole, tmp_path / "whole" / "segment_month.parquet")

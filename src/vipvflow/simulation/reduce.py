@@ -1098,30 +1098,39 @@ def _segment_outputs(cfg: Config, run_dir: Path, sm: pd.DataFrame, geo: pd.DataF
     segments = gpd.read_parquet(DataDir(data_dir).gtfs.segments)
     shapes = trips_meta.loc[trips_meta["trip_id"].isin(totals["trip_id"].unique()), "shape_id"]
     segments = segments[segments["shape_id"].isin(shapes.unique())]
-    # shading loss: sky and sun light the buildings take away (1 - (direct + diffuse) / unshaded);
-    # the reflected light they add is reported apart as reflection gain
-    sm["shading_loss"] = shading_loss(sm["h_direct"], sm["h_diffuse"], sm["h_total_unshaded"])
-    sm["shading_loss_clear"] = shading_loss(sm["h_direct_clear"], sm["h_diffuse_clear"],
-                                            sm["h_total_clear_unshaded"])
-    sm["reflection_gain"] = sm["h_reflected"] / sm["h_total_unshaded"].where(sm["h_total_unshaded"] > 0)
     shape_route = shape_routes(trips_meta[trips_meta["trip_id"].isin(totals["trip_id"].unique())])
     shape_route = shape_route[["shape_id", "route_short_name", "direction_id"]]
-    parts, geo_meta = _segment_month_rows(segments, sm, shape_route)
-    write_parquet_parts(parts, RunDir(run_dir).output("segment_month.parquet"), geo_meta, ROW_GROUP_ROWS)
+    # the segments' year and the summary's sums first (made beside the segment-months'
+    # file, the year's sums were the top of a network's segments step)
     hours_per_bus = annual.service_hours_per_bus(float(totals["seconds"].sum()), n_buses,
                                                  12.0 / len(cfg.run.months))
-    segments = annual.segment_year(segments.merge(shape_route, on="shape_id", how="left"), geo, sm,
-                                   cfg.pv_system().kwp, hours_per_bus)
-    write_parquet(segments, RunDir(run_dir).output("segments.parquet"))
+    year = annual.segment_year(segments.merge(shape_route, on="shape_id", how="left"), geo, sm,
+                               cfg.pv_system().kwp, hours_per_bus)
+    write_parquet(year, RunDir(run_dir).output("segments.parquet"))
+    sums = _SegmentSums.of(sm, year)
     # held on through the trips' step without their lines (a network's 300,000 shapely
     # lines and strings were ~0.3 GB of the command's peak): the report takes their CRS
-    return pd.DataFrame(segments.drop(columns="geometry")), segments.crs, _SegmentSums.of(sm, segments)
+    crs, year = year.crs, pd.DataFrame(year.drop(columns="geometry"))
+    parts, geo_meta = _segment_month_rows(segments, sm, shape_route)
+    write_parquet_parts(parts, RunDir(run_dir).output("segment_month.parquet"), geo_meta, ROW_GROUP_ROWS)
+    return year, crs, sums
+
+
+def _with_losses(sm: pd.DataFrame) -> pd.DataFrame:
+    """*sm* (segment-month rows) with their shading loss: sky and sun light the buildings
+    take away (1 - (direct + diffuse) / unshaded), in the weather and under clear sky, and
+    the reflected light they add, reported apart as reflection gain."""
+    return sm.assign(
+        shading_loss=shading_loss(sm["h_direct"], sm["h_diffuse"], sm["h_total_unshaded"]),
+        shading_loss_clear=shading_loss(sm["h_direct_clear"], sm["h_diffuse_clear"],
+                                        sm["h_total_clear_unshaded"]),
+        reflection_gain=sm["h_reflected"] / sm["h_total_unshaded"].where(sm["h_total_unshaded"] > 0))
 
 
 def _segment_month_rows(segments: gpd.GeoDataFrame, sm: pd.DataFrame, shape_route: pd.DataFrame):
     """The rows of ``segment_month.parquet``: each row of *sm* whose segment is one of
-    *segments*, with the segment's ``shape_id`` and line and the shape's routes
-    (*shape_route*), in the order of ``segments.merge(sm).merge(shape_route, how="left")``,
+    *segments*, with the segment's ``shape_id`` and line, its losses (:func:`_with_losses`,
+    made a part at a time) and the shape's routes (*shape_route*), in the order of ``segments.merge(sm).merge(shape_route, how="left")``,
     as GeoDataFrames of :data:`SEGMENT_MONTH_PART_ROWS` rows (a network's whole, 3.7 M
     rows, took 1.3 GB more than *sm*); and the GeoParquet metadata of all rows (the lines'
     bounding box and types), for :func:`write_parquet_parts`."""
@@ -1144,7 +1153,7 @@ def _segment_month_rows(segments: gpd.GeoDataFrame, sm: pd.DataFrame, shape_rout
             take = rows[start:start + SEGMENT_MONTH_PART_ROWS]
             left = seg.iloc[at[take]].reset_index(drop=True)
             right = routes.reindex(left["shape_id"].to_numpy()).reset_index(drop=True)
-            rows_sums = sums.iloc[take].reset_index(drop=True).astype(strings)
+            rows_sums = _with_losses(sums.iloc[take].reset_index(drop=True).astype(strings))
             yield gpd.GeoDataFrame(pd.concat([left, rows_sums, right], axis=1),
                                    geometry="geometry", crs=segments.crs)
 
@@ -1171,12 +1180,13 @@ class _SegmentSums(NamedTuple):
         at = flags.index.get_indexer(sm["segment_id"])
         street = ~np.where(at >= 0, flags["in_building"].to_numpy(bool)[at], False)
         # column by column (the road's rows of all columns at once were a 0.4 GB copy; each
-        # column's sum is the same)
+        # column's sum is the same), the segments' sums too
+        groups = sm.groupby("segment_id")
         return cls(light=pd.Series({c: sm[c].sum() for c in h_cols}, dtype=float),
                    road=pd.Series({c: sm.loc[street, c].sum() for c in h_cols}, dtype=float),
                    passes=int(sm["n_passes"].sum()),
-                   per_segment=sm.groupby("segment_id")[["seconds", "pv_kwh", "h_direct", "h_diffuse",
-                                                         "h_total_unshaded"]].sum(),
+                   per_segment=pd.DataFrame({c: groups[c].sum() for c in (
+                       "seconds", "pv_kwh", "h_direct", "h_diffuse", "h_total_unshaded")}),
                    flags=flags)
 
 
