@@ -944,8 +944,8 @@ def reduce_run(cfg: Config, year: int, run_dir: Path, say=print, client=None, cl
     clock("segments")
     # the trip sums and their blocks handed over: the trips' step lets them go once they are
     # joined into its table
-    trip, bd, idle, traces, shares = _trip_outputs(cfg, year, run_dir, parts.pop("totals"), parts.pop("placed"),
-                                           trips_meta, say, consumption)
+    trip, bd, idle, traces, shares = _trip_outputs(cfg, year, run_dir, parts.pop("totals"),
+                                                   parts.pop("placed"), trips_meta, say, consumption)
     del parts
     clock("trips")
     rm = _route_month(trip, bd, shares)
@@ -1137,7 +1137,8 @@ def _with_losses(sm: pd.DataFrame) -> pd.DataFrame:
 def _segment_month_rows(segments: gpd.GeoDataFrame, sm: pd.DataFrame, shape_route: pd.DataFrame):
     """The rows of ``segment_month.parquet``: each row of *sm* whose segment is one of
     *segments*, with the segment's ``shape_id`` and line, its losses (:func:`_with_losses`,
-    made a part at a time) and the shape's routes (*shape_route*), in the order of ``segments.merge(sm).merge(shape_route, how="left")``,
+    made a part at a time) and the shape's routes (*shape_route*), in the order of
+    ``segments.merge(sm).merge(shape_route, how="left")``,
     as GeoDataFrames of :data:`SEGMENT_MONTH_PART_ROWS` rows (a network's whole, 3.7 M
     rows, took 1.3 GB more than *sm*); and the GeoParquet metadata of all rows (the lines'
     bounding box and types), for :func:`write_parquet_parts`."""
@@ -1300,8 +1301,9 @@ def _ranking(cfg: Config, bd: pd.DataFrame, trip: pd.DataFrame, shares: TripShar
     per = shares.of(bd, ["grid_kwh_avoided", "pv_kwh_usable"], trip.index)
     t = trip[["route_id", "route_short_name"]].assign(grid=per["grid_kwh_avoided"], usable=per["pv_kwh_usable"],
                                                       bus_days=per["share"])
-    rt = t.groupby("route_id", observed=True).agg(name=("route_short_name", "first"), bus_days=("bus_days", "sum"),
-                                   grid=("grid", "sum"), usable=("usable", "sum"))
+    rt = t.groupby("route_id", observed=True).agg(name=("route_short_name", "first"),
+                                                  bus_days=("bus_days", "sum"), grid=("grid", "sum"),
+                                                  usable=("usable", "sum"))
     buses = rt["bus_days"] / period_days       # buses the route keeps busy, on average
     routes = pd.DataFrame({"kind": "route", "id": rt.index.astype(str), "name": rt["name"].astype(str).to_numpy(),
                            "block_days": rt["bus_days"].to_numpy(),
