@@ -138,6 +138,9 @@ def run(tiny: bool = False) -> dict:
         # over the workers' partitions: full physics per pass on the demo city, per core
         "physics_passes_per_s_per_core": round(passes / max(1e-9, sum(
             split[f"{k}_s"] for k in ("lookup", "ray_setup", "rays", "components", "pack")))),
+        # each tile's geometry, once per tile (worker-s summed), and its share
+        "worker_geometry_s": round(split["geometry_s"], 2),
+        "share_geometry": split["geometry_share"],
         "share_rays": split["rays_share"],
         "share_lookup": split["lookup_share"],
         "share_components": split["components_share"],

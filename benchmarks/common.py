@@ -299,14 +299,17 @@ def _children_cpu() -> float:
 def stage_split(manifest: dict) -> dict:
     """Worker time per stage (s, summed over partitions) and each stage's share of the sum.
 
-    Stages: pass generation, radiation lookup, ray-batch setup, Embree rays, irradiance
-    components (direct, diffuse, reflected), packing, per-trip/segment/hour aggregation, and
-    writing the partition files; ``load_and_other`` is the rest of the irradiance call (the
-    worker's first load of the radiation table and of the tile's BVH).  The per-tile
-    geometry tasks (sky view factor, reflector rays) are not in the partition timings.
+    Stages: each tile's geometry (sky view factor, reflector and horizon-band rays, the
+    crowns' sky cells: ``geometry_s``, once per tile, in its first partition's timings; read
+    back where the run folder has it), pass generation, radiation lookup, ray-batch setup,
+    Embree rays, irradiance components (direct, diffuse, reflected), packing,
+    per-trip/segment/hour aggregation, and writing the partition files; ``load_and_other``
+    is the rest of the irradiance call (the worker's first load of the radiation table and
+    of the tile's BVH).
     """
     t = manifest.get("partition_timings_s", {})
     stages = {
+        "geometry": t.get("geometry_s", 0.0),
         "passes": t.get("passes_s", 0.0),
         "lookup": t.get("irradiance_lookup_s", 0.0),
         "ray_setup": t.get("irradiance_ray_setup_s", 0.0),

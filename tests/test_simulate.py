@@ -415,6 +415,12 @@ def test_split_tiles_give_the_partitions_of_whole_tiles(small_run, small_config,
     tiles = sorted({p.parent.name.split("=", 1)[1] for p in whole.part_files("trip")})
     assert tiles and all(split.part("trip", t, "2024-05").exists() for t in tiles)
     assert len(tile_tasks([(t, m) for t in tiles for m in ("2024-05", "2024-06")], 2)) == 2 * len(tiles)
+    # each tile's geometry timed once, by the first of its tasks; so in the one-task run
+    manifest = json.loads(split.manifest.read_text())
+    assert manifest["partition_counts"]["geometry_tiles"] == len(tiles)
+    assert manifest["partition_timings_s"]["geometry_s"] > 0
+    manifest = json.loads(whole.manifest.read_text())
+    assert manifest["partition_counts"]["geometry_tiles"] == len(tiles)
     for kind in PARTITION_KINDS:
         for tile in tiles:
             a = pq.read_table(split.part(kind, tile, "2024-06"))

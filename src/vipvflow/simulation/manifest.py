@@ -206,7 +206,8 @@ def write_manifest(cfg, year, run_dir, inputs: InputDigests, timings, results, b
         "standing_intervals": int(sum(r.get("intervals", 0) for r in results)),
         "passes_computed": int(sum(r["passes"] for r in results)),
         # sun rays in front of the roof in the driving partitions: cast with Embree, or told
-        # clear by the sun masks among the buildings (irradiance.sun_masks)
+        # clear by the sun masks among the buildings (irradiance.sun_masks); the tiles whose
+        # geometry this run made or read back (its seconds: geometry_s above)
         "partition_counts": counts,
         "bvh_builds_per_worker": builds,
         "created_utc": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),

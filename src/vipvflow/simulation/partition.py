@@ -200,15 +200,17 @@ def street_options(ctx: RunContext) -> dict:
 
 
 class TileGeometry:
-    """A tile's geometry table as the result of its Dask task (:func:`geometry_task`).
+    """A tile's geometry table as the result of its Dask task (:func:`geometry_task`), and
+    the seconds it took.
 
     Dask measures every result it keeps; walking the thousand columns of a geometry table
     for that cost more than computing the table, so this wrapper gives its size from its
     shape (8 bytes a value)."""
-    __slots__ = ("frame",)
+    __slots__ = ("frame", "seconds")
 
-    def __init__(self, frame: pd.DataFrame):
+    def __init__(self, frame: pd.DataFrame, seconds: float = 0.0):
         self.frame = frame
+        self.seconds = seconds
 
     def __sizeof__(self) -> int:
         return 64 + 8 * self.frame.shape[0] * self.frame.shape[1]
@@ -216,24 +218,36 @@ class TileGeometry:
 
 def geometry_task(ctx: RunContext, tile: str) -> TileGeometry:
     """:func:`tile_geometry` as a task of the run's graph (for a tile whose months are split
-    over several tasks, :func:`vipvflow.simulation.tasks.tile_tasks`)."""
-    return TileGeometry(tile_geometry(ctx, tile))
+    over several tasks, :func:`vipvflow.simulation.tasks.tile_tasks`), with its seconds."""
+    t = time.perf_counter()
+    frame = tile_geometry(ctx, tile)
+    return TileGeometry(frame, time.perf_counter() - t)
 
 
 def tile_task(ctx: RunContext, tile: str, months: list[str],
-              geometry: TileGeometry | None = None) -> list[dict]:
+              geometry: TileGeometry | None = None, counts_geometry: bool = True) -> list[dict]:
     """A tile's geometry (:func:`tile_geometry`, or the result of its :func:`geometry_task`),
     then its partitions of *months* (:func:`run_partition`, each written as it is done): one
-    task of the run's graph.
+    task of the run's graph.  The geometry's seconds go into the first partition's timings
+    (``geometry_s``) and counts (``geometry_tiles``: 1), with *counts_geometry* (the first
+    task of a tile split over several).
 
     One task per tile rather than per partition: the tile's BVH is built once and its
     geometry table never leaves the worker, and the scheduler (in the command's process on a
     LocalCluster) handles 12 times fewer tasks: the line-year's 492 partitions as 41 tasks
     took ~2 s of a core off the command's process."""
-    frame = geometry.frame if geometry is not None else _held_geometry(ctx, tile, tile_geometry(ctx, tile))
+    if geometry is not None:
+        frame, geometry_s = geometry.frame, geometry.seconds
+    else:
+        t = time.perf_counter()
+        frame = _held_geometry(ctx, tile, tile_geometry(ctx, tile))
+        geometry_s = time.perf_counter() - t
     done = []
     for month in months:
         done.append(run_partition(ctx, tile, month, frame))
+        if counts_geometry and len(done) == 1:
+            done[0]["timings"]["geometry_s"] = geometry_s
+            done[0]["counts"]["geometry_tiles"] = 1
         # a month's passes freed, before the next (a few ms): what the worker holds between
         # them is what it keeps, ~0.25 GB less on a network's largest tile
         hand_back_memory()

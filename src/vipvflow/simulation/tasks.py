@@ -53,8 +53,12 @@ def submit_tiles(client, ctx: RunContext, todo: list[tuple[str, str]]) -> list:
     tasks = tile_tasks(todo, slots)
     geometry = {t: client.submit(geometry_task, ctx, t, key=f"geometry-{t}")
                 for t in sorted(_split_tiles(tasks))}
-    return [client.submit(tile_task, ctx, tile, ms, geometry.get(tile), key=key)
-            for (tile, ms), key in zip(tasks, task_keys(tasks))]
+    # a split tile's geometry seconds counted once, by its first task
+    first = {}
+    for i, (tile, _) in enumerate(tasks):
+        first.setdefault(tile, i)
+    return [client.submit(tile_task, ctx, tile, ms, geometry.get(tile), first[tile] == i, key=key)
+            for i, ((tile, ms), key) in enumerate(zip(tasks, task_keys(tasks)))]
 
 
 def submit_standing(client, ctx: RunContext, standing: list[str]) -> list:
