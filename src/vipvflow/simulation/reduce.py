@@ -1056,8 +1056,9 @@ def _trip_outputs(cfg: Config, year: int, run_dir: Path, totals: pd.DataFrame, p
                                        "block_id", "pattern_id", "start_s"])
     # the trips' names and ids repeat on every service day: held as categories through the
     # block-days (a network's strings were half its trip table), written as the strings they are
-    strings = {c: meta[c].dtype for c in meta.columns.drop(["trip_id", "pattern_id"])
-               if pd.api.types.is_string_dtype(meta[c].dtype)}
+    # (:func:`_as_values`)
+    strings = [c for c in meta.columns.drop(["trip_id", "pattern_id"])
+               if pd.api.types.is_string_dtype(meta[c].dtype)]
     trip = totals.merge(meta.astype({c: "category" for c in strings}), on="trip_id", how="left",
                         validate="many_to_one")
     del totals          # joined (the caller hands it over)
@@ -1066,25 +1067,22 @@ def _trip_outputs(cfg: Config, year: int, run_dir: Path, totals: pd.DataFrame, p
                             vecto_dir=RunDir(run_dir).vecto, say=say, made=consumption)
     trip = trip.merge(cons, on=["pattern_id", "month"], how="left", validate="many_to_one")
     trip["coverage"] = trip["pv_kwh"] / trip["consumption_kwh"]
-    later = {c: trip[c].dtype for c in ("pattern_id", "month", "consumption_source")
-             if c in trip and pd.api.types.is_string_dtype(trip[c].dtype)}
-    trip = trip.astype({c: "category" for c in later})
-    strings.update(later)
+    trip = trip.astype({c: "category" for c in ("pattern_id", "month", "consumption_source")
+                        if c in trip and pd.api.types.is_string_dtype(trip[c].dtype)})
     # vehicle block per day: driving, layovers, parked; the battery's share (sets the
     # trips' block_id to the timeline's: the GTFS block or the inferred one)
     bd, idle, trip, traces, trip_at = block_day_table(cfg, run_dir, trip, cfg.vehicle_params(), placed)
     del placed
     shares = TripShares(trip_at, trip["seconds"])
     del trip_at
-    back = {c: t for c, t in strings.items() if isinstance(trip[c].dtype, pd.CategoricalDtype)}
     path = RunDir(run_dir).output("trip_energy.parquet")
     try:
         # a slice at a time, each with its names as strings (the whole table's Arrow copy
         # beside it was the top of a network's trips' step)
-        write_parquet_parts((trip.iloc[i:i + TRIP_PART_ROWS].astype(back)
+        write_parquet_parts((_as_values(trip.iloc[i:i + TRIP_PART_ROWS])
                              for i in range(0, max(len(trip), 1), TRIP_PART_ROWS)), path)
     except PartSchemaError:     # slices typed apart by their values: the whole at once
-        write_parquet(trip.astype(back), path)
+        write_parquet(_as_values(trip), path)
     # the trips go on with their names as categories: the routes', the ranking's and the
     # months' tables take them back to their values (a network's table as strings was
     # 0.45 GB more, at the trips' and the fleet's steps)
@@ -1103,9 +1101,10 @@ def _segment_outputs(cfg: Config, run_dir: Path, sm: pd.DataFrame, geo: pd.DataF
 
     data_dir = Path(cfg.data_dir)
     segments = gpd.read_parquet(DataDir(data_dir).gtfs.segments)
-    shapes = trips_meta.loc[trips_meta["trip_id"].isin(totals["trip_id"].unique()), "shape_id"]
-    segments = segments[segments["shape_id"].isin(shapes.unique())]
-    shape_route = shape_routes(trips_meta[trips_meta["trip_id"].isin(totals["trip_id"].unique())])
+    run_trips = trips_meta[trips_meta["trip_id"].isin(totals["trip_id"].unique())]
+    segments = segments[segments["shape_id"].isin(run_trips["shape_id"].unique())]
+    shape_route = shape_routes(run_trips)
+    del run_trips
     shape_route = shape_route[["shape_id", "route_short_name", "direction_id"]]
     # the segments' year and the summary's sums first (made beside the segment-months'
     # file, the year's sums were the top of a network's segments step)
@@ -1151,7 +1150,6 @@ def _segment_month_rows(segments: gpd.GeoDataFrame, sm: pd.DataFrame, shape_rout
     rows = rows[np.argsort(at[rows], kind="stable")]
     routes = shape_route.set_index("shape_id")
     sums = sm.drop(columns="segment_id")
-    strings = {c: "str" for c in sums.columns if isinstance(sums[c].dtype, pd.CategoricalDtype)}
     used = np.unique(at[rows])
     geo_meta = {b"geo": _geopandas_to_arrow(gpd.GeoDataFrame(seg.iloc[used][["geometry"]], crs=segments.crs),
                                             index=False).schema.metadata[b"geo"]}
@@ -1161,7 +1159,7 @@ def _segment_month_rows(segments: gpd.GeoDataFrame, sm: pd.DataFrame, shape_rout
             take = rows[start:start + SEGMENT_MONTH_PART_ROWS]
             left = seg.iloc[at[take]].reset_index(drop=True)
             right = routes.reindex(left["shape_id"].to_numpy()).reset_index(drop=True)
-            rows_sums = _with_losses(sums.iloc[take].reset_index(drop=True).astype(strings))
+            rows_sums = _with_losses(_as_values(sums.iloc[take].reset_index(drop=True)))
             yield gpd.GeoDataFrame(pd.concat([left, rows_sums, right], axis=1),
                                    geometry="geometry", crs=segments.crs)
 
