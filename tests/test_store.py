@@ -185,6 +185,22 @@ def test_wide_and_float32_tables_read_back_as_written(tmp_path):
     assert back["other"].dtype == np.float64 and back["other"][0] == 1.0 / 3
 
 
+def test_nullable_numbers_keep_their_type_and_their_gaps_as_nulls(tmp_path):
+    """pandas' nullable integers and bools (a route's ``direction_id`` where the feed leaves it
+    out) are written as the integers and bools they are, each gap a null: not a double with
+    NaN in its place; a table of plain strings beside them keeps Arrow's plain strings."""
+    from vipvflow.store import write_parquet
+
+    frame = pd.DataFrame({"route_id": ["a", "b", "c"],
+                          "direction_id": pd.array([0, None, 1], dtype="Int32"),
+                          "wheelchair": pd.array([True, None, False], dtype="boolean"),
+                          "pv_kwh": [1.0, 2.0, 3.0]})
+    table = pq.read_table(write_parquet(frame, tmp_path / "routes.parquet"))
+    assert [str(f.type) for f in table.schema] == ["string", "int32", "bool", "double"]
+    assert table.column("direction_id").to_pylist() == [0, None, 1]
+    assert table.column("wheelchair").to_pylist() == [True, None, False]
+
+
 def test_runs_with_hourly_files_reduce_to_the_same_hours(small_run, tmp_path):
     """A run folder written before the sums per local hour moved into the segment files'
     metadata (one ``parts/hourly`` file per partition) reduces to the same sums; a segment

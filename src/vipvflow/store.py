@@ -486,8 +486,10 @@ def write_npz(path: str | Path, **arrays) -> Path:
 
 def _plain_table(df):
     """*df* as a pyarrow Table built column by column from numpy, when every column is a
-    number, bool, datetime64 or string (the partition and geometry tables); ``None``
-    otherwise (GeoDataFrames, categoricals, ...), for pandas to convert."""
+    number (pandas' nullable ones with their gaps as nulls), bool, datetime64 or string
+    (the partition and geometry tables); ``None`` otherwise (GeoDataFrames, categoricals,
+    ...), for pandas to convert."""
+    import numpy as np
     import pandas as pd
     import pyarrow as pa
 
@@ -499,8 +501,11 @@ def _plain_table(df):
             continue
         col = df[name]
         kind = col.dtype.kind
-        if kind in "biuf" or (kind == "M" and getattr(col.dtype, "tz", None) is None):
+        if isinstance(col.dtype, np.dtype) and kind in "biufM":
             arrays[i] = pa.array(col.to_numpy())
+        elif kind in "biuf" and hasattr(col.array, "__arrow_array__"):
+            # pandas' nullable numbers and bools: their gaps as nulls (as NaN from numpy)
+            arrays[i] = pa.array(col.array)
         elif pd.api.types.is_string_dtype(col.dtype) and not isinstance(col.dtype, pd.CategoricalDtype):
             try:        # object columns may hold anything: only real strings take this path
                 arr = (pa.array(col.array) if hasattr(col.array, "__arrow_array__")
