@@ -428,27 +428,6 @@ def test_split_tiles_give_the_partitions_of_whole_tiles(small_run, small_config,
             assert a.equals(b), (kind, tile)
 
 
-def test_a_long_map_hands_the_reduce_fresh_workers(small_run, small_config, tmp_path, monkeypatch):
-    """After a long map the run's LocalCluster's workers are restarted before the reduce
-    (here every map counts as long): the trip patterns' consumption computed on the old
-    workers is kept, and every output is the session's run's."""
-    from vipvflow.simulation import run as run_module
-
-    restarts = []
-    fresh = run_module._fresh_workers
-
-    def counted(client, *args):
-        before = set(client.scheduler_info()["workers"])
-        fresh(client, *args)
-        restarts.append(before.isdisjoint(client.scheduler_info()["workers"]))
-
-    monkeypatch.setattr(run_module, "RESTART_AFTER_MAP_S", 0.0)
-    monkeypatch.setattr(run_module, "_fresh_workers", counted)
-    run_dir = run_simulation(_cfg(small_config, tmp_path / "fresh", n_workers=2), 2024, say=lambda *a: None)
-    assert restarts == [True]           # once, and the workers after it are new ones
-    assert_same_results(run_dir, small_run)
-
-
 def _busy(seconds: float) -> int:
     n, end = 0, time.perf_counter() + seconds
     while time.perf_counter() < end:

@@ -438,16 +438,8 @@ class Consumption:
 
     def __init__(self, futures: list, vmod: dict):
         self.futures, self.vmod = futures, vmod
-        self._held: dict | None = None
-
-    def fetch(self) -> None:
-        """Wait for the results and hold them here (the workers may then go)."""
-        self._held = self.results()
-        self.futures = []
 
     def results(self) -> dict:
-        if self._held is not None:
-            return self._held
         out = {}
         for part in (f.result() for f in self.futures):
             out.update(part)

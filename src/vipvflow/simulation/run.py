@@ -184,8 +184,6 @@ def _run(cfg: Config, year: int, scheduler, n_workers, say, max_partitions, forc
         timings["map_s"] = time.perf_counter() - t_map
         # the BVH builds of each worker, whose caches of the map are then dropped
         builds = client.run(worker_bvh_builds, release=True)
-        if cluster is not None and timings["map_s"] >= RESTART_AFTER_MAP_S:
-            _fresh_workers(client, consumption, n_workers_now, say)
         if not (all(partition_done(run_dir, t, m) for t in tiles for m in _months(cfg, year))
                 and all(standing_done(run_dir, t) for t in standing)):
             say("stopped before all partitions were computed; run the same command again to resume")
@@ -252,26 +250,6 @@ def _run_context(cfg: Config, year: int, run_dir: Path) -> tuple[RunContext, lis
 
 #: how long a run waits for the first worker of a scheduler that has none (s)
 WORKER_WAIT_S = 60.0
-
-#: a map at least this long (s) on the run's own LocalCluster is followed by fresh workers
-#: for the reduce (:func:`_fresh_workers`; the restart takes ~1.3 s on 2 workers)
-RESTART_AFTER_MAP_S = 120.0
-
-
-def _fresh_workers(client, consumption, n_workers: int, say) -> None:
-    """The run's own LocalCluster's workers restarted before the reduce: after a long map
-    each held ~150 MB more than a fresh one after its caches were dropped (the modules,
-    compiled kernels and heap the map left), through the reduce's peak in this process
-    (the 200-line network-year's).  The trip patterns' consumption, computed on them, is
-    fetched here first.  A restart that fails is said and the run goes on with the workers
-    there are."""
-    consumption.fetch()
-    try:
-        client.restart(timeout=WORKER_WAIT_S)
-    except Exception as exc:        # noqa: BLE001 - the workers as they are do the reduce
-        say(f"the workers were not restarted before the reduce ({type(exc).__name__}: {exc}); "
-            "going on with them")
-        client.wait_for_workers(max(1, n_workers), timeout=WORKER_WAIT_S)
 
 
 def _wait_for_workers(client, address) -> int:
