@@ -359,15 +359,22 @@ def test_trips_share_of_their_block_days_is_that_of_the_join_by_block_and_date()
 
 
 def test_parts_typed_apart_by_their_values_are_refused_and_leave_no_file(tmp_path):
-    """Parts whose values give a column another type (a nullable integer column with a gap
-    in one part only) are refused with PartSchemaError (the trips' writer then writes the
-    whole at once), and no file or temporary file is left."""
+    """Parts whose values give a column another type (a column of Python objects: strings in
+    one part, only gaps in the other) are refused with PartSchemaError (the trips' writer
+    then writes the whole at once), and no file or temporary file is left.  A nullable
+    integer column with a gap in one part only is one type in every part (its gaps nulls)."""
     from vipvflow.store import PartSchemaError
 
-    parts = [pd.DataFrame({"direction_id": pd.array([0, 1], dtype="Int32"), "x": [1.0, 2.0]}),
-             pd.DataFrame({"direction_id": pd.array([1, None], dtype="Int32"), "x": [3.0, 4.0]})]
+    parts = [pd.DataFrame({"block_id": pd.Series(["b1", "b2"], dtype=object), "x": [1.0, 2.0]}),
+             pd.DataFrame({"block_id": pd.Series([None, None], dtype=object), "x": [3.0, 4.0]})]
     with pytest.raises(PartSchemaError):
         write_parquet_parts(iter(parts), tmp_path / "t.parquet", row_group_rows=1)
     assert list(tmp_path.iterdir()) == []
     whole = write_parquet(pd.concat(parts, ignore_index=True), tmp_path / "t.parquet")
-    assert pq.read_table(whole).num_rows == 4
+    assert pq.read_table(whole).column("block_id").to_pylist() == ["b1", "b2", None, None]
+
+    parts = [pd.DataFrame({"direction_id": pd.array([0, 1], dtype="Int32"), "x": [1.0, 2.0]}),
+             pd.DataFrame({"direction_id": pd.array([1, None], dtype="Int32"), "x": [3.0, 4.0]})]
+    table = pq.read_table(write_parquet_parts(iter(parts), tmp_path / "n.parquet", row_group_rows=1))
+    assert str(table.schema.field("direction_id").type) == "int32"
+    assert table.column("direction_id").to_pylist() == [0, 1, 1, None]
