@@ -301,7 +301,8 @@ def stage_split(manifest: dict) -> dict:
 
     Stages: each tile's geometry (sky view factor, reflector and horizon-band rays, the
     crowns' sky cells: ``geometry_s``, once per tile, in its first partition's timings; read
-    back where the run folder has it), pass generation, radiation lookup, ray-batch setup,
+    back where the run folder has it; with its packing for the fused kernel where the tile
+    is one task), pass generation, radiation lookup, ray-batch setup,
     Embree rays, irradiance components (direct, diffuse, reflected), packing,
     per-trip/segment/hour aggregation, and writing the partition files; ``load_and_other``
     is the rest of the irradiance call (the worker's first load of the radiation table and

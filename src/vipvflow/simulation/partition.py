@@ -229,8 +229,9 @@ def tile_task(ctx: RunContext, tile: str, months: list[str],
     """A tile's geometry (:func:`tile_geometry`, or the result of its :func:`geometry_task`),
     then its partitions of *months* (:func:`run_partition`, each written as it is done): one
     task of the run's graph.  The geometry's seconds go into the first partition's timings
-    (``geometry_s``) and counts (``geometry_tiles``: 1), with *counts_geometry* (the first
-    task of a tile split over several).
+    (``geometry_s``; with its packing for the fused kernel where the tile is one task, a
+    split tile's tasks pack it in their first partition) and counts (``geometry_tiles``: 1),
+    with *counts_geometry* (the first task of a tile split over several).
 
     One task per tile rather than per partition: the tile's BVH is built once and its
     geometry table never leaves the worker, and the scheduler (in the command's process on a
