@@ -149,6 +149,35 @@ def test_layovers_apart_take_only_their_own_minutes():
         share = np.clip(np.minimum(minutes + 60.0, b) - np.maximum(minutes, a), 0.0, None)
         assert together["h_total"].iloc[i] == pytest.approx(float((irr * share).sum() / 3600.0), rel=1e-9)
 
+def test_points_packed_once_give_what_each_point_packed_alone_gives():
+    """The standing work packs a tile's points once (with their sun masks among the
+    buildings) for all its points and months: the sums are those of interval_integrals
+    packing for each point on its own, bit for bit, with the default physics (Perez sky,
+    reflectors, sun masks) in a street between two walls."""
+    from vipvflow.models.view_factors import pack_geometry
+
+    day = "2024-06-10"
+    table, *_ = _clear_day_table(day, cloud=0.3)
+    scene = Scene(box_mesh([[12.0, -60.0, 0.0, 13.0, 60.0, 20.0],
+                            [-14.0, -60.0, 0.0, -13.0, 60.0, 15.0]]))
+    cfg = IrradianceCfg(svf_rays=128, reflection_rays=64, reflector_points=4, horizon_band_rays=16)
+    points = pd.DataFrame({"point_id": [0, 1, 2], "x": [0.0, 8.0, -9.0], "y": [0.0, 20.0, -30.0],
+                           "z": [3.2, 3.2, 3.2]})
+    geom = point_geometry(scene, points, cfg)
+    base = pd.Timestamp(f"{day} 04:00", tz="UTC").timestamp()
+    iv = pd.DataFrame({"point_id": [0, 1, 2, 0, 2],
+                       "t0_utc": [base + 10.0, base + 3600.0, base + 5 * 3600 + 7.0,
+                                  base + 8 * 3600.0, base + 12 * 3600.0],
+                       "t1_utc": [base + 1800.0, base + 3 * 3600.0, base + 6 * 3600.0,
+                                  base + 8 * 3600 + 905.0, base + 15 * 3600.0]})
+    packed = pack_geometry(geom, cfg, 0.2, scene)
+    once = interval_integrals(iv, geom, table, scene, cfg, _energy, packed=packed)
+    each = interval_integrals(iv, geom, table, scene, cfg, _energy)
+    assert (once["h_direct"] > 0).any() and (once["h_reflected"] > 0).all()
+    pd.testing.assert_frame_equal(once, each, check_exact=True)
+    # the packing kept the points' sun masks among the buildings, made once
+    assert packed["_building_masks"][0] is scene
+
 
 def _gtfs(folder):
     """A small feed in Luxembourg: one line A - B - C, block B1 of three trips, the last one

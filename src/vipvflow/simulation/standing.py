@@ -59,7 +59,7 @@ def point_geometry(scene, points: pd.DataFrame, cfg: IrradianceCfg, **street) ->
 
 def interval_integrals(intervals: pd.DataFrame, geometry: pd.DataFrame, radiation, scene,
                        cfg: IrradianceCfg, energy_kwh, ground_albedo: float = 0.20,
-                       dark: bool = False) -> pd.DataFrame:
+                       dark: bool = False, packed: dict | None = None) -> pd.DataFrame:
     """Irradiation and PV energy of standing intervals.
 
     Parameters
@@ -72,6 +72,8 @@ def interval_integrals(intervals: pd.DataFrame, geometry: pd.DataFrame, radiatio
     energy_kwh : callable ``(poa_wm2, dt_s) -> kWh`` per minute (the run's PV model, still)
     ground_albedo : float
     dark : bool, a covered depot: no light at all
+    packed : dict, optional, ``pack_geometry(geometry, cfg, ground_albedo, scene)`` when the
+        caller keeps it: the points' packing and sun masks are then made once, not per point
 
     Returns
     -------
@@ -107,7 +109,7 @@ def interval_integrals(intervals: pd.DataFrame, geometry: pd.DataFrame, radiatio
                                 "t_utc": lo + minute * _MINUTE,
                                 "dt_s": np.full(len(minute), _MINUTE, np.float32)})
         irr = evaluate_passes(minutes, None, geometry, radiation, scene, cfg,
-                              ground_albedo=ground_albedo, time_at="mid")
+                              ground_albedo=ground_albedo, time_at="mid", packed=packed)
         dt = minutes["dt_s"].to_numpy(np.float64)
         per_minute = np.empty((len(names), len(dt) + 1))      # running totals from 0
         per_minute[:, 0] = 0.0
@@ -140,6 +142,7 @@ def run_standing(ctx, tile: str) -> dict:
     ``covered``: the depot outside the city model) of the run's block-days; writes
     ``parts/standing/tile=T/month=all.parquet``, one row per interval (``seconds`` and the
     sums are per bus times ``buses``: more than 1 only for the idle buses of a day)."""
+    from ..models.view_factors import pack_geometry
     from .partition import _radiation, _scene, pv_energy_kwh, street_options, tune_malloc
 
     tune_malloc()
@@ -151,6 +154,7 @@ def run_standing(ctx, tile: str) -> dict:
     cfg = IrradianceCfg(**ctx.irradiance)
     dark = tile == "covered" or not len(iv)
     timings = {"standing_load_s": time.perf_counter() - t_start}
+    packed = None
     if not dark:
         t = time.perf_counter()
         scene = open_scene() if tile == "open" else _scene(ctx, tile)
@@ -158,6 +162,9 @@ def run_standing(ctx, tile: str) -> dict:
         timings["standing_scene_s"] = time.perf_counter() - t
         t = time.perf_counter()
         geom = point_geometry(scene, points, cfg, **street_options(ctx))
+        # packed once for all the points and months (with the points' sun masks among the
+        # buildings, kept in it): evaluate_passes would otherwise pack every point's all
+        packed = pack_geometry(geom, cfg, ctx.ground_albedo, scene)
         timings["standing_geometry_s"] = time.perf_counter() - t
     t_eval = time.perf_counter()
     # each month's sums into its rows of one array (iv is numbered from 0), not a frame per
@@ -174,7 +181,7 @@ def run_standing(ctx, tile: str) -> dict:
             part = interval_integrals(group, None, None, None, cfg, energy, dark=True)
         else:
             part = interval_integrals(group, geom, _radiation(ctx.data_dir, ctx.year), scene, cfg,
-                                      energy, ground_albedo=ctx.ground_albedo)
+                                      energy, ground_albedo=ctx.ground_albedo, packed=packed)
         values[group.index.to_numpy()] = part[res.columns].to_numpy(np.float64)
         del part, group
     timings["standing_eval_s"] = time.perf_counter() - t_eval
