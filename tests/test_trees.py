@@ -192,6 +192,48 @@ def test_sun_masks_rule_out_only_rays_that_miss_every_crown(monkeypatch):
     assert (got == want).all() and (want > 0).any()
 
 
+@pytest.mark.parametrize("leaf_type", [1, 0], ids=["evergreen_one_class", "deciduous_two_classes"])
+def test_sky_cell_loss_is_the_weighted_loss_of_each_cells_own_directions(monkeypatch, leaf_type):
+    """The crowns' share of each sky cell, points taken in blocks and only the cells the
+    crowns could take from: for every point, class and cell, the ``sin cos``-weighted mean
+    over the cell's 16 directions above the point's horizon of ``1 - T`` with ``T`` from
+    the plain-numpy every-ray-every-crown reference (float32 rounding); the result does not
+    depend on the block size (bit for bit)."""
+    from vipvflow.models import trees
+    from vipvflow.models.sky import SKY_AZIMUTH_BINS, SKY_LEVEL_DEG, SKY_LEVELS
+
+    rng = np.random.default_rng(5)
+    n = 60
+    t = TreeTable(x=rng.uniform(-60, 60, n), y=rng.uniform(-60, 60, n), z=np.zeros(n),
+                  height=rng.uniform(6, 20, n), crown_diameter=rng.uniform(3, 12, n),
+                  crown_base=rng.uniform(2, 4, n), leaf_type=np.full(n, leaf_type),
+                  leaf_off=np.full(n, -1), source=np.zeros(n), tree_id=[str(i) for i in range(n)],
+                  latitude=50.0)
+    crowns = Crowns(t, TreeCfg(), origin=(0.0, 0.0, 0.0))
+    assert crowns.n_classes == (1 if leaf_type == 1 else 2)
+    k = 25
+    pts = np.column_stack([rng.uniform(-50, 50, k), rng.uniform(-50, 50, k), rng.uniform(2, 6, k)])
+    levels = rng.integers(0, 4, (k, SKY_AZIMUTH_BINS)).astype(np.float32)     # horizons 0-30 deg
+    got = trees.sky_cell_loss(crowns, pts, levels, 200.0)
+    monkeypatch.setattr(trees, "SKY_LOSS_BLOCK", 3 * SKY_AZIMUTH_BINS * SKY_LEVELS * 16)
+    assert np.array_equal(trees.sky_cell_loss(crowns, pts, levels, 200.0), got)   # 3 points a block
+    # the reference, direction by direction
+    S = trees.SKY_CELL_SAMPLES
+    sub = (np.arange(S) + 0.5) / S
+    for i in rng.choice(k, 6, replace=False):
+        for cell in range(SKY_AZIMUTH_BINS * SKY_LEVELS):
+            sector, band = divmod(cell, SKY_LEVELS)
+            az = np.radians((sector + sub) * 360.0 / SKY_AZIMUTH_BINS)[:, None]
+            el = np.radians((band + sub) * SKY_LEVEL_DEG)[None, :]
+            d = np.stack(np.broadcast_arrays(np.cos(el) * np.sin(az), np.cos(el) * np.cos(az),
+                                             np.sin(el)), -1).reshape(-1, 3)
+            wt = np.broadcast_to(np.sin(el) * np.cos(el), (S, S)).reshape(-1)
+            seen = np.degrees(np.broadcast_to(el, (S, S)).reshape(-1)) > levels[i, sector] * SKY_LEVEL_DEG
+            T = transmittance_reference(crowns, np.broadcast_to(pts[i], (len(d), 3)), d, 200.0)
+            want = ((1.0 - T.astype(np.float64)) * (wt * seen)[:, None]).sum(0) / wt.sum()
+            np.testing.assert_allclose(got[i, :, cell], want, rtol=1e-5, atol=1e-7)
+    assert (got > 0).mean() > 0.05 and (got == 0).any()
+
 def test_fused_kernel_equals_the_numpy_reference_with_crowns(monkeypatch):
     """A canyon with rows of crowns (deciduous and evergreen, some with their own leaf-off
     months: three classes of months) over two days, one in leaf and one not: every

@@ -439,6 +439,8 @@ def transmittance_reference(crowns: Crowns, origins, dirs, tmax, classes=None) -
 # ---------------------------------------------------------------------------- the sky
 #: samples per sky cell (per azimuth and per elevation) for the crowns' share of a cell
 SKY_CELL_SAMPLES = 4
+#: directions (points x cells x samples) :func:`sky_cell_loss` tests at a time (~2 MB of flags)
+SKY_LOSS_BLOCK = 1 << 21
 
 
 def sky_cell_loss(crowns: Crowns, origins_local, sky_x, tmax: float) -> np.ndarray:
@@ -482,19 +484,27 @@ def sky_cell_loss(crowns: Crowns, origins_local, sky_x, tmax: float) -> np.ndarr
     el_deg = np.broadcast_to(np.degrees(EL), (K, L, S, S)).reshape(K * L, S * S)
     sector = np.repeat(np.arange(K), L)
     horizon = np.asarray(sky_x, np.float64).reshape(m, K) * SKY_LEVEL_DEG
-    loss = np.zeros((K * L * S * S, C))
     # a direction rising above every crown of its sector (the point's sun mask, the same 10 deg
     # sectors) crosses none: no walk for it
     masks = crowns.sun_masks(o)
     slope = np.broadcast_to(np.tan(EL), (K, L, S, S)).reshape(K * L, S * S)
-    for i in range(m):
-        above = (el_deg > horizon[i, sector][:, None]).reshape(-1)
-        keep = np.flatnonzero(above & ~(slope > masks[i, sector][:, None]).reshape(-1))
-        if not len(keep):
+    # the points a block at a time, and of each point only the cells with a direction the
+    # crowns could take (about a quarter of them in a street with trees): one walk call per
+    # block, and the cells' weighted means over those cells' own directions
+    D = S * S
+    block = max(1, SKY_LOSS_BLOCK // (K * L * D))
+    for lo in range(0, m, block):
+        hi = min(m, lo + block)
+        keep = ((el_deg[None] > horizon[lo:hi, sector][:, :, None])
+                & ~(slope[None] > masks[lo:hi, sector][:, :, None]))         # (points, cells, D)
+        pt, cl = np.nonzero(keep.any(2))
+        if not len(pt):
             continue                       # no direction the crowns could take: no loss
-        loss[:] = 0.0
-        loss[keep] = 1.0 - crowns.transmittance(np.broadcast_to(o[i], (len(keep), 3)), d[keep], tmax)
-        out[i] = ((loss.reshape(K * L, S * S, C) * w[:, :, None]).sum(1) / w_cell[:, None]).T
+        sub = keep[pt, cl]                                                # (cells kept, D)
+        k, j = np.nonzero(sub)
+        loss = np.zeros((len(pt), D, C))
+        loss[k, j] = 1.0 - crowns.transmittance(o[lo + pt[k]], d[cl[k] * D + j], tmax)
+        out[lo + pt, :, cl] = (loss * w[cl][:, :, None]).sum(1) / w_cell[cl][:, None]
     return out
 
 
