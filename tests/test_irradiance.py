@@ -592,3 +592,42 @@ def test_open_street_reflects_like_pvlibs_ground_diffuse():
     # downwards meets the street
     ratio = out["reflected"] / want
     assert np.abs(ratio - 1).max() < 0.3 and abs(ratio.mean() - 1) < 0.04, ratio
+
+
+def test_reflector_points_sorts_equal_numpys():
+    """The reflector groups' stratified points sort their hits in compiled code: the order
+    within groups is np.lexsort's (ties keep their order; empty groups; a NaN key falls
+    back to np.lexsort), and the first hit reaching each target of a group's cumulative
+    weights is the one merging the targets into the hits' order (a target before equal
+    hits) finds."""
+    from vipvflow.models.view_factors import _first_reaching, _lexsort_groups
+
+    rng = np.random.default_rng(4)
+    for n, groups, run in ((5_000, 40, 1), (20_000, 3_000, 2), (3, 10, 1), (0, 4, 1)):
+        group = np.sort(rng.integers(0, groups, n)) if run == 1 else rng.integers(0, groups, n)
+        key = np.round(rng.normal(size=n), 1)                 # many ties
+        key[rng.random(n) < 0.05] = -0.0
+        np.testing.assert_array_equal(_lexsort_groups(key, group, groups), np.lexsort((key, group)))
+    key = rng.normal(size=300)
+    key[[3, 100]] = np.nan
+    group = rng.integers(0, 7, 300)
+    np.testing.assert_array_equal(_lexsort_groups(key, group, 7), np.lexsort((key, group)))
+    # the targets merged into the hits: hits sorted by group, cumulative weights within each
+    # (zero weights among them: equal cumulative weights), groups 2 and 5 without hits
+    m, P = 8, 5
+    gs = np.sort(rng.choice([0, 1, 3, 4, 6, 7], 400))
+    w = np.where(rng.random(400) < 0.2, 0.0, rng.random(400))
+    cw = pd.Series(w).groupby(gs, sort=False).cumsum().to_numpy()
+    total = np.bincount(gs, w, m)
+    target = np.sort(rng.random((m, P)), axis=1) * total[:, None]
+    target[1, :2] = cw[np.searchsorted(gs, 1) + 3]             # exactly a hit's (a run of equal)
+    glo = np.searchsorted(gs, np.arange(m), side="left")
+    ghi = np.searchsorted(gs, np.arange(m), side="right") - 1
+    q_group = np.repeat(np.arange(m), P)
+    order = np.lexsort((np.r_[np.zeros(len(q_group), np.int8), np.ones(len(gs), np.int8)],
+                        np.r_[target.reshape(-1), cw], np.r_[q_group, gs]))
+    is_hit = order >= len(q_group)
+    hits_before = np.cumsum(is_hit) - is_hit
+    want = np.empty(len(q_group), np.int64)
+    want[order[~is_hit]] = hits_before[~is_hit]
+    np.testing.assert_array_equal(_first_reaching(cw, glo, ghi, target), want.reshape(m, P))

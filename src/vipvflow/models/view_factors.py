@@ -11,6 +11,7 @@ import re
 
 import numpy as np
 import pandas as pd
+from numba import njit
 
 from .params import IrradianceCfg
 from .mesh import SURFACE_CODE
@@ -162,6 +163,72 @@ def _dominant_surface(gkey, surface, w, n_keys: int) -> np.ndarray:
     return out
 
 
+@njit(cache=True, nogil=True)
+def _order_in_groups(group, key, n_groups):
+    """``np.lexsort((key, group))`` for integer groups ``0 .. n_groups - 1`` and keys
+    without NaN: the hits by group (a stable counting sort), each group's by key (stable:
+    equal keys keep their order), so the same permutation, a stable sort's being unique."""
+    n = group.shape[0]
+    start = np.zeros(n_groups + 1, np.int64)
+    for i in range(n):
+        start[group[i] + 1] += 1
+    for g in range(n_groups):
+        start[g + 1] += start[g]
+    pos = start[:-1].copy()
+    out = np.empty(n, np.int64)
+    for i in range(n):
+        g = group[i]
+        out[pos[g]] = i
+        pos[g] += 1
+    for g in range(n_groups):
+        lo, hi = start[g], start[g + 1]
+        if hi - lo < 2:
+            continue
+        if hi - lo <= 24:
+            for a in range(lo + 1, hi):            # insertion: strictly greater moves on
+                v = out[a]
+                b = a - 1
+                while b >= lo and key[out[b]] > key[v]:
+                    out[b + 1] = out[b]
+                    b -= 1
+                out[b + 1] = v
+        else:
+            run = out[lo:hi].copy()
+            out[lo:hi] = run[np.argsort(key[run], kind="mergesort")]
+    return out
+
+
+def _lexsort_groups(key, group, n_groups: int) -> np.ndarray:
+    """:func:`_order_in_groups`, or ``np.lexsort`` where a key is NaN."""
+    key = np.ascontiguousarray(key, np.float64)
+    if np.isnan(key).any():
+        return np.lexsort((key, group))
+    return _order_in_groups(np.ascontiguousarray(group, np.int64), key, np.int64(n_groups))
+
+
+@njit(cache=True, nogil=True)
+def _first_reaching(cw, glo, ghi, target):
+    """Per group ``g`` (hits ``glo[g] .. ghi[g]``, their cumulative weights *cw* not
+    decreasing) and each of its targets ``target[g, k]``: the number of hits before the
+    first whose cumulative weight reaches the target (all hits of earlier groups, and the
+    group's own with a smaller weight)."""
+    m, P = target.shape
+    out = np.empty((m, P), np.int64)
+    for g in range(m):
+        lo, hi = glo[g], ghi[g] + 1
+        for k in range(P):
+            a, b = lo, max(lo, hi)
+            t = target[g, k]
+            while a < b:                          # the first index with cw >= t
+                c = (a + b) >> 1
+                if cw[c] < t:
+                    a = c + 1
+                else:
+                    b = c
+            out[g, k] = a
+    return out
+
+
 def _group_points(o, hs, gkey, w, hp, hn, w_g, n_g, P: int, lift: float, w_t=None):
     """P sample points per reflector group, each standing for an equal share of the group's
     weight (albedo x view factor), stratified over the group's surface in two dimensions.
@@ -215,7 +282,7 @@ def _group_points(o, hs, gkey, w, hp, hn, w_g, n_g, P: int, lift: float, w_t=Non
     wflat = w_g.reshape(-1)
     # band of each hit: the weight quantile of its mid-weight along key1 within its group
     # (sums within each group only, so a group's points do not depend on the others')
-    srt = np.lexsort((key1, gkey))
+    srt = _lexsort_groups(key1, gkey, m * G)
     mid = np.empty(len(w))
     mid[srt] = _group_cumsum(w[srt], gkey[srt]) - 0.5 * w[srt]
     B = math.isqrt(P)
@@ -224,7 +291,7 @@ def _group_points(o, hs, gkey, w, hp, hn, w_g, n_g, P: int, lift: float, w_t=Non
     # cell within the band: the weight quantile of the hit's mid-weight along key2
     bkey = gkey * B + band
     w_band = np.bincount(bkey, w, m * G * B)
-    srt = np.lexsort((key2, bkey))
+    srt = _lexsort_groups(key2, bkey, m * G * B)
     mid[srt] = _group_cumsum(w[srt], bkey[srt]) - 0.5 * w[srt]
     per = P // B                                                # cells per band
     cell = np.minimum((per * mid / np.maximum(w_band[bkey], 1e-300)).astype(np.int64), per - 1)
@@ -232,7 +299,7 @@ def _group_points(o, hs, gkey, w, hp, hn, w_g, n_g, P: int, lift: float, w_t=Non
     # point k = (band b, cell c) takes, within its cell ordered by key1, the weight quantile
     # (s + 1/2) / per with s = (c + b) mod per: the P points hold P distinct key1 levels
     # (a Latin square of bands and cells) and B x per strata of key2 within the bands
-    srt = np.lexsort((key1, ckey))
+    srt = _lexsort_groups(key1, ckey, m * G * B * per)
     cs = ckey[srt]
     gs = gkey[srt]
     cw = _group_cumsum(w[srt], gs)                              # within each group
@@ -250,16 +317,11 @@ def _group_points(o, hs, gkey, w, hp, hn, w_g, n_g, P: int, lift: float, w_t=Non
     ghi = np.searchsorted(gs, np.arange(m * G), side="right")[:, None] - 1
     empty = hi < lo
     lo, hi = np.where(empty, glo, lo), np.where(empty, np.maximum(ghi, glo), hi)
-    # the first hit of the group whose cumulative weight reaches the target: merge the
-    # targets into the hits' (group, cumulative weight) order, a target before equal hits
-    q_group = np.repeat(np.arange(m * G), P)
-    order = np.lexsort((np.r_[np.zeros(len(q_group), np.int8), np.ones(len(gs), np.int8)],
-                        np.r_[target.reshape(-1), cw], np.r_[q_group, gs]))
-    is_hit = order >= len(q_group)
-    hits_before = np.cumsum(is_hit) - is_hit
-    first = np.empty(len(q_group), np.int64)
-    first[order[~is_hit]] = hits_before[~is_hit]
-    idx = np.clip(first.reshape(m * G, P), lo, hi)
+    # the first hit of the group whose cumulative weight reaches the target (the hits before
+    # it: the earlier groups' and the group's own below the target; the weights are not
+    # negative, so a group's cumulative weights do not decrease)
+    first = _first_reaching(cw, glo[:, 0], ghi[:, 0], np.ascontiguousarray(target, np.float64))
+    idx = np.clip(first, lo, hi)
     idx = srt[np.minimum(idx, len(srt) - 1)]
     used = (wflat > 0)[:, None]
     pts = np.where(used[..., None], hp[idx] + lift * hn[idx],
