@@ -163,7 +163,7 @@ def run_standing(ctx, tile: str) -> dict:
         t = time.perf_counter()
         geom = point_geometry(scene, points, cfg, **street_options(ctx))
         # packed once for all the points and months (with the points' sun masks among the
-        # buildings, kept in it): evaluate_passes would otherwise pack every point's all
+        # buildings, kept in it): evaluate_passes would otherwise pack them all for each point
         packed = pack_geometry(geom, cfg, ctx.ground_albedo, scene)
         timings["standing_geometry_s"] = time.perf_counter() - t
     t_eval = time.perf_counter()
