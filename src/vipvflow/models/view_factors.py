@@ -917,7 +917,7 @@ def _reflectors(scene, o, nrm, keys, N: int, cfg: IrradianceCfg, acc: dict, idx,
     mean_p = p_g / np.maximum(w_g, 1e-300)[..., None]
     # representative point: the group's hit point nearest its weighted mean
     dev = np.linalg.norm(hp - mean_p.reshape(-1, 3)[gkey], axis=1)
-    srt = np.lexsort((dev, gkey))
+    srt = _lexsort_groups(dev, gkey, m * G)
     first = srt[np.unique(gkey[srt], return_index=True)[1]]
     rep = np.repeat(o[:, None], G, axis=1).reshape(-1, 3)
     rep[gkey[first]] = hp[first]
