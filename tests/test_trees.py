@@ -234,6 +234,7 @@ def test_sky_cell_loss_is_the_weighted_loss_of_each_cells_own_directions(monkeyp
             np.testing.assert_allclose(got[i, :, cell], want, rtol=1e-5, atol=1e-7)
     assert (got > 0).mean() > 0.05 and (got == 0).any()
 
+
 def test_fused_kernel_equals_the_numpy_reference_with_crowns(monkeypatch):
     """A canyon with rows of crowns (deciduous and evergreen, some with their own leaf-off
     months: three classes of months) over two days, one in leaf and one not: every

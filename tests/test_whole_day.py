@@ -149,6 +149,7 @@ def test_layovers_apart_take_only_their_own_minutes():
         share = np.clip(np.minimum(minutes + 60.0, b) - np.maximum(minutes, a), 0.0, None)
         assert together["h_total"].iloc[i] == pytest.approx(float((irr * share).sum() / 3600.0), rel=1e-9)
 
+
 def test_points_packed_once_give_what_each_point_packed_alone_gives():
     """The standing work packs a tile's points once (with their sun masks among the
     buildings) for all its points and months: the sums are those of interval_integrals
