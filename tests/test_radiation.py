@@ -153,3 +153,74 @@ def test_several_locations_nearest(cams, tmp_path):
     t = pd.Timestamp("2020-06-01 12:01:30", tz="UTC").timestamp()
     a, b = table.lookup([t, t], location=loc)["zenith"]
     assert a < b        # the same minute, the sun higher in Luxembourg than in Denmark
+
+
+def test_npz_member_maps_an_uncompressed_array(tmp_path):
+    """npz_member: where np.savez put an array, for np.memmap; None for a compressed one."""
+    from vipvflow.store import npz_member, write_npz
+
+    a = np.arange(12 * 7, dtype=np.float32).reshape(12, 7)
+    write_npz(tmp_path / "a.npz", key=np.array("k"), packed=a)
+    with open(tmp_path / "a.npz", "rb") as fh:
+        offset, dtype, shape, order = npz_member(fh, "packed")
+        assert fh.tell() == 0
+        mapped = np.memmap(fh, dtype=dtype, mode="r", offset=offset, shape=shape, order=order)
+        np.testing.assert_array_equal(mapped, a)
+        del mapped
+        with pytest.raises(KeyError):
+            npz_member(fh, "other")
+    np.savez_compressed(tmp_path / "c.npz", packed=a)
+    with open(tmp_path / "c.npz", "rb") as fh:
+        assert npz_member(fh, "packed") is None
+
+
+def test_sky_window_reads_the_tables_of_its_days_only(small_config, tmp_path):
+    """The compiled kernel's sky tables (RadiationTable.sky_window): for a year's table
+    kept beside the radiation file, the rows of the passes' steps only, read from the file
+    (no year of values in memory) with the days after them, each equal to the whole
+    table's; still equal after the file was written again under the reader."""
+    import os
+
+    from vipvflow.config import load_config
+    from vipvflow.models.sun_sky import SKY_READ_AHEAD_S
+
+    # the small demo's year at its place and, a second location, 2 deg further north
+    src = load_config(small_config).inputs.cams[0]
+    head, body = _data_rows(src)
+    north = tmp_path / "north.csv"
+    north.write_text("".join(h.replace("Latitude (positive North, ISO 19115): 49.",
+                                       "Latitude (positive North, ISO 19115): 51.") for h in head)
+                     + "".join(body))
+    data_dir = tmp_path / "data"
+    ingest_cams([src, north], data_dir)
+    RadiationTable.load(data_dir, 2024).sky_index()            # the file kept beside the radiation
+    full = RadiationTable.load(data_dir, 2024).sky()
+    table = RadiationTable.load(data_dir, 2024)
+    index = table.sky_index()
+    assert "file" in index and "packed" not in index and "_sky" not in table.__dict__
+    assert full["rows"].shape[0] == 2
+    rng = np.random.default_rng(3)
+    t_year = pd.Timestamp("2024-01-01", tz="UTC").timestamp()
+    for k in range(6):
+        if k == 5:                      # written again (same tables): read from the new file
+            cache = index["file"][0]
+            os.utime(cache, ns=(os.stat(cache).st_atime_ns, os.stat(cache).st_mtime_ns + 10**9))
+        t = t_year + rng.uniform(0, 340 * 86400) + rng.uniform(0, 3 * 86400, 500)
+        win = table.sky_window(t)
+        # the window: both places' rows from the first pass's step to the last's and those
+        # read ahead
+        j = table.sky_steps(t)
+        steps = full["rows"][:, j.min():j.max() + 1 + int(SKY_READ_AHEAD_S // full["step"])]
+        assert win["packed"].shape[1] == (steps >= 0).sum() == len(win["all_open"])
+        assert win["packed"].flags.c_contiguous and win["packed"].dtype == np.float32
+        later = t + 10 * 86400          # the days read ahead: the same window serves them
+        assert table.sky_window(later) is win
+        for times, loc in ((t, 0), (later, 1)):
+            j = table.sky_steps(times)
+            rows, got = full["rows"][loc, j], win["rows"][loc, j]
+            assert ((rows >= 0) == (got >= 0)).all() and (rows >= 0).any()
+            day = rows >= 0
+            np.testing.assert_array_equal(win["packed"][:, got[day]], full["packed"][:, rows[day]])
+            for name in ("all_open", "clear_open"):
+                np.testing.assert_array_equal(win[name][got[day]], full[name][rows[day]])
+    assert table.sky_window(np.array([np.nan]))["packed"].shape[1] == 0

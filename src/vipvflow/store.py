@@ -484,6 +484,41 @@ def write_npz(path: str | Path, **arrays) -> Path:
     return path
 
 
+def npz_member(file, name: str) -> tuple | None:
+    """Where the array *name* of an uncompressed ``.npz`` (:func:`write_npz`) lies in it, for
+    ``np.memmap``: ``(offset, dtype, shape, order)``; ``None`` when the member is compressed
+    or not a plain array.  *file*: the ``.npz`` opened in binary mode (read, then left where
+    it was); :class:`KeyError` when it has no such member."""
+    import struct
+    import zipfile
+
+    import numpy as np
+
+    at = file.tell()
+    try:
+        with zipfile.ZipFile(file) as zf:
+            info = zf.getinfo(name + ".npy")
+        if info.compress_type != zipfile.ZIP_STORED:
+            return None
+        # the member's local header (30 bytes, then its name and extra field), then the array
+        file.seek(info.header_offset)
+        head = file.read(30)
+        if len(head) < 30 or head[:4] != b"PK\x03\x04":
+            return None
+        n_name, n_extra = struct.unpack("<HH", head[26:30])
+        file.seek(info.header_offset + 30 + n_name + n_extra)
+        read = {(1, 0): np.lib.format.read_array_header_1_0,
+                (2, 0): np.lib.format.read_array_header_2_0}.get(np.lib.format.read_magic(file))
+        if read is None:
+            return None
+        shape, fortran, dtype = read(file)
+        if dtype.hasobject:
+            return None
+        return file.tell(), dtype, shape, "F" if fortran else "C"
+    finally:
+        file.seek(at)
+
+
 def _plain_table(df):
     """*df* as a pyarrow Table built column by column from numpy, when every column is a
     number (pandas' nullable ones with their gaps as nulls), bool, datetime64 or string

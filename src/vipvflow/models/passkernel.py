@@ -718,7 +718,7 @@ def _writable(a: np.ndarray) -> np.ndarray:
     return a if a.flags.writeable else a.copy()
 
 
-def _inputs(geo: dict, cfg, radiation_table, rows_of_segment_loc, scene=None, clock=None):
+def _inputs(geo: dict, cfg, radiation_table, rows_of_segment_loc, times, scene=None, clock=None):
     f32 = np.float32
     names, packed = radiation_table._packed()
     cols = np.array([names.index(c) for c in _RAD], np.int64)
@@ -756,7 +756,8 @@ def _inputs(geo: dict, cfg, radiation_table, rows_of_segment_loc, scene=None, cl
     x["bmask"] = _building_masks(geo, scene, cfg, clock) if cfg.sun_masks else _NO_BMASK
     sky_x = geo.get("sky_x")
     if perez and sky_x is not None and sky_x.shape[1]:
-        tables = radiation_table.sky()
+        # the sky tables of the passes' days only (*times*: when each pass looks them up)
+        tables = radiation_table.sky_window(times)
         x.update(sky_cell=_writable(geo["sky_cell"]), sky_f=_writable(geo["sky_f"]),
                  sky_t=_writable(geo["sky_t"]), sky_tilted=_writable(geo["sky_tilted"]),
                  sky_rows=_writable(tables["rows"]), sky_packed=_writable(tables["packed"]),
@@ -821,7 +822,8 @@ _NO_TREES = (np.zeros(0), np.zeros(0), np.zeros(0), np.zeros(0), np.zeros(0),
 def _run(seg, t_start, dt, mid, row, geo, cfg, radiation_table, scene, loc_of_row, clock,
          finish):
     """Chunks of passes through setup -> Embree -> *finish(lo, hi, x, batch, occ, P, rotate)*."""
-    x = _inputs(geo, cfg, radiation_table, loc_of_row, scene, clock)
+    x = _inputs(geo, cfg, radiation_table, loc_of_row, t_start + 0.5 * dt if mid else t_start,
+                scene, clock)
     J, P, rotate, per_pass, chunk = _plan(geo, cfg)
     n = len(row)
     chunk = min(chunk, max(n, 1))

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import json
 import logging
+import os
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -16,7 +17,7 @@ import pandas as pd
 
 from ..errors import InputError
 from ..inputs.cams import _GRID_S, COLUMNS, ingest_cams
-from ..store import DataDir, RadiationDir, write_npz
+from ..store import DataDir, RadiationDir, npz_member, write_npz
 from .sky import (SKY_AZIMUTH_BINS, SKY_PACK, SKY_STEP_S, open_terms, pack_sky, perez_table,
                   sky_table, unpack_sky)
 
@@ -99,10 +100,20 @@ def _sky_tables(grid_t0: float, n_steps: int, table: "RadiationTable", k: int) -
     return out
 
 
-#: what the sky tables' file holds (the four tables packed: :func:`vipvflow.models.sky.pack_sky`)
-_SKY_KEYS = ("rows", "packed", "all_open", "clear_open")
+#: what the sky tables' file holds: the four tables packed (:func:`vipvflow.models.sky.pack_sky`)
+#: and stored by table row (``packed_rows``: the packed array's transpose, so that the rows of
+#: a few days are one contiguous read, :meth:`RadiationTable.sky_window`)
+_SKY_KEYS = ("rows", "packed_rows", "all_open", "clear_open")
 _SKY_TABLES = ("all", "all_h", "clear", "clear_h")
 _SKY_OPEN = ("all_open", "clear_open")
+#: :meth:`RadiationTable.sky_window` also reads the rows of this long after its passes' last
+#: (the next chunks of a month's passes come in order: one read serves a few; ~2.5 MB)
+SKY_READ_AHEAD_S = 16 * 86400.0
+
+
+def _identity(st: os.stat_result) -> tuple:
+    """A file's identity for a reader that opens it again: device, inode, size, time."""
+    return st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns
 
 
 # --------------------------------------------------------------------------- lookup
@@ -295,19 +306,15 @@ class RadiationTable:
         if cache is not None:
             return cache
         n_steps = int(np.floor((self.t_end - self.t0) / SKY_STEP_S)) + 2
-        path = self.__dict__.get("_source")
-        key = None
-        if path is not None:
-            st = Path(path).stat()
-            key = json.dumps(["sky-5", st.st_size, st.st_mtime_ns, self.t0, self.n, SKY_STEP_S,
-                              np.round(self.lat, 8).tolist(), np.round(self.lon, 8).tolist()])
-            file = RadiationDir(Path(path).parent).sky_cache(int(self.t0), self.n)
+        key, file = self._sky_key()
+        if key is not None:
             try:
                 with np.load(file) as z:
                     if str(z["key"]) == key:
                         cache = {k: z[k] for k in _SKY_KEYS}
+                        cache["packed"] = np.ascontiguousarray(cache.pop("packed_rows").T)
             except (OSError, KeyError, ValueError):
-                pass
+                cache = None
         if cache is None:
             parts = [_sky_tables(self.t0, n_steps, self, k) for k in range(len(self.lat))]
             offset = np.cumsum([0] + [len(p["all"]) for p in parts])
@@ -317,7 +324,8 @@ class RadiationTable:
                      "packed": pack_sky({k: np.concatenate([p[k] for p in parts]) for k in _SKY_TABLES})}
             if key is not None:
                 try:
-                    write_npz(file, key=np.array(key), **cache)
+                    write_npz(file, key=np.array(key), packed_rows=np.ascontiguousarray(cache["packed"].T),
+                              **{k: cache[k] for k in _SKY_KEYS if k != "packed_rows"})
                 except OSError:
                     pass
         # the four tables are kept once, interleaved for the compiled kernel, and read as views
@@ -326,6 +334,119 @@ class RadiationTable:
         cache = {**cache, **unpack_sky(packed, shape), "t0": float(self.t0), "step": float(SKY_STEP_S)}
         self.__dict__["_sky"] = cache
         return cache
+
+    def _sky_key(self) -> tuple:
+        """The key of :meth:`sky`'s tables (the radiation file's size and time, the grid,
+        the locations) and the file beside the radiation file that keeps them; ``(None,
+        None)`` for a table that did not come from a file."""
+        path = self.__dict__.get("_source")
+        if path is None:
+            return None, None
+        st = Path(path).stat()
+        key = json.dumps(["sky-6", st.st_size, st.st_mtime_ns, self.t0, self.n, SKY_STEP_S,
+                          np.round(self.lat, 8).tolist(), np.round(self.lon, 8).tolist()])
+        return key, RadiationDir(Path(path).parent).sky_cache(int(self.t0), self.n)
+
+    def sky_index(self) -> dict:
+        """:meth:`sky`'s tables without their values: ``t0``, ``step``, ``rows``,
+        ``all_open``, ``clear_open``, and ``n_rows`` and where the values (``packed``) are:
+        in memory (``packed``) or in the file that keeps them (``file``: its path, identity
+        and the array's place in it), read a window at a time by :meth:`sky_window`.  A
+        year's values are ~100 MB; a process that reads the file keeps none of them."""
+        index = self.__dict__.get("_sky_index")
+        if index is not None:
+            return index
+        key, file = self._sky_key()
+        if key is not None and "_sky" not in self.__dict__:
+            try:
+                with open(file, "rb") as fh:
+                    ident = _identity(os.fstat(fh.fileno()))
+                    with np.load(fh) as z:
+                        if str(z["key"]) == key:
+                            index = {k: z[k] for k in ("rows", *_SKY_OPEN)}
+                    member = npz_member(fh, "packed_rows") if index is not None else None
+                if member is None or len(member[2]) != 2 or member[3] != "C":
+                    index = None
+                else:
+                    index.update(file=(str(file), ident, member), n_rows=int(member[2][0]))
+            except (OSError, KeyError, ValueError):
+                index = None
+        if index is None:           # computed here (and kept beside the radiation file)
+            full = self.sky()
+            index = {k: full[k] for k in ("rows", *_SKY_OPEN, "packed")}
+            index["n_rows"] = int(full["packed"].shape[1])
+        index.update(t0=float(self.t0), step=float(SKY_STEP_S))
+        self.__dict__["_sky_index"] = index
+        return index
+
+    def sky_window(self, t_utc) -> dict:
+        """:meth:`sky`'s tables for passes at the times *t_utc* (Unix s) only, as the
+        compiled kernel reads them: ``t0``, ``step``, ``rows`` (K, n_steps) int32 into
+        ``packed`` (cells x 4, m) float32 and ``all_open``, ``clear_open`` (m, 2), which hold
+        the m table rows of the steps from the first time's to the last's and of
+        :data:`SKY_READ_AHEAD_S` after (their values those of :meth:`sky`; -1 at night and at
+        the steps outside).  The last window is kept and serves a later call whose steps it
+        holds."""
+        index = self.sky_index()
+        rows = index["rows"]
+        t = np.asarray(t_utc, np.float64)
+        t = t[np.isfinite(t)]
+        used = np.zeros(0, np.int64)
+        if len(t) and rows.shape[1]:
+            # the steps of the first and last time, as the kernel finds them (sky_steps)
+            f = (np.array([t.min(), t.max()]) - index["t0"]) / index["step"]
+            j0, j1 = np.clip(np.floor(f + 0.5), 0, rows.shape[1] - 1).astype(np.int64)
+            near = rows[:, j0:j1 + 1]
+            used = np.unique(near[near >= 0]).astype(np.int64)
+            last = self.__dict__.get("_sky_last")
+            if last is not None and last[0] is index and (last[1][used] >= 0).all():
+                return last[2]              # the window read for an earlier call holds them
+            # and the rows of the days after (the next passes of a month's, in order)
+            ahead = rows[:, j1 + 1:j1 + 1 + int(SKY_READ_AHEAD_S // index["step"])]
+            used = np.union1d(used, ahead[ahead >= 0]).astype(np.int64)
+        packed = self._sky_values(index, used)
+        if packed is None:
+            # the file changed under the run: the tables read again (or made), kept in memory
+            self.__dict__.pop("_sky", None)
+            full = self.sky()
+            index = {**index, **{k: full[k] for k in ("rows", *_SKY_OPEN, "packed")},
+                     "n_rows": int(full["packed"].shape[1])}
+            index.pop("file", None)
+            self.__dict__["_sky_index"] = index
+            rows = index["rows"]
+            packed = self._sky_values(index, used)
+        new = np.full(index["n_rows"] + 1, -1, np.int32)           # [-1] stays -1
+        new[used] = np.arange(len(used), dtype=np.int32)
+        window = {"t0": index["t0"], "step": index["step"], "rows": new[rows], "packed": packed,
+                  **{k: np.ascontiguousarray(index[k][used]) for k in _SKY_OPEN}}
+        self.__dict__["_sky_last"] = (index, new, window)
+        return window
+
+    @staticmethod
+    def _sky_values(index: dict, used: np.ndarray) -> np.ndarray | None:
+        """The columns *used* (sorted) of the sky tables' values, a C-ordered copy; ``None``
+        when the file that keeps them is no longer the one :meth:`sky_index` checked."""
+        if "packed" in index:
+            lo, hi = (int(used[0]), int(used[-1]) + 1) if len(used) else (0, 0)
+            pick = slice(lo, hi) if hi - lo == len(used) else used
+            return np.array(index["packed"][:, pick], np.float32, order="C")
+        path, ident, (offset, dtype, shape, _) = index["file"]
+        width = int(shape[1])
+        out = np.empty((width, len(used)), np.float32)
+        # each run of consecutive rows (one per location) is one read of the file
+        cut = np.flatnonzero(np.diff(used) != 1) + 1
+        with open(path, "rb") as fh:
+            if _identity(os.fstat(fh.fileno())) != ident:
+                return None
+            for run, at in zip(np.split(used, cut), np.concatenate([[0], cut])):
+                if not len(run):
+                    continue
+                fh.seek(offset + int(run[0]) * width * dtype.itemsize)
+                block = np.fromfile(fh, dtype=dtype, count=len(run) * width)
+                if len(block) != len(run) * width:
+                    return None
+                out[:, at:at + len(run)] = block.reshape(len(run), width).T
+        return out
 
     def sky_share(self, t_utc, levels, normal, location=None, clear: bool = False):
         """The share of DHI a roof point receives from the Perez (1993) sky it sees, and
@@ -371,7 +492,7 @@ class RadiationTable:
 
     def sky_steps(self, t_utc) -> np.ndarray:
         """The sky tables' step nearest each time (int64, within the tables)."""
-        sky = self.sky()
+        sky = self.sky_index()
         f = (np.asarray(t_utc, np.float64) - sky["t0"]) / sky["step"]
         return np.clip(np.floor(f + 0.5), 0, sky["rows"].shape[1] - 1).astype(np.int64)
 

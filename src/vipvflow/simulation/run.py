@@ -338,7 +338,7 @@ def _warm_radiation(data_dir: str, year: int, sky: bool = False) -> None:
     try:
         table = RadiationTable.load(data_dir, year)
         if sky:
-            table.sky()
+            table.sky_index()           # computes and keeps the sky's tables where there are none
     except Exception:  # noqa: BLE001 - the same load fails again in the tasks, with its message
         pass
 
