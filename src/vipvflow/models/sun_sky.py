@@ -143,13 +143,18 @@ class RadiationTable:
     lon: np.ndarray
 
     def _packed(self):
-        """All series as one (K, N, C) float32 array: one gather per pass instead of C."""
+        """All series as one (K, N, C) float32 array: one gather per pass instead of C.
+        The float32 series of :attr:`data` are then views into it (the table holds each
+        value once: ~26 MB for a year and one location)."""
         cache = self.__dict__.get("_pack")
         if cache is None or cache[0] != tuple(self.data) or any(
                 cache[2][c] is not self.data[c] for c in self.data):
             names = tuple(self.data)
             packed = np.ascontiguousarray(np.stack([self.data[c] for c in names], axis=-1),
                                           dtype=np.float32)
+            for j, c in enumerate(names):
+                if self.data[c].dtype == np.float32 and self.data[c].shape == packed.shape[:2]:
+                    self.data[c] = packed[..., j]
             cache = (names, packed, dict(self.data))
             self.__dict__["_pack"] = cache
         return cache[0], cache[1]
