@@ -224,3 +224,20 @@ def test_sky_window_reads_the_tables_of_its_days_only(small_config, tmp_path):
             for name in ("all_open", "clear_open"):
                 np.testing.assert_array_equal(win[name][got[day]], full[name][rows[day]])
     assert table.sky_window(np.array([np.nan]))["packed"].shape[1] == 0
+
+
+def test_packed_table_holds_each_value_once(cams, tmp_path):
+    """Once packed for the kernel, the table's series are views into the packed array: the
+    same lookups, no second copy."""
+    ingest_cams([cams / "cams_radiation_1min_verbose.csv"], tmp_path)
+    table = RadiationTable.load(tmp_path, 2020)
+    t = pd.Timestamp("2020-06-01 12:00:30", tz="UTC").timestamp() + np.linspace(0, 3000, 41)
+    before = table.lookup(t)
+    names, packed = table._packed()
+    for j, name in enumerate(names):
+        assert np.shares_memory(table.data[name], packed)
+        np.testing.assert_array_equal(table.data[name], packed[..., j])
+    after = table.lookup(t)
+    for k in before:
+        np.testing.assert_array_equal(before[k], after[k])
+    assert table._packed()[1] is packed
