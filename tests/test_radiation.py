@@ -177,7 +177,7 @@ def test_npz_member_maps_an_uncompressed_array(tmp_path):
 def test_sky_window_reads_the_tables_of_its_days_only(small_config, tmp_path):
     """The compiled kernel's sky tables (RadiationTable.sky_window): for a year's table
     kept beside the radiation file, the rows of the passes' steps only, read from the file
-    (no year of values in memory) with the days after them, each equal to the whole
+    (no year of values in memory) up to the end of their month, each equal to the whole
     table's; still equal after the file was written again under the reader."""
     import os
 
@@ -200,20 +200,20 @@ def test_sky_window_reads_the_tables_of_its_days_only(small_config, tmp_path):
     assert "file" in index and "packed" not in index and "_sky" not in table.__dict__
     assert full["rows"].shape[0] == 2
     rng = np.random.default_rng(3)
-    t_year = pd.Timestamp("2024-01-01", tz="UTC").timestamp()
     for k in range(6):
         if k == 5:                      # written again (same tables): read from the new file
             cache = index["file"][0]
             os.utime(cache, ns=(os.stat(cache).st_atime_ns, os.stat(cache).st_mtime_ns + 10**9))
-        t = t_year + rng.uniform(0, 340 * 86400) + rng.uniform(0, 3 * 86400, 500)
+        start = pd.Timestamp(f"2024-{2 * k + 1:02d}-02", tz="UTC").timestamp()
+        t = start + rng.uniform(0, 3 * 86400, 500)
         win = table.sky_window(t)
-        # the window: both places' rows from the first pass's step to the last's and those
-        # read ahead
-        j = table.sky_steps(t)
-        steps = full["rows"][:, j.min():j.max() + 1 + int(SKY_READ_AHEAD_S // full["step"])]
+        # the window: both places' rows from the first pass's step to the end of its month
+        # and a day
+        end = pd.Timestamp(f"2024-{2 * k + 2:02d}-01", tz="UTC").timestamp() + SKY_READ_AHEAD_S
+        steps = full["rows"][:, table.sky_steps([t.min()])[0]:table.sky_steps([end])[0] + 1]
         assert win["packed"].shape[1] == (steps >= 0).sum() == len(win["all_open"])
         assert win["packed"].flags.c_contiguous and win["packed"].dtype == np.float32
-        later = t + 10 * 86400          # the days read ahead: the same window serves them
+        later = t + 25 * 86400          # the month's later days: the same window serves them
         assert table.sky_window(later) is win
         for times, loc in ((t, 0), (later, 1)):
             j = table.sky_steps(times)

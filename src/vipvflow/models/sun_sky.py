@@ -106,9 +106,10 @@ def _sky_tables(grid_t0: float, n_steps: int, table: "RadiationTable", k: int) -
 _SKY_KEYS = ("rows", "packed_rows", "all_open", "clear_open")
 _SKY_TABLES = ("all", "all_h", "clear", "clear_h")
 _SKY_OPEN = ("all_open", "clear_open")
-#: :meth:`RadiationTable.sky_window` also reads the rows of this long after its passes' last
-#: (the next chunks of a month's passes come in order: one read serves a few; ~2.5 MB)
-SKY_READ_AHEAD_S = 16 * 86400.0
+#: :meth:`RadiationTable.sky_window` also reads the rows up to this long after the end of
+#: the month (UTC) of its passes' last (a month's next chunks of passes come in order: one
+#: read serves them all; a service day's last trips end after midnight)
+SKY_READ_AHEAD_S = 86400
 
 
 def _identity(st: os.stat_result) -> tuple:
@@ -388,9 +389,9 @@ class RadiationTable:
         """:meth:`sky`'s tables for passes at the times *t_utc* (Unix s) only, as the
         compiled kernel reads them: ``t0``, ``step``, ``rows`` (K, n_steps) int32 into
         ``packed`` (cells x 4, m) float32 and ``all_open``, ``clear_open`` (m, 2), which hold
-        the m table rows of the steps from the first time's to the last's and of
-        :data:`SKY_READ_AHEAD_S` after (their values those of :meth:`sky`; -1 at night and at
-        the steps outside).  The last window is kept and serves a later call whose steps it
+        the m table rows of the steps from the first time's to the end of the last time's
+        month and :data:`SKY_READ_AHEAD_S` (their values those of :meth:`sky`; -1 at night
+        and at the steps outside).  The last window is kept and serves a later call whose steps it
         holds."""
         index = self.sky_index()
         rows = index["rows"]
@@ -406,8 +407,12 @@ class RadiationTable:
             last = self.__dict__.get("_sky_last")
             if last is not None and last[0] is index and (last[1][used] >= 0).all():
                 return last[2]              # the window read for an earlier call holds them
-            # and the rows of the days after (the next passes of a month's, in order)
-            ahead = rows[:, j1 + 1:j1 + 1 + int(SKY_READ_AHEAD_S // index["step"])]
+            # and the rows up to the end of the last time's month (UTC) and a day: the next
+            # chunks of a month's passes come in order
+            month_end = (np.datetime64(int(t.max()), "s").astype("datetime64[M]") + 1).astype(
+                "datetime64[s]").astype(np.int64) + SKY_READ_AHEAD_S
+            j2 = int(np.clip(np.floor((month_end - index["t0"]) / index["step"] + 0.5), j1, rows.shape[1] - 1))
+            ahead = rows[:, j1 + 1:j2 + 1]
             used = np.union1d(used, ahead[ahead >= 0]).astype(np.int64)
         packed = self._sky_values(index, used)
         if packed is None:
@@ -450,7 +455,9 @@ class RadiationTable:
                 block = np.fromfile(fh, dtype=dtype, count=len(run) * width)
                 if len(block) != len(run) * width:
                     return None
-                out[:, at:at + len(run)] = block.reshape(len(run), width).T
+                block = block.reshape(len(run), width)
+                for i in range(0, len(run), 128):       # in slabs that stay in the cache
+                    out[:, at + i:at + min(i + 128, len(run))] = block[i:i + 128].T
         return out
 
     def sky_share(self, t_utc, levels, normal, location=None, clear: bool = False):
