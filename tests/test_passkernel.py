@@ -311,3 +311,20 @@ def test_utc_offsets_from_the_cached_table_equal_pandas_conversion():
             got, want = utc_offsets(tz, lo, hi), _offsets(tz, lo, hi)
             assert got.shape == (hi - lo + 1,) and (got == want).all(), (tz, lo, hi)
 
+
+
+def test_time_span_holds_every_pass_time():
+    """The span of the passes' radiation times the sky tables are read for (_time_span):
+    no pass time outside it, NaN left out; none without passes."""
+    from vipvflow.models.passkernel import _time_span
+
+    rng = np.random.default_rng(5)
+    t_start = rng.uniform(1.7e9, 1.7e9 + 3e6, 5000)
+    dt = rng.uniform(0.0, 400.0, 5000)
+    t_start[::97], dt[::61] = np.nan, np.nan
+    for mid in (True, False):
+        lo, hi = _time_span(t_start, dt, mid)
+        t = t_start + 0.5 * dt if mid else t_start
+        t = t[~np.isnan(t)]
+        assert lo <= t.min() and hi >= t.max() and hi - lo < 3e6 + 400
+    assert len(_time_span(np.zeros(0), np.zeros(0), True)) == 0

@@ -822,8 +822,7 @@ _NO_TREES = (np.zeros(0), np.zeros(0), np.zeros(0), np.zeros(0), np.zeros(0),
 def _run(seg, t_start, dt, mid, row, geo, cfg, radiation_table, scene, loc_of_row, clock,
          finish):
     """Chunks of passes through setup -> Embree -> *finish(lo, hi, x, batch, occ, P, rotate)*."""
-    x = _inputs(geo, cfg, radiation_table, loc_of_row, t_start + 0.5 * dt if mid else t_start,
-                scene, clock)
+    x = _inputs(geo, cfg, radiation_table, loc_of_row, _time_span(t_start, dt, mid), scene, clock)
     J, P, rotate, per_pass, chunk = _plan(geo, cfg)
     n = len(row)
     chunk = min(chunk, max(n, 1))
@@ -856,6 +855,19 @@ def _run(seg, t_start, dt, mid, row, geo, cfg, radiation_table, scene, loc_of_ro
         clock["sun_rays_masked_n"] = clock.get("sun_rays_masked_n", 0) + masked
         clock["sun_rays_cast_n"] = (clock.get("sun_rays_cast_n", 0)
                                     + int(np.count_nonzero(bt.cos_aoi[:m] > 0)) - masked)
+
+
+def _time_span(t_start, dt, mid) -> np.ndarray:
+    """Times no later than the first and no earlier than the last of the passes' radiation
+    times (``t_start + dt / 2`` with *mid*, as :func:`_setup` takes them; NaN left out); none
+    without passes."""
+    if not len(t_start):
+        return np.zeros(0)
+    lo, hi = np.fmin.reduce(t_start), np.fmax.reduce(t_start)
+    if mid and len(dt):
+        lo = lo + 0.5 * min(0.0, np.fmin.reduce(dt))
+        hi = hi + 0.5 * max(0.0, np.fmax.reduce(dt))
+    return np.array([lo, hi], np.float64)
 
 
 def evaluate_block(seg, t_start, dt, mid, row, geo, cfg, radiation_table, scene,

@@ -391,12 +391,12 @@ class RadiationTable:
         ``packed`` (cells x 4, m) float32 and ``all_open``, ``clear_open`` (m, 2), which hold
         the m table rows of the steps from the first time's to the end of the last time's
         month and :data:`SKY_READ_AHEAD_S` (their values those of :meth:`sky`; -1 at night
-        and at the steps outside).  The last window is kept and serves a later call whose steps it
-        holds."""
+        and at the steps outside).  The last window is kept and serves a later call whose
+        steps it holds.  *t_utc* may be just the first and last time (NaN is none)."""
         index = self.sky_index()
         rows = index["rows"]
         t = np.asarray(t_utc, np.float64)
-        t = t[np.isfinite(t)]
+        t = t[~np.isnan(t)]
         used = np.zeros(0, np.int64)
         if len(t) and rows.shape[1]:
             # the steps of the first and last time, as the kernel finds them (sky_steps)
@@ -409,7 +409,8 @@ class RadiationTable:
                 return last[2]              # the window read for an earlier call holds them
             # and the rows up to the end of the last time's month (UTC) and a day: the next
             # chunks of a month's passes come in order
-            month_end = (np.datetime64(int(t.max()), "s").astype("datetime64[M]") + 1).astype(
+            last_s = int(index["t0"] + j1 * index["step"])
+            month_end = (np.datetime64(last_s, "s").astype("datetime64[M]") + 1).astype(
                 "datetime64[s]").astype(np.int64) + SKY_READ_AHEAD_S
             j2 = int(np.clip(np.floor((month_end - index["t0"]) / index["step"] + 0.5), j1, rows.shape[1] - 1))
             ahead = rows[:, j1 + 1:j2 + 1]
