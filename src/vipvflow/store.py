@@ -486,7 +486,8 @@ def write_npz(path: str | Path, **arrays) -> Path:
 
 def npz_member(file, name: str) -> tuple | None:
     """Where the array *name* of an uncompressed ``.npz`` (:func:`write_npz`) lies in it, for
-    ``np.memmap``: ``(offset, dtype, shape, order)``; ``None`` when the member is compressed
+    a reader that seeks to it (``np.fromfile``, ``np.memmap``): ``(offset, dtype, shape,
+    order)``; ``None`` when the member is compressed
     or not a plain array.  *file*: the ``.npz`` opened in binary mode (read, then left where
     it was); :class:`KeyError` when it has no such member."""
     import struct

@@ -378,12 +378,16 @@ class RadiationTable:
             except (OSError, KeyError, ValueError):
                 index = None
         if index is None:           # computed here (and kept beside the radiation file)
-            full = self.sky()
-            index = {k: full[k] for k in ("rows", *_SKY_OPEN, "packed")}
-            index["n_rows"] = int(full["packed"].shape[1])
+            index = self._sky_in_memory()
         index.update(t0=float(self.t0), step=float(SKY_STEP_S))
         self.__dict__["_sky_index"] = index
         return index
+
+    def _sky_in_memory(self) -> dict:
+        """:meth:`sky_index`'s entries for :meth:`sky`'s tables held in memory."""
+        full = self.sky()
+        return {**{k: full[k] for k in ("rows", *_SKY_OPEN, "packed")},
+                "n_rows": int(full["packed"].shape[1])}
 
     def sky_window(self, t_utc) -> dict:
         """:meth:`sky`'s tables for passes at the times *t_utc* (Unix s) only, as the
@@ -419,10 +423,7 @@ class RadiationTable:
         if packed is None:
             # the file changed under the run: the tables read again (or made), kept in memory
             self.__dict__.pop("_sky", None)
-            full = self.sky()
-            index = {**index, **{k: full[k] for k in ("rows", *_SKY_OPEN, "packed")},
-                     "n_rows": int(full["packed"].shape[1])}
-            index.pop("file", None)
+            index = {"t0": index["t0"], "step": index["step"], **self._sky_in_memory()}
             self.__dict__["_sky_index"] = index
             rows = index["rows"]
             packed = self._sky_values(index, used)
