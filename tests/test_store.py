@@ -14,8 +14,9 @@ import pytest
 from vipvflow.errors import InputError
 from vipvflow.simulation.dictionary import OUTPUTS
 from vipvflow.simulation.rundir import open_run
-from vipvflow.store import (ALL_MONTHS, GTFS_TABLES, HOURLY_METADATA, PARTS, TIMELINE_TABLES, DataDir,
-                            RunDir, atomic_path, remove_stale, staging_dir, swap_dir, write_json)
+from vipvflow.store import (ALL_MONTHS, GEOMETRY_CACHE_FILES, GTFS_TABLES, HOURLY_METADATA, PARTS,
+                            TIMELINE_TABLES, DataDir, RunDir, atomic_path, remove_stale, staging_dir,
+                            swap_dir, write_json)
 
 
 def _named_by_store(data_dir, run_dir) -> set:
@@ -33,6 +34,9 @@ def _named_by_store(data_dir, run_dir) -> set:
     names |= {city.mesh(t) for t in tiles} | {city.surface_part(t) for t in tiles}
     names |= {city.tree_points} | {city.trees_file(t) for t in tiles}     # the trees' crowns
     names |= {gtfs.table(n) for n in GTFS_TABLES}
+    # the geometry cache's entries, each of its two files (their keys: content digests)
+    if data.geometry_cache().is_dir():
+        names |= {e / n for e in data.geometry_cache().iterdir() for n in GEOMETRY_CACHE_FILES}
     names |= {run.output(f"{name}.parquet") for name in OUTPUTS}
     names |= {run.timeline_table(n) for n in TIMELINE_TABLES}
     for kind, spec in PARTS.items():

@@ -136,6 +136,11 @@ class RadiationDir(_Ingested):
         return self.root / f"sky_{first_s}_{n}.npz"
 
 
+#: the files of an entry of the geometry cache (:meth:`DataDir.geometry_cache`): a tile's
+#: ``parts/geometry`` and ``parts/horizon`` files
+GEOMETRY_CACHE_FILES = ("geometry.parquet", "horizon.parquet")
+
+
 @dataclass(frozen=True)
 class DataDir:
     """The ingested inputs of a scenario: ``city/``, ``gtfs/``, ``radiation/``."""
@@ -147,6 +152,12 @@ class DataDir:
     city = _Entry("city", kind=CityDir)
     gtfs = _Entry("gtfs", kind=GtfsDir)
     radiation = _Entry("radiation", kind=RadiationDir)
+
+    def geometry_cache(self, key: str | None = None) -> Path:
+        """The runs' cache of the tiles' geometry (``cache/geometry/``), or the folder of its
+        entry *key* (:data:`GEOMETRY_CACHE_FILES`; :mod:`vipvflow.simulation.geometry_cache`)."""
+        root = self.root / "cache" / "geometry"
+        return root / key if key is not None else root
 
     def tile_size_m(self) -> float:
         """The tile edge (m) of this data dir's grid: ``tile_size_m`` of ``gtfs/feed.json``

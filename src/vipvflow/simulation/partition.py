@@ -165,22 +165,35 @@ def tile_geometry(ctx: RunContext, tile: str) -> pd.DataFrame:
     """Per-segment geometry factors of a tile (sky view factor, reflector groups), computed
     once per run and stored in ``parts/geometry/tile=<TILE>.parquet``, and the segments'
     horizon profiles (:func:`vipvflow.models.horizon.horizon_profile` from the roof ray origins)
-    in ``parts/horizon/tile=<TILE>.parquet``, so a trip can be recomputed without rays."""
+    in ``parts/horizon/tile=<TILE>.parquet``, so a trip can be recomputed without rays.
+
+    Both files are kept in the data dir's cache (:mod:`vipvflow.simulation.geometry_cache`)
+    and taken from it by a later run of the same segments, city, settings and code; the
+    table's ``attrs["from_cache"]`` says whether this one was."""
     from ..models.horizon import horizon_frame, horizon_profile
+    from ..models.shading import modelled_tiles
     from ..models.view_factors import geometry_table, read_geometry, segment_geometry
+    from . import geometry_cache
 
     path = RunDir(ctx.run_dir).tile_part("geometry", tile)
-    if path.exists():
-        geom = read_geometry(path)
-    else:
+    hpath = RunDir(ctx.run_dir).tile_part("horizon", tile)
+    key, cached = None, False
+    if not path.exists():
         seg = _segments(ctx.data_dir)
         seg = seg[seg["tile"] == tile]
         if ctx.shapes is not None:
             seg = seg[seg["shape_id"].isin(ctx.shapes)]
-        geom = segment_geometry(_scene(ctx, tile), seg, IrradianceCfg(**ctx.irradiance),
-                                **street_options(ctx))
-        write_parquet(geometry_table(geom), path)
-    hpath = RunDir(ctx.run_dir).tile_part("horizon", tile)
+        # an earlier run's geometry of the same segments, city and settings (the data dir's
+        # cache, geometry_cache), else computed here and kept there
+        key = geometry_cache.tile_key(ctx.data_dir, tile, seg, geometry_settings(ctx),
+                                      tile in modelled_tiles(ctx.data_dir))
+        cached = geometry_cache.fetch(ctx.data_dir, key, path, hpath)
+        if not cached:
+            geom = segment_geometry(_scene(ctx, tile), seg, IrradianceCfg(**ctx.irradiance),
+                                    **street_options(ctx))
+            write_parquet(geometry_table(geom), path)
+    if path.exists() and (key is None or cached):
+        geom = read_geometry(path)
     if not hpath.exists():
         profile = geom.attrs.get("horizon_profile")         # computed with the geometry (perez_svf)
         if profile is None or len(profile) != len(geom):
@@ -188,7 +201,16 @@ def tile_geometry(ctx: RunContext, tile: str) -> pd.DataFrame:
             profile = horizon_profile(_scene(ctx, tile), origins,
                                       max_distance_m=IrradianceCfg(**ctx.irradiance).ray_length_m)
         write_parquet(horizon_frame(geom["segment_id"].to_numpy(), profile), hpath)
+    if key is not None and not cached:
+        geometry_cache.keep(ctx.data_dir, key, path, hpath)
+    geom.attrs["from_cache"] = cached
     return geom
+
+
+def geometry_settings(ctx: RunContext) -> dict:
+    """The settings a tile's geometry depends on (besides its segments and city): the
+    ``irradiance`` section and the street options (:func:`street_options`)."""
+    return {"irradiance": ctx.irradiance, "street": street_options(ctx)}
 
 
 def street_options(ctx: RunContext) -> dict:
@@ -206,11 +228,12 @@ class TileGeometry:
     Dask measures every result it keeps; walking the thousand columns of a geometry table
     for that cost more than computing the table, so this wrapper gives its size from its
     shape (8 bytes a value)."""
-    __slots__ = ("frame", "seconds")
+    __slots__ = ("frame", "seconds", "from_cache")
 
-    def __init__(self, frame: pd.DataFrame, seconds: float = 0.0):
+    def __init__(self, frame: pd.DataFrame, seconds: float = 0.0, from_cache: bool = False):
         self.frame = frame
         self.seconds = seconds
+        self.from_cache = from_cache
 
     def __sizeof__(self) -> int:
         return 64 + 8 * self.frame.shape[0] * self.frame.shape[1]
@@ -221,7 +244,7 @@ def geometry_task(ctx: RunContext, tile: str) -> TileGeometry:
     over several tasks, :func:`vipvflow.simulation.tasks.tile_tasks`), with its seconds."""
     t = time.perf_counter()
     frame = tile_geometry(ctx, tile)
-    return TileGeometry(frame, time.perf_counter() - t)
+    return TileGeometry(frame, time.perf_counter() - t, bool(frame.attrs.get("from_cache")))
 
 
 def tile_task(ctx: RunContext, tile: str, months: list[str],
@@ -230,18 +253,22 @@ def tile_task(ctx: RunContext, tile: str, months: list[str],
     then its partitions of *months* (:func:`run_partition`, each written as it is done): one
     task of the run's graph.  The geometry's seconds go into the first partition's timings
     (``geometry_s``; with its packing for the fused kernel where the tile is one task, a
-    split tile's tasks pack it in their first partition) and counts (``geometry_tiles``: 1),
-    with *counts_geometry* (the first task of a tile split over several).
+    split tile's tasks pack it in their first partition) and counts (``geometry_tiles``: 1;
+    ``geometry_tiles_from_cache``: 1 where it came from the data dir's cache,
+    :mod:`vipvflow.simulation.geometry_cache`), with *counts_geometry* (the first task of a
+    tile split over several).
 
     One task per tile rather than per partition: the tile's BVH is built once and its
     geometry table never leaves the worker, and the scheduler (in the command's process on a
     LocalCluster) handles 12 times fewer tasks: the line-year's 492 partitions as 41 tasks
     took ~2 s of a core off the command's process."""
     if geometry is not None:
-        frame, geometry_s = geometry.frame, geometry.seconds
+        frame, geometry_s, from_cache = geometry.frame, geometry.seconds, geometry.from_cache
     else:
         t = time.perf_counter()
-        frame = _held_geometry(ctx, tile, tile_geometry(ctx, tile))
+        frame = tile_geometry(ctx, tile)
+        from_cache = bool(frame.attrs.get("from_cache"))
+        frame = _held_geometry(ctx, tile, frame)
         geometry_s = time.perf_counter() - t
     done = []
     for month in months:
@@ -249,6 +276,7 @@ def tile_task(ctx: RunContext, tile: str, months: list[str],
         if counts_geometry and len(done) == 1:
             done[0]["timings"]["geometry_s"] = geometry_s
             done[0]["counts"]["geometry_tiles"] = 1
+            done[0]["counts"]["geometry_tiles_from_cache"] = int(from_cache)
         # a month's passes freed, before the next (a few ms): what the worker holds between
         # them is what it keeps, ~0.25 GB less on a network's largest tile
         hand_back_memory()
