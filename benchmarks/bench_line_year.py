@@ -29,6 +29,12 @@ run, ``sun_rays_*`` the rays cast and told clear by the masks (the manifest's co
 ``masks_equal_all_rays`` whether the first round's two runs wrote the same summary.json and
 the same trip and segment tables (the masks are exact: they must).
 
+Every run computes its tiles' geometry as a first run does (:func:`run_pipeline` empties the
+data dir's geometry cache first); after the rounds, two more line-years keep it: the first
+fills it, the second takes its tiles' geometry from it (``geometry_cached_*``: its wall
+time, its ratio to the same fastest bare kernel, its geometry worker-s, the tiles taken from
+the cache, and whether its outputs equal the first round's).
+
 ``tiny``: the small demo (3 km line), one month, one pair.
 """
 from __future__ import annotations
@@ -42,15 +48,17 @@ from benchmarks.bench_kernel import bare_kernel
 from benchmarks.common import YEAR, demo_config, fresh_dir, prepare_demo, remove, run_pipeline, stage_split
 
 
-def _line_year(size: str, months: list[int], sun_masks: bool = True, keep: bool = False) -> dict:
+def _line_year(size: str, months: list[int], sun_masks: bool = True, keep: bool = False,
+               geometry_cache: bool = False) -> dict:
     """One line-year from a fresh output folder (:func:`run_pipeline`'s result; with *keep*
     also its ``outputs``: summary.json and the trip and segment tables, read before the
-    folder goes)."""
+    folder goes; with *geometry_cache* the tiles' geometry an earlier run kept in the data
+    dir is used, else computed as by a first run)."""
     out = fresh_dir("line_year")
     try:
         cfg = demo_config(size, out_dir=out, routes=["L1"], months=months, n_workers=2)
         cfg.irradiance.sun_masks = sun_masks
-        r = run_pipeline(cfg, YEAR, n_workers=2, pss=True)
+        r = run_pipeline(cfg, YEAR, n_workers=2, pss=True, geometry_cache=geometry_cache)
         if keep:
             d = r["run_dir"]
             r["outputs"] = {"summary": json.loads((d / "summary.json").read_text()),
@@ -91,6 +99,10 @@ def run(tiny: bool = False) -> dict:
     months = [6] if tiny else list(range(1, 13))
     prep = prepare_demo(size)
     rounds = [_round(size, months, i) for i in range(1 if tiny else 3)]
+    # a later run of the same line: the tiles' geometry from the data dir's cache (a run that
+    # fills it, then the one that uses it)
+    _line_year(size, months, geometry_cache=True)
+    cached = _line_year(size, months, keep=True, geometry_cache=True)
     pairs = [(k, line) for k, line, _ in rounds]
     every = min((e for _, _, e in rounds), key=lambda e: e["wall_s"])
     kernel = min(k["wall_s"] for k, _ in pairs)
@@ -126,6 +138,14 @@ def run(tiny: bool = False) -> dict:
         "sun_rays_masked": masked,
         "sun_rays_masked_share": round(masked / max(cast + masked, 1), 4),
         "masks_equal_all_rays": _same_outputs(rounds[0][1]["outputs"], rounds[0][2]["outputs"]),
+        # a run that takes the tiles' geometry from the cache an earlier run of the same
+        # line left in the data dir (vipvflow.simulation.geometry_cache), against the same
+        # fastest bare kernel; its outputs against the first round's
+        "geometry_cached_wall_s": round(cached["wall_s"], 2),
+        "geometry_cached_kernel_ratio": round(cached["wall_s"] / kernel, 3),
+        "geometry_cached_worker_geometry_s": round(stage_split(cached["manifest"])["geometry_s"], 2),
+        "geometry_cached_tiles": cached["manifest"]["partition_counts"].get("geometry_tiles_from_cache", 0),
+        "geometry_cached_equal": _same_outputs(rounds[0][1]["outputs"], cached["outputs"]),
         "peak_rss_gb": round(max(line["peak_rss_mb"] for _, line in pairs) / 1024, 3),
         "peak_rss_main_gb": round(max(line["peak_rss_main_mb"] for _, line in pairs) / 1024, 3),
         # the same peak counting each shared page once (PeakRSS: the workers share the

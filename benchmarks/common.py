@@ -219,12 +219,21 @@ def remove(path: Path) -> None:
 
 
 def run_pipeline(cfg, year: int = YEAR, n_workers: int | None = None, rss_interval_s: float = 0.25,
-                 scheduler: str | None = None, pss: bool = False) -> dict:
+                 scheduler: str | None = None, pss: bool = False,
+                 geometry_cache: bool = False) -> dict:
     """One :func:`run_simulation` of *cfg* (on the cluster at *scheduler*, if given): wall
     time, peak RSS of the process tree, manifest, and the CPU time of this process (the
     command's: scheduler, client, prepare, the reduce's joins; all its threads) and of the
-    child processes that ended during the run (a LocalCluster's workers and nannies)."""
+    child processes that ended during the run (a LocalCluster's workers and nannies).
+
+    The data dir's geometry cache (:mod:`vipvflow.simulation.geometry_cache`) is emptied
+    first, so every run computes its tiles' geometry as a first run does; with
+    *geometry_cache* an earlier run's entries are used."""
     from vipvflow.simulation.run import run_simulation
+    from vipvflow.store import DataDir
+
+    if not geometry_cache:
+        shutil.rmtree(DataDir(cfg.data_dir).geometry_cache(), ignore_errors=True)
 
     log: list[str] = []
     said: list[float] = []                  # when each line of *log* was said (s after the start)
