@@ -21,7 +21,11 @@ passes of ``L1``) runs before and after the network, as ``line_year`` pairs them
 ``kernel_ratio`` is its best passes per second over the network's (target 1.5); peak PSS
 beside the peak RSS (:class:`benchmarks.common.PeakRSS`) and each process's own peak RSS.
 ``VIPVFLOW_BENCH_NETWORK_LINES`` sets the lines (default 200; the cost model in README.md
-ran 50, 100 and 200).
+ran 50, 100 and 200).  The run computes its tiles' geometry as a first run does (the data
+dir's geometry cache emptied first); with ``VIPVFLOW_BENCH_NETWORK_CACHED`` set, the same
+network runs once more from a fresh folder with the geometry the first run left in the
+cache (``geometry_cached``: its time, passes per second and kernel ratio, geometry
+worker-s, peak RSS, and whether its summary.json equals the first run's).
 
 Periods (``VIPVFLOW_BENCH_NETWORK`` or ``--week``/``--month`` on the module's command line):
 ``year`` (default: every day of 2024, all 12 months: ~3.5 G passes, 20-40 min of both
@@ -39,6 +43,7 @@ import datetime as dt
 import io
 import json
 import os
+import shutil
 import sys
 import time
 import zipfile
@@ -49,7 +54,7 @@ import pandas as pd
 
 from benchmarks.bench_kernel import bare_kernel
 from benchmarks.common import (WORK, YEAR, PeakRSS, demo_config, demo_paths, fresh_dir, prepare_demo,
-                               remove, run_pipeline)
+                               remove, run_pipeline, stage_split)
 
 WEEK_START = dt.date(2024, 6, 10)         # a Monday
 PERIODS = ("year", "month", "week")
@@ -225,13 +230,57 @@ def run(tiny: bool = False, period: str | None = None, scheduler: str | None = N
         segments = len(pd.read_parquet(data_dir / "gtfs" / "segments.parquet", columns=["tile"]))
         trip_days = len(pd.read_parquet(r["run_dir"] / "trip_energy.parquet", columns=["trip_id"]))
         part_bytes = _part_bytes(r["run_dir"])
+        cached = {}
+        if os.environ.get("VIPVFLOW_BENCH_NETWORK_CACHED"):
+            # the same network again from a fresh folder, the tiles' geometry from the cache
+            # the first run left in the data dir
+            summary = json.loads((r["run_dir"] / "summary.json").read_text())
+            shutil.rmtree(r["run_dir"])
+            c = run_pipeline(cfg, YEAR, n_workers=None if scheduler else 2, scheduler=scheduler,
+                             pss=True, geometry_cache=True)
+            cached = _cached_figures(c, kernel, summary)
     finally:
         remove(out)
     return _result(r, counts, days, period if not tiny else "day", scheduler,
                    {"segments": segments, "trips_run": trip_days, "gtfs_ingest_s": round(ingest_s, 1),
                     "partition_bytes_per_pass": round(part_bytes / max(r["manifest"]["passes_computed"], 1), 3)},
                    feed_write_s=round(write_s, 1), ingest_peak_rss_mb=round(mem.peak_mb),
-                   kernel=kernel, **cluster_rss)
+                   kernel=kernel, **cached, **cluster_rss)
+
+
+def _cached_figures(c: dict, kernel: list, summary: dict) -> dict:
+    """A second run's figures (``geometry_cached``: its tiles' geometry from the data dir's
+    cache): wall and map time, passes per second and their ratio to the bare kernel's best,
+    the geometry's worker-s, the tiles taken from the cache, peak RSS, and whether its
+    summary.json equals the first run's (the run's timings and paths aside)."""
+    m = c["manifest"]
+    passes = m["passes_computed"]
+    k_pps = max(k["passes"] / k["wall_s"] for k in kernel)
+    later = json.loads((c["run_dir"] / "summary.json").read_text())
+    return {"geometry_cached": {
+        "wall_s": round(c["wall_s"], 1), "map_s": m["timings_s"].get("map_s"),
+        "passes_per_s": round(passes / c["wall_s"]),
+        "kernel_ratio": round(k_pps / (passes / c["wall_s"]), 3),
+        "worker_geometry_s": round(stage_split(m)["geometry_s"], 1),
+        "tiles_from_cache": m["partition_counts"].get("geometry_tiles_from_cache", 0),
+        "peak_rss_gb": round(c["peak_rss_mb"] / 1024, 3),
+        "summary_equal": _same_summary(summary, later)}}
+
+
+def _same_summary(a: dict, b: dict) -> bool:
+    """Whether two runs' summary.json agree in every figure (timings, paths and the run's
+    identity aside)."""
+    skip = ("timing", "run_id", "created", "elapsed", "wall", "run_dir", "path")
+
+    def flat(d, p=""):
+        out = {}
+        for k, v in d.items():
+            if isinstance(v, dict):
+                out.update(flat(v, f"{p}{k}."))
+            elif not any(s in f"{p}{k}" for s in skip):
+                out[f"{p}{k}"] = v
+        return out
+    return flat(a) == flat(b)
 
 
 def outside_cluster_peak_rss(scheduler: str) -> dict:

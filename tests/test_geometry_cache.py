@@ -105,3 +105,24 @@ def test_the_code_digest_covers_the_physics_modules():
     assert len(digest) == 64 and digest == geometry_cache.code_digest()
     sources = sorted(p.name for p in geometry_cache.Path(models.__file__).parent.rglob("*.py"))
     assert {"view_factors.py", "shading.py", "trees.py", "horizon.py", "sky.py"} <= set(sources)
+
+
+def test_entries_are_copies_where_the_run_folder_is_on_another_file_system(data_copy, tmp_path,
+                                                                          monkeypatch):
+    import errno
+    import os
+
+    cfg, data, tile = data_copy
+
+    def no_link(src, dst):
+        raise OSError(errno.EXDEV, "Invalid cross-device link", str(src))
+
+    monkeypatch.setattr(geometry_cache.os, "link", no_link)
+    part.tile_geometry(_ctx(cfg, data, tmp_path / "a"), tile)
+    (entry,) = part.DataDir(data).geometry_cache().iterdir()
+    made = part.RunDir(tmp_path / "a").tile_part("geometry", tile)
+    assert (entry / "geometry.parquet").read_bytes() == made.read_bytes()
+    assert os.stat(entry / "geometry.parquet").st_ino != os.stat(made).st_ino
+    later = part.tile_geometry(_ctx(cfg, data, tmp_path / "b"), tile)
+    assert later.attrs["from_cache"] is True
+    assert not [p for p in entry.iterdir() if p.name.startswith(".")]     # no temporaries left
