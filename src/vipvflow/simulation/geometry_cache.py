@@ -116,11 +116,20 @@ def keep(data_dir, key: str, geometry_path: Path, horizon_path: Path) -> None:
 def _place(src: Path, dest: Path) -> None:
     """*src* at *dest*: a hard link where both lie on one file system (the files are never
     written again in place: every writer renames a new file over the old), else a copy;
-    under a temporary name, renamed."""
+    under a temporary name, renamed, its time of change set to now (the file is placed by
+    this run: a run folder's files are never older than the run).  A failed copy names
+    *dest* (a full or read-only disk is the destination's); a missing *src* raises
+    FileNotFoundError."""
     with atomic_path(dest) as tmp:
         try:
             os.link(src, tmp)
-        except OSError as exc:
-            if isinstance(exc, FileNotFoundError):
+        except FileNotFoundError:
+            raise
+        except OSError:
+            try:
+                shutil.copyfile(src, tmp)
+            except FileNotFoundError:
                 raise
-            shutil.copyfile(src, tmp)
+            except OSError as exc:
+                raise OSError(exc.errno, exc.strerror, str(dest)) from None
+        os.utime(tmp)
