@@ -252,7 +252,7 @@ def _cached_figures(c: dict, kernel: list, summary: dict) -> dict:
     """A second run's figures (``geometry_cached``: its tiles' geometry from the data dir's
     cache): wall and map time, passes per second and their ratio to the bare kernel's best,
     the geometry's worker-s, the tiles taken from the cache, peak RSS, and whether its
-    summary.json equals the first run's (the run's timings and paths aside)."""
+    summary.json equals the first run's (as ``line_year`` compares its runs')."""
     m = c["manifest"]
     passes = m["passes_computed"]
     k_pps = max(k["passes"] / k["wall_s"] for k in kernel)
@@ -264,23 +264,7 @@ def _cached_figures(c: dict, kernel: list, summary: dict) -> dict:
         "worker_geometry_s": round(stage_split(m)["geometry_s"], 1),
         "tiles_from_cache": m["partition_counts"].get("geometry_tiles_from_cache", 0),
         "peak_rss_gb": round(c["peak_rss_mb"] / 1024, 3),
-        "summary_equal": _same_summary(summary, later)}}
-
-
-def _same_summary(a: dict, b: dict) -> bool:
-    """Whether two runs' summary.json agree in every figure (timings, paths and the run's
-    identity aside)."""
-    skip = ("timing", "run_id", "created", "elapsed", "wall", "run_dir", "path")
-
-    def flat(d, p=""):
-        out = {}
-        for k, v in d.items():
-            if isinstance(v, dict):
-                out.update(flat(v, f"{p}{k}."))
-            elif not any(s in f"{p}{k}" for s in skip):
-                out[f"{p}{k}"] = v
-        return out
-    return flat(a) == flat(b)
+        "summary_equal": summary == later}}
 
 
 def outside_cluster_peak_rss(scheduler: str) -> dict:

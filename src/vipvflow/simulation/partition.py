@@ -178,7 +178,9 @@ def tile_geometry(ctx: RunContext, tile: str) -> pd.DataFrame:
     path = RunDir(ctx.run_dir).tile_part("geometry", tile)
     hpath = RunDir(ctx.run_dir).tile_part("horizon", tile)
     key, cached = None, False
-    if not path.exists():
+    if path.exists():                   # this run's own (resumed)
+        geom = read_geometry(path)
+    else:
         seg = _segments(ctx.data_dir)
         seg = seg[seg["tile"] == tile]
         if ctx.shapes is not None:
@@ -188,12 +190,12 @@ def tile_geometry(ctx: RunContext, tile: str) -> pd.DataFrame:
         key = geometry_cache.tile_key(ctx.data_dir, tile, seg, geometry_settings(ctx),
                                       tile in modelled_tiles(ctx.data_dir))
         cached = geometry_cache.fetch(ctx.data_dir, key, path, hpath)
-        if not cached:
+        if cached:
+            geom = read_geometry(path)
+        else:
             geom = segment_geometry(_scene(ctx, tile), seg, IrradianceCfg(**ctx.irradiance),
                                     **street_options(ctx))
             write_parquet(geometry_table(geom), path)
-    if path.exists() and (key is None or cached):
-        geom = read_geometry(path)
     if not hpath.exists():
         profile = geom.attrs.get("horizon_profile")         # computed with the geometry (perez_svf)
         if profile is None or len(profile) != len(geom):
