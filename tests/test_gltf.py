@@ -78,6 +78,8 @@ def test_export_gltf_from_another_directory(small_run, tmp_path, monkeypatch, ca
         xy = scene.geometry[name].vertices[:, :2] + origin[:2]
         centre = xy.mean(axis=0)
         assert (centre > lo - 50).all() and (centre < hi + 50).all()
+        # each building in its one colour, every vertex of it (COLOR_0 in the file)
+        assert (scene.geometry[name].visual.vertex_colors == [205, 200, 190, 255]).all()
 
 
 def test_export_gltf_of_a_folder_that_is_no_run_says_so(tmp_path, capsys):

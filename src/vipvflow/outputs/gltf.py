@@ -117,7 +117,10 @@ def city_scene(run_dir, data_dir, column: str = "kwh_per_kwp_year"):
         tri = corners[order[bounds[k]:bounds[k + 1]]] - origin
         mesh = trimesh.Trimesh(vertices=tri.reshape(-1, 3), faces=np.arange(3 * len(tri)).reshape(-1, 3),
                                process=False, metadata={"building_id": str(bid)})
-        mesh.visual.face_colors = _BUILDING_RGBA
+        # one colour per vertex, as glTF stores it: given per face, trimesh's export turned
+        # each mesh's face colours into vertex colours (sparse sums), half of the export's
+        # time; the file is the same to the byte
+        mesh.visual.vertex_colors = np.broadcast_to(_BUILDING_RGBA, (3 * len(tri), 4))
         scene.add_geometry(mesh, geom_name=f"building {bid}", node_name=f"building {bid}",
                            parent_node_name="city")
     values = seg[column].to_numpy(float)
