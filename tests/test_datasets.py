@@ -37,6 +37,10 @@ def test_the_run_writes_both_datasets_with_spatial_partitions(small_run):
         meta = pq.read_schema(next((run / "geoparquet" / name).glob("part.*.parquet"))).metadata
         columns = json.loads(meta[b"vipvflow:columns"])
         assert columns["kwh_per_kwp_year" if name == "segments" else "h_total"]["unit"]
+        # a part read with geopandas: the single file's columns and dtypes (strings included)
+        part = gpd.read_parquet(next((run / "geoparquet" / name).glob("part.*.parquet")))
+        single = gpd.read_parquet(run / f"{name}.parquet")
+        assert part.dtypes.astype(str).to_dict() == single.dtypes.astype(str).to_dict()
 
 
 def test_partitions_are_whole_tiles_in_their_boxes(small_run, tmp_path):
