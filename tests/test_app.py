@@ -103,10 +103,10 @@ def test_trip_model_components_equal_the_runs(trip_model, small_run):
 @pytest.mark.parametrize("mode", ["paper", "pvlib"])
 def test_trip_shading_loss_is_the_runs_definition_in_both_pv_models(trip_model, small_run, mode):
     """The app's shading loss of a trip is the run's: 1 - (direct + diffuse) / unshaded light
-    on the roof (models.irradiance.shading_loss on irradiation), whatever the PV model; the
+    on the roof (models.loss.shading_loss on irradiation), whatever the PV model; the
     run (paper mode, linear) gives the same from its trip's energies."""
     from vipvflow.app.model import PVChoice
-    from vipvflow.models.irradiance import shading_loss
+    from vipvflow.models.loss import shading_loss
 
     res, date = _midday_trip(trip_model)
     r = trip_model.routes().iloc[0]

@@ -43,7 +43,7 @@ import numpy as np
 import pandas as pd
 
 from ..config import Config, PVSystem
-from ..models.irradiance import shading_loss
+from ..models.loss import shading_loss
 from ..store import DataDir, RunDir
 
 #: PV technologies offered: PVWatts temperature coefficient of power (1/K, typical datasheet
@@ -129,7 +129,7 @@ class TripResult:
     ``soc_pv``, ``pv_kwh_cum``, ``battery_kwh_cum``); ``numbers``: ``pv_kwh``,
     ``pv_kwh_unshaded``, ``consumption_kwh``, ``share``, Wh/m2 of light on the roof
     ``h_direct, h_diffuse, h_reflected, h_total, h_unshaded``, ``shading_loss`` (on that
-    light, :func:`vipvflow.models.irradiance.shading_loss`; NaN when the sun is down),
+    light, :func:`vipvflow.models.loss.shading_loss`; NaN when the sun is down),
     ``sun_up``, ``stops``, ``stop_s``, ``stop_pv_kwh``, ``soc_end``, ``soc_end_pv``,
     ``distance_km``, ``duration_min``, ``compute_s``.
     """

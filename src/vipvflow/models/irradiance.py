@@ -31,7 +31,7 @@ The paper's model (sections 3.2.1 to 3.2.3), extended for streets:
   84 point-instants, and within 20 % for other seeds (docs/reflection_sampling.md).
 
 :func:`roof_components` is the one place the components are summed (the simulation and the
-web app call it); :func:`shading_loss` the one shading-loss formula.
+web app call it); :func:`vipvflow.models.loss.shading_loss` the one shading-loss formula.
 
 Roof plane: tilt ``beta = atan(|gradient|)``, facing downhill (a bus climbing tilts its roof
 backwards), azimuth from the heading.  All angles in degrees at the interfaces, azimuths
@@ -112,7 +112,7 @@ def roof_components(dni_wm2, dhi_wm2, ghi_wm2, cos_aoi, sun_visible, sky_view,
     direct_wm2, diffuse_wm2, reflected_wm2, unshaded_wm2 : (n,) arrays, W/m2; unshaded is
     the open-field plane-of-array irradiance ``DNI cos AOI + E_sky`` (no buildings, no
     ground reflection; ``E_sky = DHI (1 + cos tilt) / 2``, or pvlib's Perez sky diffuse under
-    the Perez sky), the reference of :func:`shading_loss`.
+    the Perez sky), the reference of :func:`~vipvflow.models.loss.shading_loss`.
 
     Notes
     -----
@@ -166,26 +166,6 @@ def roof_components(dni_wm2, dhi_wm2, ghi_wm2, cos_aoi, sun_visible, sky_view,
         unshaded = beam_on_roof + np.maximum(dhi_wm2 * (iso * isotropic_view + f2 * sky["sin_tilt"])
                                              + circ_on_roof, f32(0))
     return direct, diffuse, reflected, unshaded
-
-
-def shading_loss(direct, diffuse, unshaded):
-    """Share of the open-field light the buildings take away: ``1 - (direct + diffuse) /
-    unshaded`` (sun and sky both count; the light the buildings reflect onto the roof is
-    reported apart, as a gain).  Irradiances, irradiations or energies alike (same unit in
-    all three); NaN where nothing was received unshaded.  Arrays, pandas Series or floats.
-
-    References
-    ----------
-    The definition in README.md and docs/physics.md: the sun and sky light the buildings
-    take away; their reflections are reported apart.
-    """
-    shaded = direct + diffuse
-    if hasattr(unshaded, "where"):
-        return 1.0 - shaded / unshaded.where(unshaded > 0)
-    u = np.asarray(unshaded, np.float64)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        out = np.where(u > 0, 1.0 - np.asarray(shaded, np.float64) / np.where(u > 0, u, 1.0), np.nan)
-    return out[()] if out.ndim == 0 else out
 
 
 #: reflectors weighing less than this at the roof (weight x cos of the sun on them) are

@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ..models.irradiance import shading_loss
+from ..models.loss import shading_loss
 from ..simulation.dictionary import SUMMARY, render_html
 from ..store import RunDir, write_bytes, write_text
 

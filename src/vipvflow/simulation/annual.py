@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ..models.irradiance import shading_loss
+from ..models.loss import shading_loss
 from ..store import DataDir
 
 #: geometry factors of ``parts/geometry`` that a map reader needs (the rest is the irradiance

@@ -51,8 +51,6 @@ def ensure_demo(cfg: Config, year: int, say=print) -> None:
     rewriting the demo under a finished run of that other year."""
     if not cfg.demo.enabled:
         return
-    from ..demo import generate_demo
-
     inputs = [*cfg.inputs.citygml, cfg.inputs.gtfs, *cfg.inputs.cams]
     folder = Path(cfg.inputs.gtfs).parent
     marker = folder / DEMO_MARKER
@@ -68,6 +66,8 @@ def ensure_demo(cfg: Config, year: int, say=print) -> None:
             say(f"the demo inputs in {folder} are for {made['year']} (new ones: vipvflow "
                 f"demo-data --out {folder} --year {year})")
             return
+    from ..demo import generate_demo        # pvlib, scipy, shapely: only when the demo is made
+
     say(f"generating the demo scenario ({cfg.demo.size}, seed {cfg.demo.seed}) for {year} in {folder}")
     generate_demo(folder, year=year, seed=cfg.demo.seed, size=cfg.demo.size)
     _stamp(marker, want)
@@ -145,11 +145,8 @@ def ensure_ingested(cfg: Config, say=print, inputs=None):
     """Ingest city, GTFS and CAMS inputs into ``cfg.data_dir`` unless already done from the
     same file contents and settings (each folder's ``.inputs.json`` records the SHA-256 of
     its files). Returns the inputs' :class:`~vipvflow.simulation.manifest.InputDigests`
-    (computed when *inputs* is not given)."""
-    from ..inputs.cams import ingest_cams
-    from ..inputs.city import ingest_city
-    from ..inputs.gtfs import ingest_gtfs
-
+    (computed when *inputs* is not given).  Each reader is loaded only when its folder is
+    ingested: the city's loads trimesh and Embree, which a run's own process needs not."""
     if inputs is None:
         inputs = input_digests(cfg)
     data_dir = Path(cfg.data_dir)
@@ -161,6 +158,8 @@ def ensure_ingested(cfg: Config, say=print, inputs=None):
     data = DataDir(data_dir)
     stamp = data.city.stamp
     if city_files and not _cached(stamp, fps["city"]):
+        from ..inputs.city import ingest_city
+
         say(f"ingesting {len(city_files)} CityGML file(s)"
             + (f" and {len(tree_files)} tree table(s)" if tree_files else ""))
         report = ingest_city(city_files, data_dir, cfg.city, crs=cfg.inputs.citygml_crs,
@@ -174,6 +173,7 @@ def ensure_ingested(cfg: Config, say=print, inputs=None):
     if not _cached(stamp, fps["radiation"]):
         say(f"ingesting {len(cams_files)} CAMS file(s)")
         from ..commands.ingest_cams import findings
+        from ..inputs.cams import ingest_cams
 
         report = ingest_cams(cams_files, data_dir, accept=cfg.checks.accept)
         for line in findings(report):
@@ -184,6 +184,7 @@ def ensure_ingested(cfg: Config, say=print, inputs=None):
     stamp = data.gtfs.stamp
     if not _cached(stamp, fps["gtfs"]):
         from ..commands.ingest_gtfs import findings, summary_lines
+        from ..inputs.gtfs import ingest_gtfs
 
         say(f"ingesting GTFS feed {gtfs}")
         report = ingest_gtfs(gtfs, data_dir, cfg.trajectory, crs=cfg.inputs.citygml_crs,

@@ -21,7 +21,7 @@ import pyarrow.parquet as pq
 
 from ..config import Config
 from ..errors import InputError
-from ..models.irradiance import shading_loss
+from ..models.loss import shading_loss
 from ..store import (HOURLY_METADATA, ROW_GROUP_ROWS, DataDir, PartSchemaError, RunDir, write_json,
                      write_parquet, write_parquet_parts)
 from .partition import hand_back_memory
