@@ -155,6 +155,44 @@ def test_several_locations_nearest(cams, tmp_path):
     assert a < b        # the same minute, the sun higher in Luxembourg than in Denmark
 
 
+def test_a_loaded_table_takes_its_sun_and_perez_coefficients_from_the_cache(cams, tmp_path):
+    """The sun vectors and the Perez coefficients are computed once, kept beside the
+    radiation file, and read back by every later load (a run's workers): the same values to
+    the bit as computed, without loading pvlib; a cache of an older version (no
+    coefficients) is written again."""
+    import subprocess
+    import sys
+
+    from vipvflow.models.sun_sky import PEREZ_COLUMNS, _perez
+    from vipvflow.store import DataDir
+
+    src = cams / "cams_radiation_1min_verbose.csv"
+    ingest_cams([src], tmp_path)
+    first = RadiationTable.load(tmp_path, 2020)
+    cache, = DataDir(tmp_path).radiation.root.glob("sun_*.npz")
+    grid = first.t0 + first.step_s * np.arange(first.n)
+    computed = _perez(grid, first.data, first.data["sun_z"])
+    with np.load(cache) as z:
+        assert set(PEREZ_COLUMNS) <= set(z.files)
+    again = RadiationTable.load(tmp_path, 2020)
+    for c in PEREZ_COLUMNS:
+        assert np.array_equal(again.data[c], computed[c], equal_nan=True), c
+        assert np.array_equal(first.data[c], computed[c], equal_nan=True), c
+    code = ("import sys\n"
+            "from vipvflow.models.sun_sky import RadiationTable\n"
+            f"RadiationTable.load({str(tmp_path)!r}, 2020)\n"
+            "assert 'pvlib' not in sys.modules, 'pvlib loaded with the cache in place'\n")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    # a cache without the coefficients (written before them) is replaced
+    with np.load(cache) as z:
+        np.savez(cache, sun=z["sun"], key=z["key"])
+    again = RadiationTable.load(tmp_path, 2020)
+    assert np.array_equal(again.data["f1"], computed["f1"], equal_nan=True)
+    with np.load(cache) as z:
+        assert set(PEREZ_COLUMNS) <= set(z.files)
+
+
 def test_npz_member_maps_an_uncompressed_array(tmp_path):
     """npz_member: where np.savez put an array, for np.memmap; None for a compressed one."""
     from vipvflow.store import npz_member, write_npz

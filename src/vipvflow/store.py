@@ -126,8 +126,8 @@ class RadiationDir(_Ingested):
     table = _Entry("radiation.parquet")
 
     def sun_cache(self, first_s: int, n: int) -> Path:
-        """Sun vectors of the table's grid from *first_s* (Unix s), *n* steps, kept for the
-        workers of a run (:func:`vipvflow.models.sun_sky._cached_sun`)."""
+        """Sun vectors and Perez coefficients of the table's grid from *first_s* (Unix s), *n*
+        steps, kept for the workers of a run (:func:`vipvflow.models.sun_sky._cached_sun`)."""
         return self.root / f"sun_{first_s}_{n}.npz"
 
     def sky_cache(self, first_s: int, n: int) -> Path:

@@ -56,11 +56,28 @@ def sun_vectors(t_utc, lat, lon, altitude, step_s: float = 300.0) -> np.ndarray:
     return sun / np.sqrt((sun ** 2).sum(axis=0))
 
 
-def _cached_sun(path: Path, grid, lat, lon, alt) -> np.ndarray:
-    """:func:`sun_vectors` for a radiation file's grid, kept beside the file
-    (``sun_<first>_<n>.npz``) so each worker of a run loads it instead of running SPA; the
-    cache names the radiation file's size and time, the grid and the locations it is for,
-    and is rewritten when any differ (or ignored where the folder is read-only)."""
+#: the Perez sky's coefficients a radiation table holds per time step, all-sky and clear-sky
+#: (:func:`vipvflow.models.sky.perez_table`)
+PEREZ_COLUMNS = ("f1", "f2", "f1_clear", "f2_clear")
+
+
+def _perez(t_utc, values: dict, sun_z) -> dict:
+    """The Perez coefficients (:data:`PEREZ_COLUMNS`) of *values*' DHI and DNI (all-sky and
+    clear-sky, (K, N)) on the grid *t_utc* with the sun's up component *sun_z*."""
+    out = {}
+    for sfx in ("", "_clear"):
+        out["f1" + sfx], out["f2" + sfx] = perez_table(t_utc, values["dhi" + sfx], values["dni" + sfx], sun_z)
+    return out
+
+
+def _cached_sun(path: Path, grid, lat, lon, alt, values: dict) -> tuple[np.ndarray, dict]:
+    """:func:`sun_vectors` and the Perez coefficients (:func:`_perez` of *values*, the
+    table's (K, N) columns) for a radiation file's grid, kept beside the file
+    (``sun_<first>_<n>.npz``) so each worker of a run loads them instead of running SPA and
+    pvlib's airmass (a worker then never loads pvlib: ~20 MB of its memory); the cache names
+    the radiation file's size and time, the grid and the locations it is for, and is
+    rewritten when any differ or a member is missing (or ignored where the folder is
+    read-only)."""
     st = path.stat()
     key = json.dumps([st.st_size, st.st_mtime_ns, float(grid[0]), float(grid[-1]), len(grid),
                       np.round(lat, 8).tolist(), np.round(lon, 8).tolist(), np.round(alt, 3).tolist()])
@@ -68,15 +85,16 @@ def _cached_sun(path: Path, grid, lat, lon, alt) -> np.ndarray:
     try:
         with np.load(cache) as z:
             if str(z["key"]) == key:
-                return z["sun"]
+                return z["sun"], {c: z[c] for c in PEREZ_COLUMNS}
     except (OSError, KeyError, ValueError):
         pass
     sun = sun_vectors(grid, lat, lon, alt)
+    perez = _perez(grid, values, sun[2])
     try:
-        write_npz(cache, sun=sun, key=np.array(key))
+        write_npz(cache, sun=sun, key=np.array(key), **perez)
     except OSError:
         pass
-    return sun
+    return sun, perez
 
 
 def _sky_tables(grid_t0: float, n_steps: int, table: "RadiationTable", k: int) -> dict:
@@ -204,7 +222,7 @@ class RadiationTable:
 
     @classmethod
     def from_grid(cls, t_utc, values: dict, lat, lon, altitude=0.0, sun_step_s: float = 300.0,
-                  sun: np.ndarray | None = None):
+                  sun: np.ndarray | None = None, perez: dict | None = None):
         """Build from arrays on a regular grid; computes the sun position once.
 
         Parameters
@@ -217,6 +235,9 @@ class RadiationTable:
             interpolated (chord error below 1e-4 degrees for 5 min).
         sun : (3, K, N) float32, optional
             The unit sun vectors of an earlier call on the same grid (see :meth:`load`).
+        perez : dict of (K, N) float32, optional
+            The Perez coefficients (:data:`PEREZ_COLUMNS`) of an earlier call on the same
+            grid and values (see :meth:`load`).
         """
         t = np.asarray(t_utc, dtype=np.float64)
         lat = np.atleast_1d(np.asarray(lat, np.float64))
@@ -236,9 +257,7 @@ class RadiationTable:
             data[name] = sun[j]
         # the Perez sky's circumsolar and horizon coefficients of every time step, all-sky
         # and clear-sky (models.sky): looked up per pass like the radiation
-        for sfx in ("", "_clear"):
-            data["f1" + sfx], data["f2" + sfx] = perez_table(
-                t, data["dhi" + sfx], data["dni" + sfx], data["sun_z"])
+        data.update(perez if perez is not None else _perez(t, data, data["sun_z"]))
         return cls(t0=float(t[0]), step_s=step, data=data, lat=lat, lon=lon)
 
     @classmethod
@@ -275,8 +294,8 @@ class RadiationTable:
             log.warning("%s: %.1f %% of %d's minute grid has no radiation (NaN)", path,
                         100 * (1 - covered), year)
         alts = np.array(alts)
-        sun = _cached_sun(path, grid, locs[:, 0], locs[:, 1], alts)
-        out = cls.from_grid(grid, values, locs[:, 0], locs[:, 1], alts, sun=sun)
+        sun, perez = _cached_sun(path, grid, locs[:, 0], locs[:, 1], alts, values)
+        out = cls.from_grid(grid, values, locs[:, 0], locs[:, 1], alts, sun=sun, perez=perez)
         out.__dict__["_source"] = str(path)            # where the sky tables are cached
         return out
 
