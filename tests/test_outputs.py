@@ -4,6 +4,7 @@ site figures, and the report (its table, inputs, CRS and maps over the building 
 from __future__ import annotations
 
 import json
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -166,6 +167,10 @@ def test_site_ghi_is_the_year_of_minutes(tmp_path):
     assert site_ghi_kwh_m2(tmp_path / "full", 2024) == pytest.approx(878.4, rel=1e-9)
     _radiation(tmp_path / "gappy", minutes[: int(0.98 * len(minutes))], 100.0)
     assert site_ghi_kwh_m2(tmp_path / "gappy", 2024) is None
+    # kept for the file as it was: a file written again is read again
+    shutil.rmtree(tmp_path / "full")
+    _radiation(tmp_path / "full", minutes, 50.0)
+    assert site_ghi_kwh_m2(tmp_path / "full", 2024) == pytest.approx(439.2, rel=1e-9)
 
 
 def test_footprints_are_the_city_ground_surfaces(small_config):
@@ -277,10 +282,14 @@ def test_app_map_draws_the_same_footprints(small_run):
 
 def test_the_report_module_leaves_matplotlib_to_where_figures_are_drawn():
     """The command's process loads the report module for the reduce; a run's workers draw
-    the figures, so matplotlib is loaded there (and by the first figure drawn here) only."""
+    the figures, so matplotlib is loaded there (and by the first figure drawn here) only.
+    Nor does the reduce load the ray tracing's modules (Embree, trimesh, numba: ~110 MB of
+    the command's process through the whole run)."""
     code = ("import sys\n"
             "import vipvflow.simulation.reduce, vipvflow.simulation.run, vipvflow.outputs.report as r\n"
             "assert 'matplotlib' not in sys.modules, 'matplotlib loaded by an import'\n"
+            "loaded = {'numba', 'embreex', 'trimesh', 'vipvflow.models.irradiance'} & set(sys.modules)\n"
+            "assert not loaded, loaded\n"
             "assert r._loaded() and 'matplotlib.pyplot' in sys.modules\n")
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert done.returncode == 0, done.stderr

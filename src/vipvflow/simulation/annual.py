@@ -12,6 +12,7 @@ a figure of one place or one bus. Here they become:
 """
 from __future__ import annotations
 
+import functools
 from pathlib import Path
 
 import numpy as np
@@ -79,12 +80,25 @@ def site_ghi_kwh_m2(data_dir: Path, year: int, min_coverage: float = 0.99) -> fl
     are less than *min_coverage* present (the year is then not known, not guessed).
 
     Each value is the mean over its minute (CAMS), so the year is the sum of the minutes x
-    60 s; the few missing minutes of a covered year are filled with the year's mean."""
-    import pyarrow.parquet as pq
+    60 s; the few missing minutes of a covered year are filled with the year's mean.
 
+    Kept per file (its path, size and time) and year: a run computes it while its cluster
+    starts (:func:`vipvflow.simulation.run._warm_radiation`), where reading the year's
+    minutes (~0.1 GB of the process for a moment) does not add to the workers' memory as it
+    did in the reduce."""
     path = DataDir(data_dir).radiation.table
     if not path.is_file():
         return None
+    st = path.stat()
+    return _site_ghi(str(path), st.st_size, st.st_mtime_ns, year, min_coverage)
+
+
+@functools.lru_cache(maxsize=8)
+def _site_ghi(path: str, size: int, mtime_ns: int, year: int, min_coverage: float) -> float | None:
+    """:func:`site_ghi_kwh_m2` of the radiation file *path* (*size* and *mtime_ns* name its
+    version)."""
+    import pyarrow.parquet as pq
+
     lo = int(pd.Timestamp(f"{year}-01-01", tz="UTC").timestamp())
     hi = int(pd.Timestamp(f"{year + 1}-01-01", tz="UTC").timestamp())
     table = pq.read_table(path, columns=["t_utc", "ghi", "lat", "lon"],

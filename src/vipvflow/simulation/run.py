@@ -331,14 +331,19 @@ class _Starting(_Background):
 
 def _warm_radiation(data_dir: str, year: int, sky: bool = False) -> None:
     """Load the radiation table once in this process (writes its sun-position cache, and
-    with *sky* the Perez sky's tables); a failure is left for the workers to report with
-    the file named."""
+    with *sky* the Perez sky's tables), and compute the site's irradiation of the year the
+    summary gives (kept by :func:`vipvflow.simulation.annual.site_ghi_kwh_m2`: its read,
+    done here before the workers hold their memory, not in the reduce beside them); a
+    failure is left for the workers and the reduce to report with the file named."""
     from ..models.sun_sky import RadiationTable
+    from .annual import site_ghi_kwh_m2
 
     try:
         table = RadiationTable.load(data_dir, year)
         if sky:
             table.sky_index()           # computes and keeps the sky's tables where there are none
+        del table
+        site_ghi_kwh_m2(data_dir, year)
     except Exception:  # noqa: BLE001 - the same load fails again in the tasks, with its message
         pass
 
