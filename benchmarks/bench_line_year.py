@@ -107,6 +107,7 @@ def run(tiny: bool = False) -> dict:
     every = min((e for _, _, e in rounds), key=lambda e: e["wall_s"])
     kernel = min(k["wall_s"] for k, _ in pairs)
     r = min((line for _, line in pairs), key=lambda line: line["wall_s"])
+    top = max((line for _, line in pairs), key=lambda line: line["peak_rss_mb"])
     m = r["manifest"]
     passes = m["passes_computed"]
     builds = m["bvh_builds_per_worker"]
@@ -148,6 +149,12 @@ def run(tiny: bool = False) -> dict:
         "geometry_cached_equal": _same_outputs(rounds[0][1]["outputs"], cached["outputs"]),
         "peak_rss_gb": round(max(line["peak_rss_mb"] for _, line in pairs) / 1024, 3),
         "peak_rss_main_gb": round(max(line["peak_rss_main_mb"] for _, line in pairs) / 1024, 3),
+        # the highest run's peak: each process's RSS then (MB, largest first: this process,
+        # the workers, the forkserver they were forked from, multiprocessing's resource
+        # tracker, in some order), when (s after the run's start) and the run's last line before it
+        "rss_at_peak_by_process_mb": top["rss_at_peak_by_process_mb"],
+        "peak_at_s": top["peak_at_s"],
+        "peak_after_line": top["peak_after_line"],
         # the same peak counting each shared page once (PeakRSS: the workers share the
         # forkserver's imported libraries): the memory the run takes from the machine
         "peak_pss_gb": round(max(line["peak_pss_mb"] for _, line in pairs) / 1024, 3),

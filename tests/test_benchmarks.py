@@ -70,6 +70,10 @@ def test_facts_in_the_tiny_results(tiny_results):
     assert net["peak_after_line"]
     line = json.loads((results / "line_year.tiny.json").read_text())["figures"]
     assert line["passes"] > 0 and line["partitions"] > 0
+    # so is the line-year's (its highest run's)
+    assert abs(sum(line["rss_at_peak_by_process_mb"]) - line["peak_rss_gb"] * 1024) <= len(
+        line["rss_at_peak_by_process_mb"]) + 2
+    assert line["peak_after_line"] and line["peak_at_s"] > 0
     # the sun masks spare rays and change no result (the all-rays leg of the same round)
     assert line["masks_equal_all_rays"] is True
     assert line["sun_rays_masked"] > 0 and line["sun_rays_cast"] > 0

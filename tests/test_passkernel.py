@@ -175,6 +175,13 @@ def test_fused_sums_of_passes_in_chunks_are_those_of_all_at_once(small_run, smal
         want = part.partition_tables(None, None, 6, ctx, groups=groups, bins=bins)
         for a, b in zip(want, got):
             assert a.equals(b), tile
+        # and the kernel's own batches of rays, a few hundred passes each
+        with pytest.MonkeyPatch.context() as mp:
+            mp.setattr(passkernel, "RAY_BUDGET", 4096)
+            groups, bins, _ = part._fused_sums(ctx, tile, [passes], geometry, {})
+        batched = part.partition_tables(None, None, 6, ctx, groups=groups, bins=bins)
+        for a, b in zip(want, batched):
+            assert a.equals(b), tile
     assert most >= 5
 
 
