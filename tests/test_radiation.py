@@ -193,6 +193,48 @@ def test_a_loaded_table_takes_its_sun_and_perez_coefficients_from_the_cache(cams
         assert set(PEREZ_COLUMNS) <= set(z.files)
 
 
+def test_the_radiation_caches_are_computed_again_by_another_version_of_the_code(cams, tmp_path,
+                                                                               monkeypatch):
+    """The sun vectors, the Perez coefficients and the sky tables kept beside the radiation
+    file name the code and the libraries that computed them (code_digest): another version
+    writes them again instead of reading values an older one computed."""
+    from vipvflow import models
+    from vipvflow.models import sun_sky
+    from vipvflow.store import DataDir
+
+    ingest_cams([cams / "cams_radiation_1min_verbose.csv"], tmp_path)
+    first = RadiationTable.load(tmp_path, 2020)
+    sky = first.sky()
+    radiation = DataDir(tmp_path).radiation.root
+    (sun_file,), (sky_file,) = radiation.glob("sun_*.npz"), radiation.glob("sky_*.npz")
+
+    def key(path):
+        with np.load(path) as z:
+            return str(z["key"])
+
+    assert models.code_digest() in key(sun_file) and models.code_digest() in key(sky_file)
+    # the same version reads them as they are
+    before = {p: p.stat().st_mtime_ns for p in (sun_file, sky_file)}
+    RadiationTable.load(tmp_path, 2020).sky()
+    assert {p: p.stat().st_mtime_ns for p in (sun_file, sky_file)} == before
+    # another version: both computed again, with its digest, to the same values
+    for path in (sun_file, sky_file):
+        with np.load(path) as z:
+            members = {k: z[k] for k in z.files}
+        members = {k: (v if k == "key" or v.dtype.kind != "f" else np.zeros_like(v))
+                   for k, v in members.items()}
+        np.savez(path, **members)                 # stale values under the old key
+    monkeypatch.setattr(sun_sky, "code_digest", lambda: "another version of the physics")
+    again = RadiationTable.load(tmp_path, 2020)
+    again_sky = again.sky()
+    assert "another version of the physics" in key(sun_file)
+    assert "another version of the physics" in key(sky_file)
+    for c in ("sun_x", "sun_y", "sun_z", "f1", "f2", "f1_clear", "f2_clear"):
+        assert np.array_equal(again.data[c], first.data[c], equal_nan=True), c
+    for k in ("rows", "all", "clear", "all_open"):
+        assert np.array_equal(again_sky[k], sky[k], equal_nan=True), k
+
+
 def test_npz_member_maps_an_uncompressed_array(tmp_path):
     """npz_member: where np.savez put an array, for np.memmap; None for a compressed one."""
     from vipvflow.store import npz_member, write_npz

@@ -18,6 +18,7 @@ import pandas as pd
 from ..errors import InputError
 from ..inputs.cams import _GRID_S, COLUMNS, ingest_cams
 from ..store import DataDir, RadiationDir, npz_member, write_npz
+from . import code_digest
 from .sky import (SKY_AZIMUTH_BINS, SKY_PACK, SKY_STEP_S, open_terms, pack_sky, perez_table,
                   sky_table, unpack_sky)
 
@@ -77,10 +78,12 @@ def _cached_sun(path: Path, grid, lat, lon, alt, values: dict) -> tuple[np.ndarr
     pvlib's airmass (a worker then never loads pvlib: ~20 MB of its memory); the cache names
     the radiation file's size and time, the grid and the locations it is for, and is
     rewritten when any differ or a member is missing (or ignored where the folder is
-    read-only)."""
+    read-only). The key also names the code and the libraries that computed them
+    (:func:`vipvflow.models.code_digest`): another version of either computes them again."""
     st = path.stat()
-    key = json.dumps([st.st_size, st.st_mtime_ns, float(grid[0]), float(grid[-1]), len(grid),
-                      np.round(lat, 8).tolist(), np.round(lon, 8).tolist(), np.round(alt, 3).tolist()])
+    key = json.dumps([code_digest(), st.st_size, st.st_mtime_ns,
+                      float(grid[0]), float(grid[-1]), len(grid), np.round(lat, 8).tolist(),
+                      np.round(lon, 8).tolist(), np.round(alt, 3).tolist()])
     cache = RadiationDir(path.parent).sun_cache(int(grid[0]), len(grid))
     try:
         with np.load(cache) as z:
@@ -362,14 +365,16 @@ class RadiationTable:
 
     def _sky_key(self) -> tuple:
         """The key of :meth:`sky`'s tables (the radiation file's size and time, the grid,
-        the locations) and the file beside the radiation file that keeps them; ``(None,
-        None)`` for a table that did not come from a file."""
+        the locations, :func:`vipvflow.models.code_digest`) and the file beside the
+        radiation file that keeps them; ``(None, None)`` for a table that did not come
+        from a file."""
         path = self.__dict__.get("_source")
         if path is None:
             return None, None
         st = Path(path).stat()
-        key = json.dumps(["sky-6", st.st_size, st.st_mtime_ns, self.t0, self.n, SKY_STEP_S,
-                          np.round(self.lat, 8).tolist(), np.round(self.lon, 8).tolist()])
+        key = json.dumps(["sky-6", code_digest(), st.st_size, st.st_mtime_ns, self.t0, self.n,
+                          SKY_STEP_S, np.round(self.lat, 8).tolist(),
+                          np.round(self.lon, 8).tolist()])
         return key, RadiationDir(Path(path).parent).sky_cache(int(self.t0), self.n)
 
     def sky_index(self) -> dict:

@@ -23,33 +23,12 @@ import hashlib
 import json
 import os
 import shutil
-from functools import lru_cache
-from importlib import metadata
 from pathlib import Path
 
 import pandas as pd
 
+from ..models import code_digest
 from ..store import GEOMETRY_CACHE_FILES, DataDir, atomic_path
-#: the libraries whose arithmetic the geometry's values depend on
-_LIBRARIES = ("numpy", "numba", "embreex", "trimesh", "pandas", "pyarrow")
-
-
-@lru_cache(maxsize=1)
-def code_digest() -> str:
-    """SHA-256 of the source of :mod:`vipvflow.models` (every module, by its relative path)
-    and of the versions of :data:`_LIBRARIES`."""
-    from .. import models
-
-    root = Path(models.__file__).parent
-    h = hashlib.sha256()
-    for path in sorted(root.rglob("*.py")):
-        h.update(path.relative_to(root).as_posix().encode() + b"\0" + path.read_bytes() + b"\0")
-    for name in _LIBRARIES:
-        try:
-            h.update(f"{name}={metadata.version(name)}\0".encode())
-        except metadata.PackageNotFoundError:
-            h.update(f"{name}=\0".encode())
-    return h.hexdigest()
 
 
 def _file_digest(path: Path) -> bytes:
