@@ -155,11 +155,11 @@ def test_several_locations_nearest(cams, tmp_path):
     assert a < b        # the same minute, the sun higher in Luxembourg than in Denmark
 
 
-def test_a_loaded_table_takes_its_sun_and_perez_coefficients_from_the_cache(cams, tmp_path):
-    """The sun vectors and the Perez coefficients are computed once, kept beside the
-    radiation file, and read back by every later load (a run's workers): the same values to
-    the bit as computed, without loading pvlib; a cache of an older version (no
-    coefficients) is written again."""
+def test_a_loaded_table_is_read_from_its_cache_with_its_sun_and_perez_coefficients(cams, tmp_path):
+    """The table of a year on its minute grid, its sun vectors and its Perez coefficients
+    are computed once, kept beside the radiation file, and read back by every later load (a
+    run's workers): the same values to the bit as computed, without reading the Parquet
+    file or loading pvlib; a cache missing a member is written again."""
     import subprocess
     import sys
 
@@ -169,24 +169,30 @@ def test_a_loaded_table_takes_its_sun_and_perez_coefficients_from_the_cache(cams
     src = cams / "cams_radiation_1min_verbose.csv"
     ingest_cams([src], tmp_path)
     first = RadiationTable.load(tmp_path, 2020)
-    cache, = DataDir(tmp_path).radiation.root.glob("sun_*.npz")
+    cache, = DataDir(tmp_path).radiation.root.glob("table_*.npz")
+    assert cache == DataDir(tmp_path).radiation.table_cache(2020)
     grid = first.t0 + first.step_s * np.arange(first.n)
     computed = _perez(grid, first.data, first.data["sun_z"])
     with np.load(cache) as z:
         assert set(PEREZ_COLUMNS) <= set(z.files)
     again = RadiationTable.load(tmp_path, 2020)
+    assert (again.t0, again.step_s, again.n) == (first.t0, first.step_s, first.n)
+    assert np.array_equal(again.lat, first.lat) and np.array_equal(again.lon, first.lon)
+    assert set(again.data) == set(first.data)
+    for c in first.data:
+        assert np.array_equal(again.data[c], first.data[c], equal_nan=True), c
     for c in PEREZ_COLUMNS:
-        assert np.array_equal(again.data[c], computed[c], equal_nan=True), c
         assert np.array_equal(first.data[c], computed[c], equal_nan=True), c
     code = ("import sys\n"
             "from vipvflow.models.sun_sky import RadiationTable\n"
             f"RadiationTable.load({str(tmp_path)!r}, 2020)\n"
-            "assert 'pvlib' not in sys.modules, 'pvlib loaded with the cache in place'\n")
+            "assert 'pvlib' not in sys.modules, 'pvlib loaded with the cache in place'\n"
+            "assert 'pyarrow.parquet' not in sys.modules, 'the Parquet file read'\n")
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert done.returncode == 0, done.stderr
-    # a cache without the coefficients (written before them) is replaced
+    # a cache without the coefficients (an older version's) is replaced
     with np.load(cache) as z:
-        np.savez(cache, sun=z["sun"], key=z["key"])
+        np.savez(cache, **{k: z[k] for k in z.files if k not in PEREZ_COLUMNS})
     again = RadiationTable.load(tmp_path, 2020)
     assert np.array_equal(again.data["f1"], computed["f1"], equal_nan=True)
     with np.load(cache) as z:
@@ -206,7 +212,7 @@ def test_the_radiation_caches_are_computed_again_by_another_version_of_the_code(
     first = RadiationTable.load(tmp_path, 2020)
     sky = first.sky()
     radiation = DataDir(tmp_path).radiation.root
-    (sun_file,), (sky_file,) = radiation.glob("sun_*.npz"), radiation.glob("sky_*.npz")
+    (sun_file,), (sky_file,) = radiation.glob("table_*.npz"), radiation.glob("sky_*.npz")
 
     def key(path):
         with np.load(path) as z:

@@ -53,12 +53,12 @@ def test_every_file_of_a_run_is_one_the_store_names(small_run):
     data = DataDir(open_run(run.root).data_dir)
     named = _named_by_store(data.root, run.root)
     written = {p for root in (data.root, run.root) for p in root.rglob("*") if p.is_file()}
-    # figures, VECTO files, the datasets' partitions and the sun and sky caches are named by
+    # figures, VECTO files, the datasets' partitions and the table and sky caches are named by
     # the modules that draw or compute them, in the folders the store gives them
     datasets = {run.dataset("segments"), run.dataset("segment_month")}
     free = [p for p in written
             if run.figures in p.parents or run.vecto in p.parents or p.parent in datasets
-            or (p.parent == data.radiation.root and p.name.startswith(("sun_", "sky_")))]
+            or (p.parent == data.radiation.root and p.name.startswith(("table_", "sky_")))]
     assert all(p.suffix == ".png" for p in free if run.figures in p.parents)
     parts = [p.name for p in free if p.parent in datasets]
     assert parts and all(re.fullmatch(r"part\.\d+\.parquet", n) for n in parts), parts

@@ -125,10 +125,11 @@ class RadiationDir(_Ingested):
 
     table = _Entry("radiation.parquet")
 
-    def sun_cache(self, first_s: int, n: int) -> Path:
-        """Sun vectors and Perez coefficients of the table's grid from *first_s* (Unix s), *n*
-        steps, kept for the workers of a run (:func:`vipvflow.models.sun_sky._cached_sun`)."""
-        return self.root / f"sun_{first_s}_{n}.npz"
+    def table_cache(self, year: int) -> Path:
+        """The table of *year* on its minute grid, with its sun vectors and Perez
+        coefficients, kept for the workers of a run
+        (:meth:`vipvflow.models.sun_sky.RadiationTable.load`)."""
+        return self.root / f"table_{year}.npz"
 
     def sky_cache(self, first_s: int, n: int) -> Path:
         """The Perez sky's visible-share tables of the table's grid from *first_s* (Unix s),

@@ -71,35 +71,6 @@ def _perez(t_utc, values: dict, sun_z) -> dict:
     return out
 
 
-def _cached_sun(path: Path, grid, lat, lon, alt, values: dict) -> tuple[np.ndarray, dict]:
-    """:func:`sun_vectors` and the Perez coefficients (:func:`_perez` of *values*, the
-    table's (K, N) columns) for a radiation file's grid, kept beside the file
-    (``sun_<first>_<n>.npz``) so each worker of a run loads them instead of running SPA and
-    pvlib's airmass (a worker then never loads pvlib: ~20 MB of its memory); the cache names
-    the radiation file's size and time, the grid and the locations it is for, and is
-    rewritten when any differ or a member is missing (or ignored where the folder is
-    read-only). The key also names the code and the libraries that computed them
-    (:func:`vipvflow.models.code_digest`): another version of either computes them again."""
-    st = path.stat()
-    key = json.dumps([code_digest(), st.st_size, st.st_mtime_ns,
-                      float(grid[0]), float(grid[-1]), len(grid), np.round(lat, 8).tolist(),
-                      np.round(lon, 8).tolist(), np.round(alt, 3).tolist()])
-    cache = RadiationDir(path.parent).sun_cache(int(grid[0]), len(grid))
-    try:
-        with np.load(cache) as z:
-            if str(z["key"]) == key:
-                return z["sun"], {c: z[c] for c in PEREZ_COLUMNS}
-    except (OSError, KeyError, ValueError):
-        pass
-    sun = sun_vectors(grid, lat, lon, alt)
-    perez = _perez(grid, values, sun[2])
-    try:
-        write_npz(cache, sun=sun, key=np.array(key), **perez)
-    except OSError:
-        pass
-    return sun, perez
-
-
 def _sky_tables(grid_t0: float, n_steps: int, table: "RadiationTable", k: int) -> dict:
     """The Perez (1993) visible-sky tables of location *k* every :data:`SKY_STEP_S` from
     *grid_t0*: ``rows`` (n_steps,) int32 (-1 where the sun is more than 3 deg below the
@@ -267,6 +238,14 @@ class RadiationTable:
     def load(cls, data_dir, year: int, pad_days: float = 1.0) -> "RadiationTable":
         """Load ``radiation/radiation.parquet`` for *year* (UTC, padded by *pad_days*).
 
+        The first load of a year puts the table on its minute grid with its sun vectors and
+        Perez coefficients beside the file (``table_<year>.npz``, uncompressed); each later
+        load (a run's workers) reads them from there: no Parquet read (~0.1 GB of a
+        process's memory for a moment), no SPA and no pvlib.  The cache names the radiation
+        file's size and time, *year*, *pad_days*, and the code and libraries that computed
+        it (:func:`vipvflow.models.code_digest`), and is written again when any differ or a
+        member is missing (and not written where the folder is read-only).
+
         Raises
         ------
         InputError
@@ -275,6 +254,45 @@ class RadiationTable:
         path = DataDir(data_dir).radiation.table
         if not path.is_file():
             raise InputError(f"{path}: not found; run 'vipvflow ingest cams' first")
+        st = path.stat()
+        key = json.dumps(["table-1", code_digest(), st.st_size, st.st_mtime_ns, year, pad_days])
+        cache = RadiationDir(path.parent).table_cache(year)
+        grid = None
+        try:
+            with np.load(cache) as z:
+                if str(z["key"]) == key:
+                    t0, n = float(z["t0"]), int(z["n"])
+                    locs = np.stack([z["lat"], z["lon"], z["alt"]], 1)
+                    values = {c: z[c] for c in (*COLUMNS, *PEREZ_COLUMNS, "sun")}
+                    covered = float(z["covered"])
+                    grid = t0 + _GRID_S * np.arange(n, dtype=np.float64)
+        except (OSError, KeyError, ValueError):
+            grid = None
+        if grid is None:
+            grid, locs, values, covered = cls._grid_of(path, year, pad_days)
+            values["sun"] = sun_vectors(grid, locs[:, 0], locs[:, 1], locs[:, 2])
+            values.update(_perez(grid, values, values["sun"][2]))
+            try:
+                write_npz(cache, key=np.array(key), t0=np.float64(grid[0]), n=np.int64(len(grid)),
+                          lat=locs[:, 0], lon=locs[:, 1], alt=locs[:, 2],
+                          covered=np.float64(covered), **values)
+            except OSError:
+                pass
+        if covered < 1.0:
+            log.warning("%s: %.1f %% of %d's minute grid has no radiation (NaN)", path,
+                        100 * (1 - covered), year)
+        sun = values.pop("sun")
+        perez = {c: values.pop(c) for c in PEREZ_COLUMNS}
+        out = cls.from_grid(grid, values, locs[:, 0], locs[:, 1], locs[:, 2], sun=sun, perez=perez)
+        out.__dict__["_source"] = str(path)            # where the sky tables are cached
+        return out
+
+    @staticmethod
+    def _grid_of(path: Path, year: int, pad_days: float) -> tuple:
+        """The radiation file's rows of *year* (padded by *pad_days*) on their minute grid:
+        ``(grid, locs, values, covered)``: the grid (N,) Unix s, the locations (K, 3) lat,
+        lon, altitude, the :data:`COLUMNS` (K, N) float32 (NaN where a minute has no row)
+        and the share of the grid the GHI covers."""
         lo = pd.Timestamp(f"{year}-01-01", tz="UTC").timestamp() - pad_days * 86400
         hi = pd.Timestamp(f"{year + 1}-01-01", tz="UTC").timestamp() + pad_days * 86400
         table = pd.read_parquet(path, filters=[("t_utc", ">=", int(lo)), ("t_utc", "<", int(hi))])
@@ -292,15 +310,8 @@ class RadiationTable:
             for c in COLUMNS:
                 values[c][i, idx] = part[c].to_numpy(np.float32)
             alts.append(float(part["altitude"].iloc[0]) if "altitude" in part else 0.0)
-        covered = np.isfinite(values["ghi"]).mean()
-        if covered < 1.0:
-            log.warning("%s: %.1f %% of %d's minute grid has no radiation (NaN)", path,
-                        100 * (1 - covered), year)
-        alts = np.array(alts)
-        sun, perez = _cached_sun(path, grid, locs[:, 0], locs[:, 1], alts, values)
-        out = cls.from_grid(grid, values, locs[:, 0], locs[:, 1], alts, sun=sun, perez=perez)
-        out.__dict__["_source"] = str(path)            # where the sky tables are cached
-        return out
+        locs = np.column_stack([locs.astype(np.float64), np.array(alts, np.float64)])
+        return grid, locs, values, float(np.isfinite(values["ghi"]).mean())
 
     @classmethod
     def from_cams(cls, paths, accept=()) -> "RadiationTable":
