@@ -12,7 +12,8 @@ call:
    ray batch;
 2. Embree answers the batch (:meth:`vipvflow.models.shading.Scene.occluded_local`);
 3. with the Perez sky, :func:`_sky_terms` sums each segment's sky (and what the crowns take
-   from it) over every sky step the chunk spans (:func:`_sky_grid`) and gives each pass its own;
+   from it) over the sky steps from its first pass to its last in the chunk
+   (:func:`_sky_grid`) and gives each pass its own;
 4. :func:`_finish` sums the components per pass into the output block of
    :func:`vipvflow.models.irradiance.evaluate_passes`, or adds their
    irradiation (Wh/m2) straight into the (segment, local hour) and (trip, date) bins of a
@@ -237,18 +238,18 @@ def _level_differences(TT, s0, m, ts, segs, n_used, DT):
 
 
 @njit(cache=True, nogil=True)
-def _sky_grid(TT, s0, r, sky_cell, sky_f, sky_t, sky_tilted, nrm, ts, cls_used, DT, g):
+def _sky_grid(TT, s0, d0, m, r, sky_cell, sky_f, sky_t, sky_tilted, nrm, ts, cls_used, DT, g):
     """Segment row *r*'s Perez sky at sky steps ``s0 .. s0 + m`` (*TT*: the packed tables,
-    :func:`vipvflow.models.sky.pack_sky`) into *g* (2 + 2 C, m) float32: row 0 its share of
-    DHI all-sky, row 1 clear-sky (per sector its cell, interpolation weight and tilt
-    weight, summed in sector order: :func:`vipvflow.models.sky.sky_share`), rows ``2 + 2 c``
-    and ``3 + 2 c`` what the crowns of class *c* take from it (its sky cells with a loss,
-    ``sum loss (n_z dG + t_k dH)`` cell by cell: :func:`vipvflow.models.sky.tree_share`),
+    :func:`vipvflow.models.sky.pack_sky`) into ``g[:, :m]`` (*g*: (2 + 2 C, >= m) float32):
+    row 0 its share of DHI all-sky, row 1 clear-sky (per sector its cell, interpolation
+    weight and tilt weight, summed in sector order: :func:`vipvflow.models.sky.sky_share`),
+    rows ``2 + 2 c`` and ``3 + 2 c`` what the crowns of class *c* take from it (its sky
+    cells with a loss, ``sum loss (n_z dG + t_k dH)`` cell by cell:
+    :func:`vipvflow.models.sky.tree_share`),
     for the classes in *cls_used* (*DT*: the tables' level differences ``TT[b] - TT[b + 4]``
-    at the same steps, :func:`_level_differences`).  Each step's sum is the per-pass sum,
-    term by term in the same order; the steps side by side make every loop a run over
-    contiguous memory."""
-    m = g.shape[1]
+    from the step ``s0 - d0`` on, :func:`_level_differences`).  Each step's sum is the
+    per-pass sum, term by term in the same order; the steps side by side make every loop a
+    run over contiguous memory."""
     for q in range(g.shape[0]):
         for i in range(m):
             g[q, i] = np.float32(0.0)
@@ -271,6 +272,7 @@ def _sky_grid(TT, s0, r, sky_cell, sky_f, sky_t, sky_tilted, nrm, ts, cls_used, 
                 a[i] += nz * (ga0[i] + f * (ga1[i] - ga0[i]))
                 c[i] += nz * (gc0[i] + f * (gc1[i] - gc0[i]))
     off, cell, sector, w = ts
+    d1 = d0 + m
     for q in range(cls_used.shape[0]):
         if not cls_used[q]:
             continue
@@ -278,7 +280,7 @@ def _sky_grid(TT, s0, r, sky_cell, sky_f, sky_t, sky_tilted, nrm, ts, cls_used, 
         for e in range(off[r], off[r + 1]):
             b = SKY_PACK * cell[e]
             tk, we = sky_t[r, sector[e]], w[e, q]
-            dga, dha, dgc, dhc = DT[b], DT[b + 1], DT[b + 2], DT[b + 3]
+            dga, dha, dgc, dhc = DT[b, d0:d1], DT[b + 1, d0:d1], DT[b + 2, d0:d1], DT[b + 3, d0:d1]
             for i in range(m):
                 la[i] += we * (nz * dga[i] + tk * dha[i])
                 lc[i] += we * (nz * dgc[i] + tk * dhc[i])
@@ -347,14 +349,18 @@ def _sky_terms(lo, hi, row, rad, done, sky_cell, sky_f, sky_t, sky_tilted, TT, t
     a dark pass or where the sun is more than 3 deg down (the tables' row -1).
 
     A segment's sky depends on the pass only through the sky step (15 min) and the class:
-    the sums are made per segment over every step the chunk spans (:func:`_sky_grid`, at
-    most *budget* float32 values at a time, in blocks of segments) and each pass reads its
-    own.  Equal to the per-pass sums bit for bit; ~5x faster than them (the steps' sums run
-    side by side in vector registers)."""
+    the sums are made per segment over every step from its first pass's to its last's in
+    the chunk (:func:`_sky_grid`, at most *budget* float32 values at a time, in blocks of
+    segments) and each pass reads its own.  Equal to the per-pass sums bit for bit; ~5x
+    faster than them (the steps' sums run side by side in vector registers).  A chunk that
+    spans two days holds mostly the end of one day's segments and the start of the next
+    day's: each segment's own steps are then about half the chunk's."""
     n_seg = sky_cell.shape[0]
     C = ts[3].shape[1] if ts[1].shape[0] else 0         # classes of months, where crowns take sky
     s_lo, s_hi = np.int64(1) << 62, np.int64(-1)
     slot = np.full(n_seg, -1, np.int64)
+    first = np.empty(n_seg, np.int64)                   # a used segment's first and last step
+    last = np.empty(n_seg, np.int64)
     cls_used = np.zeros(max(C, 1), np.bool_)
     n_used = 0
     for i in range(lo, hi):
@@ -376,6 +382,9 @@ def _sky_terms(lo, hi, row, rad, done, sky_cell, sky_f, sky_t, sky_tilted, TT, t
         if slot[r] < 0:
             slot[r] = n_used
             n_used += 1
+            first[r], last[r] = rs, rs
+        else:
+            first[r], last[r] = min(first[r], rs), max(last[r], rs)
     if n_used == 0:
         return
     segs = np.empty(n_used, np.int64)
@@ -392,8 +401,9 @@ def _sky_terms(lo, hi, row, rad, done, sky_cell, sky_f, sky_t, sky_tilted, TT, t
     for b0 in range(0, n_used, per_block):
         b1 = min(n_used, b0 + per_block)
         for q in range(b0, b1):
-            _sky_grid(TT, s_lo, segs[q], sky_cell, sky_f, sky_t, sky_tilted, nrm, ts, cls_used,
-                      DT, g[q - b0])
+            r = segs[q]
+            _sky_grid(TT, first[r], first[r] - s_lo, last[r] - first[r] + 1, r, sky_cell, sky_f,
+                      sky_t, sky_tilted, nrm, ts, cls_used, DT, g[q - b0])
         for i in range(lo, hi):
             c = i - lo
             if not done[c]:
@@ -402,7 +412,7 @@ def _sky_terms(lo, hi, row, rad, done, sky_cell, sky_f, sky_t, sky_tilted, TT, t
             q = slot[row[i]]
             if rs < 0 or q < b0 or q >= b1:
                 continue
-            j = rs - s_lo
+            j = rs - first[row[i]]
             terms[c, 0] = g[q - b0, 0, j]
             terms[c, 1] = g[q - b0, 1, j]
             if C:
