@@ -295,6 +295,26 @@ def test_the_report_module_leaves_matplotlib_to_where_figures_are_drawn():
     assert done.returncode == 0, done.stderr
 
 
+def test_a_run_that_ingests_nothing_loads_no_ray_tracing_in_its_own_process(small_config):
+    """A run's own process checks its ingested folders (the city's fingerprint names the
+    mesh format) and goes on to the map: with nothing to ingest it loads neither trimesh nor
+    Embree (~55 MB of the command's process through the whole run)."""
+    from vipvflow.config import load_config
+    from vipvflow.simulation.prepare import ensure_ingested
+
+    ensure_ingested(load_config(small_config), say=lambda *a: None)
+    code = ("import sys\n"
+            "from vipvflow.config import load_config\n"
+            "from vipvflow.simulation.prepare import ensure_ingested\n"
+            "said = []\n"
+            f"ensure_ingested(load_config({str(small_config)!r}), say=said.append)\n"
+            "assert not said, said\n"
+            "loaded = {'trimesh', 'embreex', 'scipy', 'numba'} & set(sys.modules)\n"
+            "assert not loaded, loaded\n")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+
+
 def test_map_lines_and_the_close_ups_shapes():
     from shapely.geometry import LineString
 

@@ -18,12 +18,15 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
-import trimesh
 
 from ..errors import InputError
 from ..store import write_npz
+
+if TYPE_CHECKING:
+    import trimesh
 
 #: surface type codes used in ``TileMesh.surface_type``
 SURFACE_TYPES = ("roof", "wall", "ground", "closure", "terrain", "vegetation", "other")
@@ -84,6 +87,8 @@ class TileMesh:
         faces = np.asarray(triangles).reshape(-1, 3)
         m = len(faces)
         values = {k: _face_values(k, face_attributes.get(k), m) for k in FACE_ATTRIBUTES}
+        import trimesh      # here: a process that reads this module's constants never loads it
+
         self.trimesh = trimesh.Trimesh(
             vertices=np.asarray(vertices, np.float64).reshape(-1, 3), faces=faces,
             face_attributes=values, process=False, validate=False,
@@ -156,6 +161,8 @@ class TileMesh:
         """One mesh of *meshes* in order (trimesh's concatenate: vertices, faces and face
         attributes); their surfaces are numbered on (``surface_index`` shifted, ``surface_ids``
         joined).  Name, extent and buffer are the first mesh's unless given."""
+        import trimesh
+
         meshes = list(meshes)
         if not meshes:
             raise ValueError("TileMesh.merge: no mesh")

@@ -2,7 +2,7 @@
 
 A LocalCluster started by a run makes its workers with multiprocessing's ``forkserver``
 (:func:`vipvflow.simulation.cluster.make_client`): one server process imports this module
-once, and every worker is then a fork of it, with Dask, numpy, pandas, pyarrow, the
+once, and every worker is then a fork of it, with Dask, numpy, pandas, pyarrow, trimesh, the
 simulation's modules, the fused per-pass kernel (loaded from numba's on-disk cache) and
 matplotlib already in memory.  A worker started with ``spawn`` loaded all of that itself:
 ~3 s of a core per worker, paid again by every worker of every run and by the second worker
@@ -18,7 +18,7 @@ from __future__ import annotations
 def _preload() -> None:
     import importlib
 
-    for name in ("distributed", "numpy", "pandas", "pyarrow.parquet", "lz4",
+    for name in ("distributed", "numpy", "pandas", "pyarrow.parquet", "lz4", "trimesh",
                  "vipvflow.simulation.worker_setup", "vipvflow.simulation.partition",
                  "vipvflow.simulation.standing", "vipvflow.simulation.reduce",
                  "vipvflow.models.irradiance", "vipvflow.models.shading",
@@ -28,6 +28,12 @@ def _preload() -> None:
             importlib.import_module(name)
         except Exception:       # noqa: BLE001 - the worker loads it (and reports) itself
             pass
+    try:
+        from .partition import arrow_on_the_heap
+
+        arrow_on_the_heap()
+    except Exception:       # noqa: BLE001 - the worker's tasks set it themselves
+        pass
     try:
         from ..models import passkernel
         from ..outputs import report
