@@ -460,16 +460,19 @@ def _worker_origin() -> tuple:
     import os
     import sys
 
+    import pyarrow as pa
+
     return (os.getppid(), os.getcwd(), "vipvflow.simulation.worker_preload" in sys.modules,
-            "matplotlib.pyplot" in sys.modules)
+            "matplotlib.pyplot" in sys.modules, pa.default_memory_pool().backend_name)
 
 
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="workers are forked on Linux only")
 def test_local_cluster_workers_are_forked_from_one_preloaded_server_in_the_callers_directory(
         small_config, tmp_path, monkeypatch):
     """A run's LocalCluster forks its workers from one server process per process, which has
-    loaded what a worker needs (the simulation, matplotlib); a later run's workers come from
-    the same server, and each run's work in the directory the run was started from."""
+    loaded what a worker needs (the simulation, matplotlib) and put Arrow's allocations on
+    the heap; a later run's workers come from the same server, and each run's work in the
+    directory the run was started from."""
     from vipvflow.simulation.cluster import make_client
 
     origins = []
@@ -486,7 +489,31 @@ def test_local_cluster_workers_are_forked_from_one_preloaded_server_in_the_calle
     assert len(servers) == 1 and os.getpid() not in servers, origins
     assert [[cwd for _, cwd, *_ in run] for run in origins] == [
         [str(tmp_path / "first")] * 2, [str(tmp_path / "second")] * 2]
-    assert all(preloaded and pyplot for run in origins for _, _, preloaded, pyplot in run), origins
+    assert all(preloaded and pyplot and pool == "system"
+               for run in origins for _, _, preloaded, pyplot, pool in run), origins
+
+
+def test_arrow_allocates_from_the_heap_unless_a_pool_is_chosen(small_run):
+    """A run puts its process's Arrow allocations on glibc's heap (pyarrow's system pool,
+    whose freed memory :func:`hand_back_memory` gives back); ``ARROW_DEFAULT_MEMORY_POOL``
+    set by the user is left as chosen."""
+    import pyarrow as pa
+
+    assert pa.default_memory_pool().backend_name == "system"        # small_run ran here
+    code = ("import pyarrow as pa\n"
+            "from vipvflow.simulation.partition import arrow_on_the_heap\n"
+            "before = pa.default_memory_pool().backend_name\n"
+            "arrow_on_the_heap()\n"
+            "print(before, pa.default_memory_pool().backend_name)\n")
+    env = {k: v for k, v in os.environ.items() if k != "ARROW_DEFAULT_MEMORY_POOL"}
+    for chosen, want in ((None, "system"), ("mimalloc", "mimalloc"), ("jemalloc", "jemalloc")):
+        if chosen is not None and chosen not in pa.supported_memory_backends():
+            continue
+        done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                              env=env if chosen is None else {**env, "ARROW_DEFAULT_MEMORY_POOL": chosen})
+        assert done.returncode == 0, done.stderr
+        before, after = done.stdout.split()
+        assert after == want and (chosen is not None or before != "system"), (chosen, done.stdout)
 
 
 def _frozen_objects() -> int:

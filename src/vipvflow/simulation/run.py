@@ -23,7 +23,7 @@ from .cluster import (bound_dashboard, check_scheduler, close_client, local_clus
                       make_client)
 from .manifest import claim_run_dir, write_manifest
 from .network import selected_network
-from .partition import RunContext, hand_back_memory, partition_done, worker_bvh_builds
+from .partition import RunContext, arrow_on_the_heap, hand_back_memory, partition_done, worker_bvh_builds
 from .standing import standing_done, write_timeline
 from .tasks import collect_map, submit_standing, submit_tiles
 
@@ -87,6 +87,7 @@ def _run(cfg: Config, year: int, scheduler, n_workers, say, max_partitions, forc
     from .prepare import ensure_demo, ensure_ingested, input_digests, preflight
     from .reduce import reduce_run
 
+    arrow_on_the_heap()
     t_start = time.perf_counter()
     timings: dict[str, float] = {}
     run_dir = run_dir_of(cfg, year)
