@@ -207,6 +207,8 @@ def run(tiny: bool = False, period: str | None = None, scheduler: str | None = N
     data_dir.mkdir(parents=True, exist_ok=True)
     for part in ("city", "radiation"):                   # the demo's city and sun, as ingested
         link = data_dir / part
+        if link.is_symlink() and link.readlink() != demo["data"] / part:
+            link.unlink()           # to another checkout's demo (perhaps gone since)
         if not link.exists():
             link.symlink_to(demo["data"] / part, target_is_directory=True)
     feed = root / f"network_{n_lines}_lines_{len(days)}d.zip"
