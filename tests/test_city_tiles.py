@@ -124,7 +124,7 @@ def test_tile_shading_equals_whole_city(small_city):
 PROBE = textwrap.dedent("""
     import gc, json, resource, sys, threading
     import psutil
-    import geopandas, numpy, pyproj, shapely  # the baseline every run pays
+    import geopandas, numpy, pyproj, shapely, trimesh  # the baseline every ingest pays
     from vipvflow.inputs.city import ingest_city
     from vipvflow.config import CityCfg
     proc = psutil.Process()
