@@ -2,6 +2,8 @@
 from __future__ import annotations
 
 import json
+import sys
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -174,7 +176,7 @@ def test_a_loaded_table_is_read_from_its_cache_with_its_sun_and_perez_coefficien
     grid = first.t0 + first.step_s * np.arange(first.n)
     computed = _perez(grid, first.data, first.data["sun_z"])
     with np.load(cache) as z:
-        assert set(PEREZ_COLUMNS) <= set(z.files)
+        assert set(PEREZ_COLUMNS) <= set(z["names"].tolist())
     again = RadiationTable.load(tmp_path, 2020)
     assert (again.t0, again.step_s, again.n) == (first.t0, first.step_s, first.n)
     assert np.array_equal(again.lat, first.lat) and np.array_equal(again.lon, first.lon)
@@ -190,13 +192,59 @@ def test_a_loaded_table_is_read_from_its_cache_with_its_sun_and_perez_coefficien
             "assert 'pyarrow.parquet' not in sys.modules, 'the Parquet file read'\n")
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert done.returncode == 0, done.stderr
-    # a cache without the coefficients (an older version's) is replaced
+    # a cache without its series (an older version's kept one member per series) is replaced
     with np.load(cache) as z:
-        np.savez(cache, **{k: z[k] for k in z.files if k not in PEREZ_COLUMNS})
+        np.savez(cache, **{k: z[k] for k in z.files if k != "packed"})
     again = RadiationTable.load(tmp_path, 2020)
     assert np.array_equal(again.data["f1"], computed["f1"], equal_nan=True)
     with np.load(cache) as z:
-        assert set(PEREZ_COLUMNS) <= set(z.files)
+        assert "packed" in z.files and set(PEREZ_COLUMNS) <= set(z["names"].tolist())
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc/self/smaps")
+def test_a_table_read_from_its_cache_is_mapped_and_its_pages_let_go(tmp_path):
+    """A later load maps the cached series from the file instead of reading them into the
+    process's memory: release_mapped_pages (a tile task's end) lets the pages read go, and
+    the values read again afterwards, the lookups and a pickled copy are the same to the
+    bit."""
+    import pickle
+
+    from vipvflow.models.sun_sky import release_mapped_pages
+    from vipvflow.store import DataDir
+
+    from vipvflow.demo.cams import write_cams_csv
+
+    write_cams_csv(tmp_path / "cams.csv", 2020, 52.52, 13.40, 40.0, seed=3, months=[6])
+    ingest_cams([tmp_path / "cams.csv"], tmp_path)
+    first = RadiationTable.load(tmp_path, 2020)          # computes and writes the cache
+    cache = DataDir(tmp_path).radiation.table_cache(2020)
+    table = RadiationTable.load(tmp_path, 2020)
+    names, packed = table._packed()
+    assert table.__dict__.get("_map") is not None and packed.flags.writeable and packed.flags.aligned
+
+    def resident_kb() -> int:
+        """The resident size of this process's mappings of the cache file (kB)."""
+        kb, inside = 0, False
+        for line in Path("/proc/self/smaps").read_text().splitlines():
+            if line[:1].isalnum() and "-" in line.split()[0] and ":" not in line.split()[0]:
+                inside = line.rstrip().endswith(str(cache))
+            elif inside and line.startswith("Rss:"):
+                kb += int(line.split()[1])
+        return kb
+
+    touched = {c: float(np.nansum(table.data[c])) for c in names}
+    assert resident_kb() * 1024 >= 0.9 * packed.nbytes
+    release_mapped_pages()
+    assert resident_kb() * 1024 < 0.1 * packed.nbytes
+    assert {c: float(np.nansum(table.data[c])) for c in names} == touched
+    for c in first.data:
+        assert np.array_equal(table.data[c], first.data[c], equal_nan=True), c
+    t = first.t0 + np.linspace(0, (first.n - 1) * first.step_s, 5000)
+    a, b = first.lookup(t), table.lookup(t)
+    assert all(np.array_equal(a[k], b[k], equal_nan=True) for k in a)
+    copy = pickle.loads(pickle.dumps(table))
+    assert "_map" not in copy.__dict__
+    assert all(np.array_equal(copy.data[c], first.data[c], equal_nan=True) for c in first.data)
 
 
 def test_the_radiation_caches_are_computed_again_by_another_version_of_the_code(cams, tmp_path,

@@ -9,6 +9,7 @@ from __future__ import annotations
 import json
 import logging
 import os
+import weakref
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -110,6 +111,51 @@ def _identity(st: os.stat_result) -> tuple:
 
 
 # --------------------------------------------------------------------------- lookup
+#: the tables this process maps from their caches (:meth:`RadiationTable.load`)
+_MAPPED: list = []
+
+
+def _map_member(path: Path, name: str) -> tuple | None:
+    """The array *name* of the uncompressed ``.npz`` *path* mapped from the file, private
+    and copy-on-write (writeable, like an array read into memory; nothing is ever written
+    back): ``(array, mmap)``; ``None`` when it cannot be mapped (compressed, misaligned for
+    its type, no ``mmap``), for the caller to read it."""
+    import mmap
+
+    with open(path, "rb") as fh:
+        where = npz_member(fh, name)
+        if where is None:
+            return None
+        offset, dtype, shape, order = where
+        if offset % dtype.alignment:
+            return None
+        try:
+            m = mmap.mmap(fh.fileno(), 0, access=mmap.ACCESS_COPY)
+        except (OSError, ValueError):
+            return None
+    return np.ndarray(shape, dtype, buffer=m, offset=offset, order=order), m
+
+
+def release_mapped_pages() -> None:
+    """Let the operating system take back the pages of the radiation tables this process
+    maps (:meth:`RadiationTable.load`): they are read again from the file (the page cache)
+    where next needed.  A tile task's end calls it
+    (:func:`vipvflow.simulation.partition.hand_back_memory`): a worker's RSS then holds the
+    month it is computing, not every month it has computed (~27 MB a location for a
+    year, in each worker)."""
+    import mmap
+
+    if not hasattr(mmap, "MADV_DONTNEED"):
+        return
+    alive = []
+    for ref in _MAPPED:
+        table = ref()
+        if table is not None and table.__dict__.get("_map") is not None:
+            table.__dict__["_map"].madvise(mmap.MADV_DONTNEED)
+            alive.append(ref)
+    _MAPPED[:] = alive
+
+
 @dataclass
 class RadiationTable:
     """Radiation and sun position on a regular time grid, for K locations.
@@ -239,11 +285,14 @@ class RadiationTable:
         """Load ``radiation/radiation.parquet`` for *year* (UTC, padded by *pad_days*).
 
         The first load of a year puts the table on its minute grid with its sun vectors and
-        Perez coefficients beside the file (``table_<year>.npz``, uncompressed); each later
-        load (a run's workers) reads them from there: no Parquet read (~0.1 GB of a
-        process's memory for a moment), no SPA and no pvlib.  The cache names the radiation
-        file's size and time, *year*, *pad_days*, and the code and libraries that computed
-        it (:func:`vipvflow.models.code_digest`), and is written again when any differ or a
+        Perez coefficients beside the file (``table_<year>.npz``, uncompressed: the series
+        interleaved as :meth:`_packed` holds them); each later load (a run's workers) maps
+        them from there: no Parquet read (~0.1 GB of a process's memory for a moment), no
+        SPA and no pvlib, and the process holds the pages of the minutes it reads until
+        :func:`release_mapped_pages` lets them go (a tile task reads one month's, ~2 MB of
+        the year's ~27 MB a location).  The cache names the radiation file's size and time,
+        *year*, *pad_days*, and the code and libraries that computed it
+        (:func:`vipvflow.models.code_digest`), and is written again when any differ or a
         member is missing (and not written where the folder is read-only).
 
         Raises
@@ -255,37 +304,52 @@ class RadiationTable:
         if not path.is_file():
             raise InputError(f"{path}: not found; run 'vipvflow ingest cams' first")
         st = path.stat()
-        key = json.dumps(["table-1", code_digest(), st.st_size, st.st_mtime_ns, year, pad_days])
+        key = json.dumps(["table-2", code_digest(), st.st_size, st.st_mtime_ns, year, pad_days])
         cache = RadiationDir(path.parent).table_cache(year)
-        grid = None
+        out = None
         try:
             with np.load(cache) as z:
                 if str(z["key"]) == key:
-                    t0, n = float(z["t0"]), int(z["n"])
-                    locs = np.stack([z["lat"], z["lon"], z["alt"]], 1)
-                    values = {c: z[c] for c in (*COLUMNS, *PEREZ_COLUMNS, "sun")}
+                    names = tuple(str(c) for c in z["names"])
+                    mapped = _map_member(cache, "packed")
+                    packed = z["packed"] if mapped is None else mapped[0]
+                    if packed.shape[:2] != (len(z["lat"]), int(z["n"])) or len(names) != packed.shape[2]:
+                        raise ValueError("packed table of another shape")
+                    data = {c: packed[..., j] for j, c in enumerate(names)}
+                    out = cls(t0=float(z["t0"]), step_s=float(_GRID_S), data=data,
+                              lat=np.array(z["lat"], np.float64), lon=np.array(z["lon"], np.float64))
+                    out.__dict__["_pack"] = (names, packed, dict(data))
                     covered = float(z["covered"])
-                    grid = t0 + _GRID_S * np.arange(n, dtype=np.float64)
+                    if mapped is not None:
+                        out.__dict__["_map"] = mapped[1]
+                        _MAPPED.append(weakref.ref(out))
         except (OSError, KeyError, ValueError):
-            grid = None
-        if grid is None:
+            out = None
+        if out is None:
             grid, locs, values, covered = cls._grid_of(path, year, pad_days)
-            values["sun"] = sun_vectors(grid, locs[:, 0], locs[:, 1], locs[:, 2])
-            values.update(_perez(grid, values, values["sun"][2]))
+            sun = sun_vectors(grid, locs[:, 0], locs[:, 1], locs[:, 2])
+            perez = _perez(grid, values, sun[2])
+            out = cls.from_grid(grid, values, locs[:, 0], locs[:, 1], locs[:, 2], sun=sun, perez=perez)
+            names, packed = out._packed()
             try:
-                write_npz(cache, key=np.array(key), t0=np.float64(grid[0]), n=np.int64(len(grid)),
-                          lat=locs[:, 0], lon=locs[:, 1], alt=locs[:, 2],
-                          covered=np.float64(covered), **values)
+                # the interleaved series first: their place in the file is then a multiple
+                # of 4 bytes, which the mapping needs (np.savez writes in this order)
+                write_npz(cache, packed=packed, names=np.array(names), key=np.array(key),
+                          t0=np.float64(out.t0), n=np.int64(out.n), lat=locs[:, 0],
+                          lon=locs[:, 1], alt=locs[:, 2], covered=np.float64(covered))
             except OSError:
                 pass
         if covered < 1.0:
             log.warning("%s: %.1f %% of %d's minute grid has no radiation (NaN)", path,
                         100 * (1 - covered), year)
-        sun = values.pop("sun")
-        perez = {c: values.pop(c) for c in PEREZ_COLUMNS}
-        out = cls.from_grid(grid, values, locs[:, 0], locs[:, 1], locs[:, 2], sun=sun, perez=perez)
         out.__dict__["_source"] = str(path)            # where the sky tables are cached
         return out
+
+    def __getstate__(self) -> dict:
+        """Pickled without the file mapping (its arrays are pickled as values)."""
+        state = dict(self.__dict__)
+        state.pop("_map", None)
+        return state
 
     @staticmethod
     def _grid_of(path: Path, year: int, pad_days: float) -> tuple:

@@ -71,8 +71,13 @@ class Figures:
             for i, w in enumerate(client.scheduler_info()["workers"])]
 
     def add(self, name: str, title: str, make, *args) -> None:
-        job = (self._client.submit(figure_png, make, *args, pure=False, key=f"figure-{name}")
-               if self._client is not None else figure_png(make, *args))
+        if self._client is not None:
+            from ..simulation.partition import handing_back
+
+            job = self._client.submit(handing_back, figure_png, make, *args, pure=False,
+                                      key=f"figure-{name}")
+        else:
+            job = figure_png(make, *args)
         self._items.append((name, title, job))
 
     def results(self) -> list[tuple[str, str, bytes]]:

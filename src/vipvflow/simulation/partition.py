@@ -104,18 +104,37 @@ def arrow_on_the_heap() -> None:
 
 def hand_back_memory() -> None:
     """Hand the memory this process has freed back to the operating system: Arrow's pool
-    (mimalloc keeps what a Parquet read freed) and glibc's heap.  A few ms; called after
-    the radiation table's load and after each tile task, it keeps a worker's memory at what
-    it holds."""
+    (mimalloc keeps what a Parquet read freed), glibc's heap, and the pages of the
+    radiation tables mapped from their file (read again where needed).  A few ms; called
+    after the radiation table's load and after each tile task, it keeps a worker's memory
+    at what it holds."""
     import pyarrow as pa
 
+    from ..models.sun_sky import release_mapped_pages
+
     pa.default_memory_pool().release_unused()
+    release_mapped_pages()
     try:
         import ctypes
 
         ctypes.CDLL("libc.so.6").malloc_trim(0)
     except (OSError, AttributeError):      # not glibc
         pass
+
+
+def handing_back(fn, *args):
+    """``fn(*args)``, then this process's garbage collected and its freed memory handed back
+    (:func:`hand_back_memory`): a reduce's task on a worker (a figure, ``city.glb``, the
+    GeoParquet datasets), whose temporaries the worker's RSS otherwise kept while it drew
+    the next figure beside the other worker's (the line-year's peak of its processes' RSS
+    is in those figures)."""
+    import gc
+
+    try:
+        return fn(*args)
+    finally:
+        gc.collect()
+        hand_back_memory()
 
 
 def _scene(ctx: RunContext, tile: str):

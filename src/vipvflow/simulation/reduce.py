@@ -24,7 +24,7 @@ from ..errors import InputError
 from ..models.loss import shading_loss
 from ..store import (HOURLY_METADATA, ROW_GROUP_ROWS, DataDir, PartSchemaError, RunDir, write_json,
                      write_parquet, write_parquet_parts)
-from .partition import hand_back_memory
+from .partition import hand_back_memory, handing_back
 
 log = logging.getLogger(__name__)
 
@@ -989,7 +989,8 @@ class _Aside:
 
     def __init__(self, client, key: str, fn, *args):
         self._client = client
-        self._job = client.submit(fn, *args, pure=False, key=key) if client is not None else fn(*args)
+        self._job = (client.submit(handing_back, fn, *args, pure=False, key=key)
+                     if client is not None else fn(*args))
 
     def result(self):
         return self._client.gather(self._job) if self._client is not None else self._job
