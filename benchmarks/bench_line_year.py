@@ -40,7 +40,9 @@ the cache, and whether its outputs equal the first round's).
 from __future__ import annotations
 
 import json
+import shutil
 import sys
+from pathlib import Path
 
 import pandas as pd
 
@@ -48,34 +50,39 @@ from benchmarks.bench_kernel import bare_kernel
 from benchmarks.common import YEAR, demo_config, fresh_dir, prepare_demo, remove, run_pipeline, stage_split
 
 
+#: the outputs :func:`_same_outputs` compares
+_COMPARED = ("summary.json", "trip_energy.parquet", "segment_month.parquet")
+
+
 def _line_year(size: str, months: list[int], sun_masks: bool = True, keep: bool = False,
                geometry_cache: bool = False) -> dict:
     """One line-year from a fresh output folder (:func:`run_pipeline`'s result; with *keep*
-    also its ``outputs``: summary.json and the trip and segment tables, read before the
-    folder goes; with *geometry_cache* the tiles' geometry an earlier run kept in the data
-    dir is used, else computed as by a first run)."""
+    also its ``outputs``: a folder with copies of its summary.json and its trip and segment
+    tables, kept on disk until the end, so that this process holds none of them while it
+    measures the later runs; with *geometry_cache* the tiles' geometry an earlier run kept
+    in the data dir is used, else computed as by a first run)."""
     out = fresh_dir("line_year")
     try:
         cfg = demo_config(size, out_dir=out, routes=["L1"], months=months, n_workers=2)
         cfg.irradiance.sun_masks = sun_masks
         r = run_pipeline(cfg, YEAR, n_workers=2, pss=True, geometry_cache=geometry_cache)
         if keep:
-            d = r["run_dir"]
-            r["outputs"] = {"summary": json.loads((d / "summary.json").read_text()),
-                            "trip_energy": pd.read_parquet(d / "trip_energy.parquet"),
-                            "segment_month": pd.read_parquet(d / "segment_month.parquet")}
+            r["outputs"] = fresh_dir("line_year_outputs")
+            for name in _COMPARED:
+                shutil.copyfile(r["run_dir"] / name, r["outputs"] / name)
         return r
     finally:
         remove(out)
 
 
-def _same_outputs(a: dict, b: dict) -> bool:
-    """Whether two runs' summary.json and trip and segment tables are identical."""
-    if a["summary"] != b["summary"]:
+def _same_outputs(a: Path, b: Path) -> bool:
+    """Whether two runs' kept summary.json and trip and segment tables are identical."""
+    if json.loads((a / "summary.json").read_text()) != json.loads((b / "summary.json").read_text()):
         return False
-    for k in ("trip_energy", "segment_month"):
+    for name in _COMPARED[1:]:
         try:
-            pd.testing.assert_frame_equal(a[k], b[k], check_exact=True)
+            pd.testing.assert_frame_equal(pd.read_parquet(a / name), pd.read_parquet(b / name),
+                                          check_exact=True)
         except AssertionError:
             return False
     return True
@@ -192,6 +199,8 @@ def run(tiny: bool = False) -> dict:
                "peak_rss_gb": "< 1.5 (issue 41)", "masks_equal_all_rays": "true",
                "physics_passes_per_s_per_core": ">= 1e6",
                "bvh_builds_per_tile": "<= 2 (once per worker)"}
+    for kept in (rounds[0][1]["outputs"], rounds[0][2]["outputs"], cached["outputs"]):
+        remove(kept)
     return {"figures": figures, "targets": targets, "stage_split_s": split,
             "run_timings_s": timings, "bvh_builds_per_worker": builds, "prepare": prep,
             "config": {"size": size, "routes": ["L1"], "months": months, "workers": 2}}
