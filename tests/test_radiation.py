@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import json
+import mmap
 import sys
 from pathlib import Path
 
@@ -12,7 +13,7 @@ import pytest
 
 from vipvflow.errors import InputError
 from vipvflow.inputs.cams import FLAG_GAP, FLAG_NEGATIVE, FLAG_NO_ALLSKY, ingest_cams, read_cams_file
-from vipvflow.models.sun_sky import RadiationTable
+from vipvflow.models.sun_sky import MAPPED_FILESYSTEMS, RadiationTable, filesystem_of
 
 
 @pytest.fixture(scope="module")
@@ -218,6 +219,8 @@ def test_a_table_read_from_its_cache_is_mapped_and_its_pages_let_go(tmp_path):
     ingest_cams([tmp_path / "cams.csv"], tmp_path)
     first = RadiationTable.load(tmp_path, 2020)          # computes and writes the cache
     cache = DataDir(tmp_path).radiation.table_cache(2020)
+    if filesystem_of(cache) not in MAPPED_FILESYSTEMS:
+        pytest.skip(f"{tmp_path} is on {filesystem_of(cache)}: tables are not mapped from there")
     table = RadiationTable.load(tmp_path, 2020)
     names, packed = table._packed()
     assert table.__dict__.get("_map") is not None and packed.flags.writeable and packed.flags.aligned
@@ -245,6 +248,52 @@ def test_a_table_read_from_its_cache_is_mapped_and_its_pages_let_go(tmp_path):
     copy = pickle.loads(pickle.dumps(table))
     assert "_map" not in copy.__dict__
     assert all(np.array_equal(copy.data[c], first.data[c], equal_nan=True) for c in first.data)
+
+
+def test_the_filesystem_of_a_path_is_its_longest_mount_point(tmp_path):
+    """filesystem_of reads the mount table: the mount with the longest mount point holding
+    the path decides (not a mount point that is only a prefix of the path's name), the last
+    of two on the same point, escaped spaces; no mount table: unknown."""
+    info = tmp_path / "mountinfo"
+    info.write_text(
+        "27 1 254:0 / / rw,relatime - ext4 /dev/vda rw\n"
+        "40 27 0:50 / /data rw,relatime shared:5 - nfs4 srv:/export rw,vers=4.2\n"
+        "41 27 0:51 / /data/local rw,relatime - xfs /dev/vdb rw\n"
+        "42 27 0:52 / /mnt/my\\040share rw,relatime - cifs //srv/s rw\n"
+        "43 27 0:53 / /scratch rw - ext4 /dev/vdc rw\n"
+        "44 27 0:54 / /scratch rw - fuse.sshfs host:/x rw\n")
+    assert filesystem_of("/data/berlin/radiation/table_2019.npz", info) == "nfs4"
+    assert filesystem_of("/data", info) == "nfs4"
+    assert filesystem_of("/data/local/radiation/table_2019.npz", info) == "xfs"
+    assert filesystem_of("/database/table_2019.npz", info) == "ext4"
+    assert filesystem_of("/mnt/my share/table_2019.npz", info) == "cifs"
+    assert filesystem_of("/scratch/t.npz", info) == "fuse.sshfs"
+    assert filesystem_of("/data/t.npz", tmp_path / "no-such-file") is None
+    for kind in ("nfs4", "cifs", "fuse.sshfs", None):
+        assert kind not in MAPPED_FILESYSTEMS
+
+
+def test_a_table_on_a_network_filesystem_is_read_into_memory(tmp_path, monkeypatch):
+    """Where the cache is on a filesystem a table is not mapped from (NFS, SMB, FUSE: a file
+    another host writes again could take a released page away), a later load reads the
+    series into memory, with the same values."""
+    from vipvflow.demo.cams import write_cams_csv
+    from vipvflow.models import sun_sky
+
+    write_cams_csv(tmp_path / "cams.csv", 2020, 52.52, 13.40, 40.0, seed=3, months=[6])
+    ingest_cams([tmp_path / "cams.csv"], tmp_path)
+    first = RadiationTable.load(tmp_path, 2020)
+    monkeypatch.setattr(sun_sky, "filesystem_of", lambda path, *a: "nfs4")
+    table = RadiationTable.load(tmp_path, 2020)
+    assert "_map" not in table.__dict__
+    assert all(ref() is not table for ref in sun_sky._MAPPED)
+    names, packed = table._packed()
+    base = packed
+    while base is not None:                      # nothing under the series is a mapping
+        assert not isinstance(base, mmap.mmap)
+        base = getattr(base, "base", None)
+    for c in first.data:
+        assert np.array_equal(table.data[c], first.data[c], equal_nan=True), c
 
 
 def test_the_radiation_caches_are_computed_again_by_another_version_of_the_code(cams, tmp_path,

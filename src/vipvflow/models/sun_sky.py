@@ -114,6 +114,37 @@ def _identity(st: os.stat_result) -> tuple:
 #: the tables this process maps from their caches (:meth:`RadiationTable.load`)
 _MAPPED: list = []
 
+#: the filesystems a table is mapped from: on these a cache written again while a process
+#: maps it (another run's code on the same data dir) is a new file, and the mapping keeps
+#: the old one's pages.  Elsewhere (NFS, SMB, Ceph, FUSE, ... : a worker of a cluster
+#: reading a shared data dir) a page read again after :func:`release_mapped_pages` could come
+#: from a file another host has removed, and the process would die of ``SIGBUS``: the table
+#: is read into memory there.
+MAPPED_FILESYSTEMS = frozenset({"ext2", "ext3", "ext4", "xfs", "btrfs", "zfs", "f2fs", "jfs",
+                                "bcachefs", "nilfs2", "reiserfs", "tmpfs", "ramfs", "overlay",
+                                "squashfs", "erofs"})
+
+
+def filesystem_of(path, mountinfo: str | Path = "/proc/self/mountinfo") -> str | None:
+    """The type of the filesystem holding *path* (``ext4``, ``nfs4``, ...), from the mount
+    with the longest mount point that contains it (the last of equal ones: it hides the
+    others); ``None`` where the mount table cannot be read (not Linux)."""
+    try:
+        lines = Path(mountinfo).read_text().splitlines()
+    except OSError:
+        return None
+    where = os.path.realpath(path)
+    best, kind = -1, None
+    for line in lines:
+        fields = line.split()
+        if " - " not in line or len(fields) < 5:
+            continue
+        point = fields[4].replace("\\040", " ").replace("\\011", "\t").replace("\\134", "\\")
+        inside = point == "/" or where == point or where.startswith(point.rstrip("/") + "/")
+        if inside and len(point) >= best:
+            best, kind = len(point), line.split(" - ", 1)[1].split()[0]
+    return kind
+
 
 def _map_member(path: Path, name: str) -> tuple | None:
     """The array *name* of the uncompressed ``.npz`` *path* mapped from the file, private
@@ -290,7 +321,8 @@ class RadiationTable:
         them from there: no Parquet read (~0.1 GB of a process's memory for a moment), no
         SPA and no pvlib, and the process holds the pages of the minutes it reads until
         :func:`release_mapped_pages` lets them go (a tile task reads one month's, ~2 MB of
-        the year's ~27 MB a location).  The cache names the radiation file's size and time,
+        the year's ~27 MB a location); on a filesystem not in :data:`MAPPED_FILESYSTEMS`
+        (NFS, SMB, FUSE, ...) it reads them into memory instead.  The cache names the radiation file's size and time,
         *year*, *pad_days*, and the code and libraries that computed it
         (:func:`vipvflow.models.code_digest`), and is written again when any differ or a
         member is missing (and not written where the folder is read-only).
@@ -311,7 +343,8 @@ class RadiationTable:
             with np.load(cache) as z:
                 if str(z["key"]) == key:
                     names = tuple(str(c) for c in z["names"])
-                    mapped = _map_member(cache, "packed")
+                    mapped = (_map_member(cache, "packed")
+                              if filesystem_of(cache) in MAPPED_FILESYSTEMS else None)
                     packed = z["packed"] if mapped is None else mapped[0]
                     if packed.shape[:2] != (len(z["lat"]), int(z["n"])) or len(names) != packed.shape[2]:
                         raise ValueError("packed table of another shape")
