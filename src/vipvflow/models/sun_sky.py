@@ -150,9 +150,12 @@ def _map_member(path: Path, name: str) -> tuple | None:
     """The array *name* of the uncompressed ``.npz`` *path* mapped from the file, private
     and copy-on-write (writeable, like an array read into memory; nothing is ever written
     back): ``(array, mmap)``; ``None`` when it cannot be mapped (compressed, misaligned for
-    its type, no ``mmap``), for the caller to read it."""
+    its type, no ``mmap``) or is not to be (on a filesystem not in
+    :data:`MAPPED_FILESYSTEMS`), for the caller to read it."""
     import mmap
 
+    if filesystem_of(path) not in MAPPED_FILESYSTEMS:
+        return None
     with open(path, "rb") as fh:
         where = npz_member(fh, name)
         if where is None:
@@ -321,9 +324,10 @@ class RadiationTable:
         them from there: no Parquet read (~0.1 GB of a process's memory for a moment), no
         SPA and no pvlib, and the process holds the pages of the minutes it reads until
         :func:`release_mapped_pages` lets them go (a tile task reads one month's, ~2 MB of
-        the year's ~27 MB a location); on a filesystem not in :data:`MAPPED_FILESYSTEMS`
-        (NFS, SMB, FUSE, ...) it reads them into memory instead.  The cache names the radiation file's size and time,
-        *year*, *pad_days*, and the code and libraries that computed it
+        the year's ~27 MB a location; on a filesystem not in :data:`MAPPED_FILESYSTEMS`,
+        NFS, SMB, FUSE, ..., it reads them into memory instead).  The cache names the
+        radiation file's size and time, *year*, *pad_days*, and the code and libraries that
+        computed it
         (:func:`vipvflow.models.code_digest`), and is written again when any differ or a
         member is missing (and not written where the folder is read-only).
 
@@ -343,8 +347,7 @@ class RadiationTable:
             with np.load(cache) as z:
                 if str(z["key"]) == key:
                     names = tuple(str(c) for c in z["names"])
-                    mapped = (_map_member(cache, "packed")
-                              if filesystem_of(cache) in MAPPED_FILESYSTEMS else None)
+                    mapped = _map_member(cache, "packed")
                     packed = z["packed"] if mapped is None else mapped[0]
                     if packed.shape[:2] != (len(z["lat"]), int(z["n"])) or len(names) != packed.shape[2]:
                         raise ValueError("packed table of another shape")
