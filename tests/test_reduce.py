@@ -242,7 +242,6 @@ def test_segment_month_is_written_in_parts_as_the_whole_merge_was(tmp_path, monk
     assert b.column("segment_id").to_pylist() == [7, 7, 3, 3, 5, 5, 9]
 
 
-
 def test_the_reduce_writes_segment_months_and_trips_in_row_groups_of_their_own(small_config, small_run,
                                                                                tmp_path, monkeypatch):
     """The reduce writes ``segment_month.parquet`` and ``trip_energy.parquet`` in row groups
@@ -281,6 +280,7 @@ def test_the_reduce_writes_segment_months_and_trips_in_row_groups_of_their_own(s
         sizes = [meta.row_group(i).num_rows for i in range(meta.num_row_groups)]
         assert sizes[:-1] == [group] * (len(sizes) - 1) and 0 < sizes[-1] <= group and len(sizes) >= 3, (
             name, sizes)
+
 
 def test_the_service_intervals_are_each_kind_of_the_buses_in_service_in_file_order(tmp_path):
     """The layovers and parked intervals the battery's day takes, read a batch at a time:
