@@ -457,20 +457,13 @@ def test_local_cluster_profiles_workers_only_when_asked(small_config, tmp_path, 
 
 
 def _worker_origin() -> tuple:
-    import io
     import os
     import sys
 
     import pyarrow as pa
-    import pyarrow.parquet as pq
 
-    # a Parquet read and a group_by, whose internal buffers come from Arrow's C++ default pool
-    buf = io.BytesIO()
-    pq.write_table(pa.table({"k": [1, 2, 1] * 1000, "v": [0.5] * 3000}), buf)
-    pq.read_table(pa.BufferReader(buf.getvalue())).group_by("k").aggregate([("v", "sum")])
     return (os.getppid(), os.getcwd(), "vipvflow.simulation.worker_preload" in sys.modules,
-            "matplotlib.pyplot" in sys.modules, pa.default_memory_pool().backend_name,
-            pa.mimalloc_memory_pool().max_memory())
+            "matplotlib.pyplot" in sys.modules, pa.default_memory_pool().backend_name)
 
 
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="workers are forked on Linux only")
@@ -478,8 +471,7 @@ def test_local_cluster_workers_are_forked_from_one_preloaded_server_in_the_calle
         small_config, tmp_path, monkeypatch):
     """A run's LocalCluster forks its workers from one server process per process, which has
     loaded what a worker's map needs (the simulation; not matplotlib, which only the reduce's
-    figures load) and put Arrow's allocations on the heap, those of its C++ internals (a
-    Parquet read's, a group_by's) too: nothing from mimalloc; a later run's workers come from
+    figures load) and put Arrow's allocations on the heap; a later run's workers come from
     the same server, and each run's work in the directory the run was started from."""
     from vipvflow.simulation.cluster import make_client
 
@@ -497,15 +489,14 @@ def test_local_cluster_workers_are_forked_from_one_preloaded_server_in_the_calle
     assert len(servers) == 1 and os.getpid() not in servers, origins
     assert [[cwd for _, cwd, *_ in run] for run in origins] == [
         [str(tmp_path / "first")] * 2, [str(tmp_path / "second")] * 2]
-    assert all(preloaded and not pyplot and pool == "system" and not mimalloc
-               for run in origins for _, _, preloaded, pyplot, pool, mimalloc in run), origins
+    assert all(preloaded and not pyplot and pool == "system"
+               for run in origins for _, _, preloaded, pyplot, pool in run), origins
 
 
 def test_arrow_allocates_from_the_heap_unless_a_pool_is_chosen(small_run):
     """A run puts its process's Arrow allocations on glibc's heap (pyarrow's system pool,
-    whose freed memory :func:`hand_back_memory` gives back), and those of the processes it
-    starts (``ARROW_DEFAULT_MEMORY_POOL``, which Arrow's C++ default pool is chosen from);
-    ``ARROW_DEFAULT_MEMORY_POOL`` set by the user is left as chosen."""
+    whose freed memory :func:`hand_back_memory` gives back); ``ARROW_DEFAULT_MEMORY_POOL``
+    set by the user is left as chosen."""
     import pyarrow as pa
 
     assert pa.default_memory_pool().backend_name == "system"        # small_run ran here
@@ -513,10 +504,7 @@ def test_arrow_allocates_from_the_heap_unless_a_pool_is_chosen(small_run):
             "from vipvflow.simulation.partition import arrow_on_the_heap\n"
             "before = pa.default_memory_pool().backend_name\n"
             "arrow_on_the_heap()\n"
-            "import subprocess, sys\n"
-            "child = subprocess.run([sys.executable, '-c', 'import pyarrow as pa; "
-            "print(pa.default_memory_pool().backend_name)'], capture_output=True, text=True)\n"
-            "print(before, pa.default_memory_pool().backend_name, child.stdout.strip())\n")
+            "print(before, pa.default_memory_pool().backend_name)\n")
     env = {k: v for k, v in os.environ.items() if k != "ARROW_DEFAULT_MEMORY_POOL"}
     for chosen, want in ((None, "system"), ("mimalloc", "mimalloc"), ("jemalloc", "jemalloc")):
         if chosen is not None and chosen not in pa.supported_memory_backends():
@@ -524,8 +512,8 @@ def test_arrow_allocates_from_the_heap_unless_a_pool_is_chosen(small_run):
         done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                               env=env if chosen is None else {**env, "ARROW_DEFAULT_MEMORY_POOL": chosen})
         assert done.returncode == 0, done.stderr
-        before, after, child = done.stdout.split()
-        assert after == want == child and (chosen is not None or before != "system"), (chosen, done.stdout)
+        before, after = done.stdout.split()
+        assert after == want and (chosen is not None or before != "system"), (chosen, done.stdout)
 
 
 def _frozen_objects() -> int:

@@ -146,15 +146,10 @@ def _forkserver() -> dict:
     worker; its preload is set here, after Dask's own (``distributed.utils.get_mp_context``,
     which would replace it), and does nothing when a server already runs.  Each worker still
     starts in the directory and with the ``sys.path`` of the process at its own start
-    (multiprocessing hands them over with every fork request); the server's environment is
-    this process's when it starts, with Arrow's allocations on the heap
-    (:func:`~vipvflow.simulation.partition.arrow_on_the_heap`, also for spawned workers)."""
+    (multiprocessing hands them over with every fork request)."""
     import multiprocessing
     import sys
 
-    from .partition import arrow_on_the_heap
-
-    arrow_on_the_heap()
     if not sys.platform.startswith("linux") or "forkserver" not in multiprocessing.get_all_start_methods():
         return {}
     import dask

@@ -93,23 +93,12 @@ def arrow_on_the_heap() -> None:
     grew ~20 MB a run.  On the heap, :func:`hand_back_memory` gives it back: the line-year's
     peak of its processes' RSS 1.39-1.42 GB instead of 1.53-1.55 (three fresh runs each),
     no slower.  Called by a run's own process, the forkserver its LocalCluster's workers are
-    forked from, and each tile task (a worker of a cluster started elsewhere).
-
-    ``set_memory_pool`` sets only the pool pyarrow's own calls take; the Parquet reader's and
-    the compute kernels' internal buffers (``group_by``) come from Arrow's C++ default pool,
-    which pyarrow chooses from ``ARROW_DEFAULT_MEMORY_POOL`` when it is loaded.  So the
-    variable is set here (to ``system``) too, for the processes this one starts from now on:
-    a LocalCluster's forkserver and the workers forked from it.  mimalloc had kept those
-    buffers in each worker (a 1 GiB reservation, 37-44 MiB resident after a 50-line
-    network month)."""
+    forked from, and each tile task (a worker of a cluster started elsewhere)."""
     import os
 
     import pyarrow as pa
 
-    if "ARROW_DEFAULT_MEMORY_POOL" in os.environ:
-        return
-    os.environ["ARROW_DEFAULT_MEMORY_POOL"] = "system"
-    if pa.default_memory_pool().backend_name != "system":
+    if "ARROW_DEFAULT_MEMORY_POOL" not in os.environ and pa.default_memory_pool().backend_name != "system":
         pa.set_memory_pool(pa.system_memory_pool())
 
 
