@@ -153,12 +153,19 @@ def segment_month_part(files: list, month: str) -> tuple[pa.Table | pd.DataFrame
 
 
 def _months_frame(parts: list) -> pd.DataFrame:
-    """The months' segment tables (:func:`segment_month_part`) as one DataFrame.  Arrow tables
-    are joined without a copy and converted column by column, each column's Arrow buffers
-    released as it is converted (a concatenation of the months' frames held them twice)."""
+    """The months' segment tables (:func:`segment_month_part`) as one DataFrame, *parts*
+    emptied.  Each month's columns are first copied out of the message the table was
+    received in, which is let go then (a received table's columns are views of one message,
+    which the conversion could free only once every column was converted: the months' tables
+    were held twice).  The months are then joined without a copy and converted column by
+    column, each column its own block, its Arrow buffers released as it is converted (pandas'
+    blocks of one type were allocated whole before the first column was released)."""
     if parts and all(isinstance(p, pa.Table) for p in parts):
-        table = pa.concat_tables(parts)
-        parts.clear()
+        owned = []
+        while parts:
+            owned.append(_own_buffers(parts.pop(0)))
+        table = pa.concat_tables(owned)
+        owned.clear()
         # the strings copied: pandas keeps Arrow's string columns as they are, and each
         # received column is a view of its whole message, which it would keep alive; the
         # tiles and months (a few values on every row: a network's 0.12 GB as strings) as
@@ -171,7 +178,7 @@ def _months_frame(parts: list) -> pd.DataFrame:
                 if field.name in ("tile", "month"):
                     column = pc.dictionary_encode(column)
                 table = table.set_column(i, pa.field(field.name, column.type), pa.chunked_array([column]))
-        return table.to_pandas(self_destruct=True)
+        return table.to_pandas(self_destruct=True, split_blocks=True)
     frames = [p.to_pandas() if isinstance(p, pa.Table) else p for p in parts]
     return pd.concat(frames, ignore_index=True) if frames else pd.DataFrame()
 
@@ -235,35 +242,55 @@ def _trip_tree(run_dir: Path, client) -> list:
     return months
 
 
+def _own_buffers(table: pa.Table) -> pa.Table:
+    """*table* with each column copied into buffers of its own: a table received from a
+    worker is a view of the message it came in, which stays whole while any of its columns
+    is held."""
+    return pa.table([pa.concat_arrays(c.chunks) if c.num_chunks else c for c in table.columns],
+                    schema=table.schema)
+
+
 def _join_months(tables: list) -> pa.Table | None:
     """The months' trip sums (:func:`sum_trips`, each one row per trip and service date) as
-    one table sorted by both.  A trip past midnight at a month's end is in two months: the
-    rows whose date lies within another month's dates are summed again (in month order, as
-    a sum of the whole would), the rest taken as they are (summing the whole held four times
-    its size)."""
+    one table sorted by both; *tables* emptied.  A trip past midnight at a month's end is in
+    two months: the rows whose date lies within another month's dates are summed again (in
+    month order, as a sum of the whole would), the rest taken as they are (summing the whole
+    held four times its size).  Each month is first copied out of the message it was
+    received in (:func:`_own_buffers`), which is let go then, and the joined table is taken
+    a column at a time, the months' column released as it is (taken at once, beside the
+    received months, the trip sums were held twice)."""
     import pyarrow.compute as pc
 
-    tables = [t for t in tables if t is not None and t.num_rows]
-    if len(tables) <= 1:
-        return tables[0] if tables else None
+    months = [t for t in tables if t is not None and t.num_rows]
+    tables.clear()
+    if len(months) <= 1:
+        return months[0] if months else None
+    owned = []
+    while months:
+        owned.append(_own_buffers(months.pop(0)))
     keys = ["trip_id", "service_date"]
-    spans = [(pc.min(t.column("service_date")), pc.max(t.column("service_date"))) for t in tables]
+    spans = [(pc.min(t.column("service_date")), pc.max(t.column("service_date"))) for t in owned]
     shared = []
-    for k, t in enumerate(tables):
+    for k, t in enumerate(owned):
         date, mask = t.column("service_date"), np.zeros(t.num_rows, bool)
         for j, (lo, hi) in enumerate(spans):
             if j != k:
                 mask |= pc.and_(pc.greater_equal(date, lo), pc.less_equal(date, hi)).to_numpy(
                     zero_copy_only=False)
         shared.append(mask)
-    again = sum_trips([t.filter(pa.array(m)) for t, m in zip(tables, shared)])
-    whole = pa.concat_tables(tables + ([again] if again is not None else []),
-                             promote_options="permissive")
-    rows = np.flatnonzero(np.concatenate([~m for m in shared]
-                                         + [np.ones(again.num_rows if again is not None else 0, bool)]))
-    order = pc.sort_indices(whole.select(keys).take(rows),
-                            sort_keys=[(k, "ascending") for k in keys]).to_numpy()
-    return whole.take(rows[order])
+    again = sum_trips([t.filter(pa.array(m)) for t, m in zip(owned, shared)])
+    whole = pa.concat_tables(owned + ([again] if again is not None else []), promote_options="permissive")
+    owned.clear()
+    keep = np.concatenate([~m for m in shared] + [np.ones(again.num_rows if again is not None else 0, bool)])
+    del again, shared
+    # the rows kept in the order of their keys (each pair once among them): the whole's order
+    # without the rows summed again (the kept rows' keys taken to sort them were a copy)
+    order = pc.sort_indices(whole.select(keys), sort_keys=[(k, "ascending") for k in keys]).to_numpy()
+    at, schema, columns = pa.array(order[keep[order]]), whole.schema, []
+    while whole.num_columns:
+        columns.append(whole.column(0).take(at))
+        whole = whole.remove_column(0)
+    return pa.table(columns, schema=schema)
 
 
 def partial_sums(run_dir: Path, client=None) -> dict:
