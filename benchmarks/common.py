@@ -266,15 +266,19 @@ def peaks_by_step(series: list, run_start: float, timings: dict) -> dict:
     before the map (the cluster's start, the timeline), the map, and each step of the
     reduce, from *series* (the sampler's ``(s, MB, bytes of each process)``), the run's start
     on the sampler's clock and the run's own *timings* (``map_s``, ``reduce_<step>_s``,
-    ``close_wait_s``, ``total_s``).  The steps are placed back from the run's end: the
-    reduce's steps run one after another, the map just before them."""
+    ``restart_s``, ``close_wait_s``, ``total_s``).  The steps are placed back from the run's
+    end: the reduce's steps run one after another, the workers' restart (a LocalCluster's)
+    just before them, the map before that."""
     if "total_s" not in timings or "map_s" not in timings:
         return {}
     steps = [(k[len("reduce_"):-2], v) for k, v in timings.items()
              if k.startswith("reduce_") and k.endswith("_s") and k != "reduce_s"]
     end = run_start + timings["total_s"] - timings.get("close_wait_s", 0.0)
     start = end - sum(v for _, v in steps)
-    bounds = [("before_map", run_start, start - timings["map_s"]), ("map", start - timings["map_s"], start)]
+    map_end = start - timings.get("restart_s", 0.0)
+    bounds = [("before_map", run_start, map_end - timings["map_s"]), ("map", map_end - timings["map_s"], map_end)]
+    if "restart_s" in timings:
+        bounds.append(("restart", map_end, start))
     for name, seconds in steps:
         bounds.append((f"reduce_{name}", start, start + seconds))
         start += seconds

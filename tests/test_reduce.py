@@ -263,6 +263,52 @@ def test_a_worker_hands_back_once_it_has_dropped_the_results():
         assert list(client.run(held).values()) == [True]
 
 
+def test_a_runs_workers_are_new_processes_with_the_consumption_fetched_before():
+    """Before the reduce, a run's LocalCluster has as many workers as before, each a new
+    process (the map's heaps let go); the patterns' consumption, fetched first, stays."""
+    from dask.distributed import Client, LocalCluster
+
+    from vipvflow.simulation.cluster import fresh_workers
+    from vipvflow.simulation.reduce import Consumption
+
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster, \
+            Client(cluster) as client:
+        before = set(client.run(os.getpid).values())
+        made = Consumption([client.submit(dict, a=1, pure=False), client.submit(dict, b=2, pure=False)], {})
+        assert made.results() == {"a": 1, "b": 2} and made.futures == []
+        said = []
+        assert fresh_workers(client, said.append) > 0
+        after = set(client.run(os.getpid).values())
+        assert len(after) == 2 and not after & before and said == []
+        assert made.results() == {"a": 1, "b": 2}
+        assert client.submit(sum, [1, 2], pure=False).result() == 3
+
+
+def test_the_sums_on_a_runs_own_cluster_restart_its_workers_once_gathered(small_run, tmp_path):
+    """The sums on a run's own LocalCluster equal those made in this process, and its
+    workers are new processes once they are gathered (what the sums' reads left in their
+    heaps let go)."""
+    import shutil
+
+    from dask.distributed import Client, LocalCluster
+
+    from vipvflow.simulation import reduce as R
+    from vipvflow.simulation.cluster import fresh_workers
+
+    run = tmp_path / "run"
+    shutil.copytree(small_run / "parts", run / "parts")
+    want = R.partial_sums(run)
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster, \
+            Client(cluster) as client:
+        before = set(client.run(os.getpid).values())
+        got = R.partial_sums(run, client, lambda: fresh_workers(client))
+        after = set(client.run(os.getpid).values())
+    assert len(after) == 2 and not after & before
+    assert got["trip"].equals(want["trip"])
+    for name in ("segment_month", "hourly", "geometry"):
+        pd.testing.assert_frame_equal(got[name], want[name], check_exact=True)
+
+
 def test_segment_month_is_written_in_parts_as_the_whole_merge_was(tmp_path, monkeypatch):
     """segment_month.parquet, written a slice of rows at a time, holds what writing the
     merge of the segments, their month rows and the shapes' routes at once wrote: the

@@ -87,6 +87,9 @@ def test_simulate_on_a_dask_cli_cluster_equals_the_local_run(small_run, small_co
     # the partitions were computed by the two CLI workers (each built the BVHs of its tiles)
     builds = json.loads((run_dir / "manifest.json").read_text())["bvh_builds_per_worker"]
     assert len(builds) == 2 and all(sum(per.values()) >= 1 for per in builds.values())
+    # an outside cluster's workers are not restarted before the reduce (a LocalCluster's are)
+    assert "restart_s" not in json.loads((run_dir / "manifest.json").read_text())["timings_s"]
+    assert "restart_s" in json.loads((small_run / "manifest.json").read_text())["timings_s"]
 
 
 @pytest.mark.slow

@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import logging
 import os
+import time
 import warnings
 
 from ..config import Config
@@ -181,6 +182,28 @@ def dashboard_address(port: int | None, host: str = "127.0.0.1") -> str:
         except OSError:
             return f"{host}:0"
     return f"{host}:{port}"
+
+
+#: how long the workers of a run's LocalCluster may take to restart before its reduce (s)
+RESTART_TIMEOUT_S = 120.0
+
+
+def fresh_workers(client, say=print) -> float:
+    """Restart the workers of a run's LocalCluster (forked again from its preloaded server,
+    :func:`_forkserver`: ~1.5 s) and return the seconds it took; every result they hold is
+    dropped.  The reduce then starts from what a new worker holds rather than from what the
+    map's tasks left in each worker's heap, which the sums' reads add to (the heap's freed
+    pieces are not handed back).  Only for a cluster the run started: an outside
+    scheduler's workers may be another client's too.  When they do not all come back in
+    :data:`RESTART_TIMEOUT_S`, a line says so and the reduce goes on with those there are
+    (a LocalCluster's nannies start the others)."""
+    t = time.perf_counter()
+    try:
+        client.restart(timeout=RESTART_TIMEOUT_S)
+    except (TimeoutError, OSError) as exc:
+        say(f"the workers were not all restarted before the reduce ({exc or type(exc).__name__}): "
+            f"it goes on with those there are")
+    return time.perf_counter() - t
 
 
 def close_client(client, cluster) -> None:

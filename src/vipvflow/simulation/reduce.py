@@ -293,7 +293,7 @@ def _join_months(tables: list) -> pa.Table | None:
     return pa.table(columns, schema=schema)
 
 
-def partial_sums(run_dir: Path, client=None) -> dict:
+def partial_sums(run_dir: Path, client=None, fresh_workers=None) -> dict:
     """The partitions read and summed on the cluster of *client* (in this process without
     one): ``trip`` (Arrow: per trip and service date, sorted), ``segment_month`` (per segment
     and month, with tile and month), ``hourly`` (per month and local hour) and ``geometry``
@@ -301,7 +301,9 @@ def partial_sums(run_dir: Path, client=None) -> dict:
 
     Each month's files are read by tasks of their own (trips in a tree of partial sums), so
     the reduce's reading grows with the partitions per worker; the client only joins the
-    months' tables."""
+    months' tables.  Once they are gathered, *fresh_workers* (a run's own LocalCluster:
+    :func:`vipvflow.simulation.cluster.fresh_workers`) restarts the workers, else each
+    worker hands back what the sums freed."""
     client = client or _InProcess()
     run_dir = Path(run_dir)
     # one list of the tasks (trips' months, segments' months, geometry): no other reference
@@ -314,9 +316,14 @@ def partial_sums(run_dir: Path, client=None) -> dict:
         "geometry", "tile=*.parquet")], pure=False))
     if not isinstance(client, _InProcess):
         tasks = _gather_as_done(tasks)
-        # the workers, once they have dropped the results, hand back what the reads and
-        # sums took (200 lines: 1.9 and 2.3 GB held, 0.4 after)
-        client.run(forget_and_hand_back, tasks.keys)
+        if fresh_workers is not None:
+            # what the sums' reads left in the workers' heaps (200 lines: ~440 MiB each, ~260
+            # in a new one) is not held through the rest of the reduce
+            fresh_workers()
+        else:
+            # the workers, once they have dropped the results, hand back what the reads and
+            # sums took (200 lines: 1.9 and 2.3 GB held, 0.4 after)
+            client.run(forget_and_hand_back, tasks.keys)
     trip, sm, geometry = tasks[:n_trip], tasks[n_trip:-1], tasks[-1]
     del tasks
     hourly = pd.concat([h for _, h in sm], ignore_index=True) if sm else hourly_sums([], "")[:0]
@@ -470,12 +477,17 @@ class Consumption:
 
     def __init__(self, futures: list, vmod: dict):
         self.futures, self.vmod = futures, vmod
+        self._results = None
 
     def results(self) -> dict:
-        out = {}
-        for part in (f.result() for f in self.futures):
-            out.update(part)
-        return out
+        """The patterns' consumption, fetched once: the futures are let go then (the workers
+        may be restarted before the reduce, :func:`vipvflow.simulation.cluster.fresh_workers`)."""
+        if self._results is None:
+            out = {}
+            for part in (f.result() for f in self.futures):
+                out.update(part)
+            self._results, self.futures = out, []
+        return self._results
 
 
 def consumption_tasks(client, cfg: Config, year: int, run_dir: Path, say=print) -> Consumption:
@@ -943,7 +955,8 @@ def _soc_traces(bd: pd.DataFrame, lowest: np.ndarray, run) -> pd.DataFrame:
 
 
 def reduce_run(cfg: Config, year: int, run_dir: Path, say=print, client=None, cluster_done=None,
-               timings: dict | None = None, consumption: Consumption | None = None) -> dict:
+               timings: dict | None = None, consumption: Consumption | None = None,
+               fresh_workers=None) -> dict:
     """Write trip_energy, segments, segment_month, route_month, block_day, monthly, hourly
     outputs, ``summary.json``, ``city.glb``, the ``geoparquet/`` datasets and ``report.html``;
     return the summary.
@@ -954,12 +967,14 @@ def reduce_run(cfg: Config, year: int, run_dir: Path, say=print, client=None, cl
     draw the report's figures.  *cluster_done* is called once the cluster's part is done
     (the run shuts its cluster down then, while this process writes the report).  The
     seconds of each step are added to *timings* (``reduce_<step>_s``).  *consumption*: the
-    trip patterns' consumption already submitted to the cluster (:func:`consumption_tasks`)."""
+    trip patterns' consumption already submitted to the cluster (:func:`consumption_tasks`).
+    *fresh_workers*: restarts the workers of a run's own cluster once the sums are gathered
+    (:func:`partial_sums`)."""
     from ..outputs import gltf, report
     from ..outputs.datasets import write_datasets
 
     clock = _Clock(timings)
-    parts = partial_sums(run_dir, client)
+    parts = partial_sums(run_dir, client, fresh_workers)
     clock("sums")
     # the figures are drawn on the cluster's workers as their data is made (here without one):
     # the hourly chart at once, while the segments are joined here

@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
+import functools
 import gc
 import importlib
 import importlib.util
@@ -19,8 +20,8 @@ from ..config import Config
 from ..errors import InputError
 from ..progress import FolderProgress
 from ..store import DataDir, FolderLock, data_dir_lock, folder_path, lock_for_writing, run_dir_lock
-from .cluster import (bound_dashboard, check_scheduler, close_client, local_cluster_size,
-                      make_client)
+from .cluster import (bound_dashboard, check_scheduler, close_client, fresh_workers,
+                      local_cluster_size, make_client)
 from .manifest import claim_run_dir, write_manifest
 from .network import selected_network
 from .partition import RunContext, arrow_on_the_heap, hand_back_memory, partition_done, worker_bvh_builds
@@ -189,6 +190,17 @@ def _run(cfg: Config, year: int, scheduler, n_workers, say, max_partitions, forc
                 and all(standing_done(run_dir, t) for t in standing)):
             say("stopped before all partitions were computed; run the same command again to resume")
             return run_dir
+        restart = None
+        if cluster is not None:
+            # the run's own workers start the reduce afresh, with the patterns' consumption
+            # fetched first (what the map left in their heaps, under the sums' reads, was
+            # the top of a network-year's peak), and again once the sums are gathered
+            t_restart = time.perf_counter()
+            consumption.results()
+            del shared
+            fresh_workers(client, say)
+            timings["restart_s"] = time.perf_counter() - t_restart
+            restart = functools.partial(fresh_workers, client, say)
         # the partitions are read and summed by tasks on the cluster; the joins and the
         # outputs are made here
         t_red = time.perf_counter()
@@ -197,7 +209,7 @@ def _run(cfg: Config, year: int, scheduler, n_workers, say, max_partitions, forc
             # while this process writes the report
             summary = reduce_run(cfg, year, run_dir, say=say, client=client,
                                  cluster_done=lambda: closer.start(), timings=timings,
-                                 consumption=consumption)
+                                 consumption=consumption, fresh_workers=restart)
         timings["reduce_s"] = time.perf_counter() - t_red
     finally:
         t_close = time.perf_counter()
