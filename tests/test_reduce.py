@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import json
+import logging
 import os
 import subprocess
 import sys
@@ -263,9 +264,10 @@ def test_a_worker_hands_back_once_it_has_dropped_the_results():
         assert list(client.run(held).values()) == [True]
 
 
-def test_a_runs_workers_are_new_processes_with_the_consumption_fetched_before():
+def test_a_runs_workers_are_new_processes_with_the_consumption_fetched_before(caplog):
     """Before the reduce, a run's LocalCluster has as many workers as before, each a new
-    process (the map's heaps let go); the patterns' consumption, fetched first, stays."""
+    process (the map's heaps let go), and the nannies' warnings of it are not shown; the
+    patterns' consumption, fetched first, stays."""
     from dask.distributed import Client, LocalCluster
 
     from vipvflow.simulation.cluster import fresh_workers
@@ -277,9 +279,11 @@ def test_a_runs_workers_are_new_processes_with_the_consumption_fetched_before():
         made = Consumption([client.submit(dict, a=1, pure=False), client.submit(dict, b=2, pure=False)], {})
         assert made.results() == {"a": 1, "b": 2} and made.futures == []
         said = []
-        assert fresh_workers(client, said.append) > 0
+        with caplog.at_level(logging.WARNING, logger="distributed.nanny"):
+            assert fresh_workers(client, said.append) > 0
         after = set(client.run(os.getpid).values())
         assert len(after) == 2 and not after & before and said == []
+        assert "Restarting worker" not in caplog.text
         assert made.results() == {"a": 1, "b": 2}
         assert client.submit(sum, [1, 2], pure=False).result() == 3
 

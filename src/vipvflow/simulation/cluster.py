@@ -198,12 +198,24 @@ def fresh_workers(client, say=print) -> float:
     :data:`RESTART_TIMEOUT_S`, a line says so and the reduce goes on with those there are
     (a LocalCluster's nannies start the others)."""
     t = time.perf_counter()
+    # each nanny logs its worker's restart as a warning: asked for here, not news to the user
+    nanny, quiet = logging.getLogger("distributed.nanny"), _NotRestarting()
+    nanny.addFilter(quiet)
     try:
         client.restart(timeout=RESTART_TIMEOUT_S)
     except (TimeoutError, OSError) as exc:
         say(f"the workers were not all restarted before the reduce ({exc or type(exc).__name__}): "
             f"it goes on with those there are")
+    finally:
+        nanny.removeFilter(quiet)
     return time.perf_counter() - t
+
+
+class _NotRestarting(logging.Filter):
+    """Drops a nanny's "Restarting worker" record (:func:`fresh_workers`)."""
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        return not record.getMessage().startswith("Restarting worker")
 
 
 def close_client(client, cluster) -> None:
