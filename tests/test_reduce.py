@@ -7,6 +7,7 @@ import os
 import subprocess
 import sys
 import threading
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -311,6 +312,62 @@ def test_the_sums_on_a_runs_own_cluster_restart_its_workers_once_gathered(small_
     assert got["trip"].equals(want["trip"])
     for name in ("segment_month", "hourly", "geometry"):
         pd.testing.assert_frame_equal(got[name], want[name], check_exact=True)
+
+
+def test_the_reduces_tail_keeps_one_new_worker_of_a_runs_cluster(caplog):
+    """Once the sums are gathered, a run's LocalCluster keeps one worker, a new process (the
+    other closed with its nanny, not restarted), and no nanny's warning is shown; a
+    cluster of one worker has it restarted."""
+    import psutil
+    from dask.distributed import Client, LocalCluster
+
+    from vipvflow.simulation.cluster import fewer_fresh_workers
+
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster, \
+            Client(cluster) as client:
+        before = set(client.run(os.getpid).values())
+        said = []
+        with caplog.at_level(logging.WARNING, logger="distributed.nanny"):
+            assert fewer_fresh_workers(client, cluster, said.append) > 0
+        after = set(client.run(os.getpid).values())
+        assert len(after) == 1 and not after & before and said == []
+        assert len(cluster.workers) == 1 and len(cluster.worker_spec) == 1
+        assert "Restarting worker" not in caplog.text
+        assert client.submit(sum, [1, 2], pure=False).result() == 3
+        fewer_fresh_workers(client, cluster, said.append)
+        again = set(client.run(os.getpid).values())
+        assert len(again) == 1 and not again & after and said == []
+    assert not any(psutil.pid_exists(p) for p in before | after | again)
+
+
+def _pid_figure(path):
+    """A figure that writes the pid of the process drawing it to *path*."""
+    import matplotlib.pyplot as plt
+
+    Path(path).write_text(str(os.getpid()))
+    fig, ax = plt.subplots(figsize=(2, 1))
+    ax.plot([0, 1], [0, 1])
+    return fig
+
+
+def test_the_figures_drawn_here_and_on_the_workers_come_back_in_their_order(tmp_path):
+    """A figure added with ``here`` is drawn in this process, the others on the workers,
+    and :meth:`Figures.results` gives each one's PNG in the order they were added."""
+    from dask.distributed import Client, LocalCluster
+
+    from vipvflow.outputs import report
+
+    with LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None) as cluster, \
+            Client(cluster) as client:
+        worker = set(client.run(os.getpid).values())
+        figures = report.Figures(client)
+        for name, here in (("a", False), ("b", True), ("c", False)):
+            figures.add(name, name.upper(), _pid_figure, str(tmp_path / name), here=here)
+        got = figures.results()
+    assert [(n, t) for n, t, _ in got] == [("a", "A"), ("b", "B"), ("c", "C")]
+    assert all(png.startswith(b"\x89PNG") for _, _, png in got)
+    drew = {n: int((tmp_path / n).read_text()) for n in "abc"}
+    assert drew["b"] == os.getpid() and {drew["a"], drew["c"]} == worker
 
 
 def test_segment_month_is_written_in_parts_as_the_whole_merge_was(tmp_path, monkeypatch):

@@ -211,6 +211,30 @@ def fresh_workers(client, say=print) -> float:
     return time.perf_counter() - t
 
 
+#: the workers a run's LocalCluster keeps for the reduce's tail, once the sums are gathered
+TAIL_WORKERS = 1
+
+
+def fewer_fresh_workers(client, cluster, say=print, keep: int = TAIL_WORKERS) -> float:
+    """Close all but *keep* of the workers of a run's LocalCluster *cluster* (the last ones
+    started), restart those left (:func:`fresh_workers`) and return the seconds it took.
+
+    Once the sums are gathered, the workers only draw the report's figures and write
+    ``city.glb`` and the GeoParquet datasets: each worker then loads matplotlib, pyogrio and
+    dask.dataframe and holds the city's footprints, so each worker beyond one added its
+    ~150 MB to the run's peak (the line-year's), and an idle one its ~300 MB beside the
+    trips' step (the network's).  A worker that does not close in
+    :data:`RESTART_TIMEOUT_S` is left to the cluster's shutdown."""
+    t = time.perf_counter()
+    if cluster is not None and len(cluster.worker_spec) > keep:
+        cluster.scale(keep)
+        deadline = time.monotonic() + RESTART_TIMEOUT_S
+        while len(cluster.workers) > keep and time.monotonic() < deadline:
+            time.sleep(0.02)
+    fresh_workers(client, say)
+    return time.perf_counter() - t
+
+
 class _NotRestarting(logging.Filter):
     """Drops a nanny's "Restarting worker" record (:func:`fresh_workers`)."""
 

@@ -20,8 +20,8 @@ from ..config import Config
 from ..errors import InputError
 from ..progress import FolderProgress
 from ..store import DataDir, FolderLock, data_dir_lock, folder_path, lock_for_writing, run_dir_lock
-from .cluster import (bound_dashboard, check_scheduler, close_client, fresh_workers,
-                      local_cluster_size, make_client)
+from .cluster import (bound_dashboard, check_scheduler, close_client, fewer_fresh_workers,
+                      fresh_workers, local_cluster_size, make_client)
 from .manifest import claim_run_dir, write_manifest
 from .network import selected_network
 from .partition import RunContext, arrow_on_the_heap, hand_back_memory, partition_done, worker_bvh_builds
@@ -194,13 +194,14 @@ def _run(cfg: Config, year: int, scheduler, n_workers, say, max_partitions, forc
         if cluster is not None:
             # the run's own workers start the reduce afresh, with the patterns' consumption
             # fetched first (what the map left in their heaps, under the sums' reads, was
-            # the top of a network-year's peak), and again once the sums are gathered
+            # the top of a network-year's peak), and once the sums are gathered, all but one
+            # are closed and that one restarted (:func:`cluster.fewer_fresh_workers`)
             t_restart = time.perf_counter()
             consumption.results()
             del shared
             fresh_workers(client, say)
             timings["restart_s"] = time.perf_counter() - t_restart
-            restart = functools.partial(fresh_workers, client, say)
+            restart = functools.partial(fewer_fresh_workers, client, cluster, say)
         # the partitions are read and summed by tasks on the cluster; the joins and the
         # outputs are made here
         t_red = time.perf_counter()
