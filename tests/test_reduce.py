@@ -7,7 +7,6 @@ import os
 import subprocess
 import sys
 import threading
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -338,36 +337,6 @@ def test_the_reduces_tail_keeps_one_new_worker_of_a_runs_cluster(caplog):
         again = set(client.run(os.getpid).values())
         assert len(again) == 1 and not again & after and said == []
     assert not any(psutil.pid_exists(p) for p in before | after | again)
-
-
-def _pid_figure(path):
-    """A figure that writes the pid of the process drawing it to *path*."""
-    import matplotlib.pyplot as plt
-
-    Path(path).write_text(str(os.getpid()))
-    fig, ax = plt.subplots(figsize=(2, 1))
-    ax.plot([0, 1], [0, 1])
-    return fig
-
-
-def test_the_figures_drawn_here_and_on_the_workers_come_back_in_their_order(tmp_path):
-    """A figure added with ``here`` is drawn in this process, the others on the workers,
-    and :meth:`Figures.results` gives each one's PNG in the order they were added."""
-    from dask.distributed import Client, LocalCluster
-
-    from vipvflow.outputs import report
-
-    with LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None) as cluster, \
-            Client(cluster) as client:
-        worker = set(client.run(os.getpid).values())
-        figures = report.Figures(client)
-        for name, here in (("a", False), ("b", True), ("c", False)):
-            figures.add(name, name.upper(), _pid_figure, str(tmp_path / name), here=here)
-        got = figures.results()
-    assert [(n, t) for n, t, _ in got] == [("a", "A"), ("b", "B"), ("c", "C")]
-    assert all(png.startswith(b"\x89PNG") for _, _, png in got)
-    drew = {n: int((tmp_path / n).read_text()) for n in "abc"}
-    assert drew["b"] == os.getpid() and {drew["a"], drew["c"]} == worker
 
 
 def test_segment_month_is_written_in_parts_as_the_whole_merge_was(tmp_path, monkeypatch):

@@ -30,8 +30,8 @@ CLOSE_UP_M = 1200.0
 
 def _pyplot():
     """matplotlib's pyplot on its file-only backend, loaded where a figure is drawn (a run's
-    workers draw the charts; the command's own process loads it only once the workers'
-    map is done, for the maps: ~0.6 s of a core not taken from them while they compute)."""
+    workers draw them: the command's own process then never loads matplotlib, ~0.6 s of
+    a core taken from the workers while they compute)."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -57,8 +57,7 @@ def _loaded() -> bool:
 class Figures:
     """The report's figures, drawn as they are added: on the workers of *client* while the
     reduce goes on (a figure takes a core for 0.1-0.6 s, mostly text layout and PNG
-    encoding), or in this process without one or when added with ``here``.
-    :meth:`results` waits for them."""
+    encoding), or in this process without one.  :meth:`results` waits for them."""
 
     def __init__(self, client=None):
         self._client = client
@@ -71,23 +70,19 @@ class Figures:
                           key=f"figure-load-{i}")
             for i, w in enumerate(client.scheduler_info()["workers"])]
 
-    def add(self, name: str, title: str, make, *args, here: bool = False) -> None:
-        """Start the figure ``make(*args)``: on a worker, or in this process with *here*."""
-        if self._client is not None and not here:
+    def add(self, name: str, title: str, make, *args) -> None:
+        if self._client is not None:
             from ..simulation.partition import handing_back
 
             job = self._client.submit(handing_back, figure_png, make, *args, pure=False,
                                       key=f"figure-{name}")
         else:
-            from ..simulation.partition import handing_back
-
-            job = handing_back(figure_png, make, *args)
+            job = figure_png(make, *args)
         self._items.append((name, title, job))
 
     def results(self) -> list[tuple[str, str, bytes]]:
         """(name, title, PNG bytes) of every figure, in the order added."""
         jobs = [job for _, _, job in self._items]
-        # (the PNGs drawn here are in the list as they are: gather leaves them alone)
         data = self._client.gather(jobs) if self._client is not None else jobs
         self._loading = []
         return [(name, title, png) for (name, title, _), png in zip(self._items, data)]
@@ -594,12 +589,12 @@ def map_figure(run_dir: str, data_dir: str | None, name: str):
     return fig_map(segments, column, label, cmap, title, footprints, crs_label(segments.crs), scale)
 
 
-def add_maps(figures: Figures, run_dir: Path, cfg=None, here: bool = False) -> None:
+def add_maps(figures: Figures, run_dir: Path, cfg=None) -> None:
     """Start the maps of the run's ``segments.parquet`` (written) over the building
-    footprints of *cfg*'s city model (drawn in this process with *here*)."""
+    footprints of *cfg*'s city model."""
     data_dir = str(cfg.data_dir) if cfg is not None else None
     for name, (title, *_) in MAPS.items():
-        figures.add(name, title, map_figure, str(run_dir), data_dir, name, here=here)
+        figures.add(name, title, map_figure, str(run_dir), data_dir, name)
 
 
 def add_hourly(figures: Figures, hp) -> None:

@@ -220,11 +220,13 @@ def fewer_fresh_workers(client, cluster, say=print, keep: int = TAIL_WORKERS) ->
     started), restart those left (:func:`fresh_workers`) and return the seconds it took.
 
     Once the sums are gathered, the workers only draw the report's figures and write
-    ``city.glb`` and the GeoParquet datasets: each worker then loads matplotlib, pyogrio and
-    dask.dataframe and holds the city's footprints, so each worker beyond one added its
-    ~150 MB to the run's peak (the line-year's), and an idle one its ~300 MB beside the
-    trips' step (the network's).  A worker that does not close in
-    :data:`RESTART_TIMEOUT_S` is left to the cluster's shutdown."""
+    ``city.glb`` and the GeoParquet datasets: each worker doing so loaded matplotlib and
+    dask.dataframe and read the city's footprints and surfaces, so each worker
+    beyond one added its ~150 MB to the line-year's peak (there, in the figures), and an
+    idle one its ~300 MB beside the command's trips step (the network's).  The command's
+    own process does not take them over: what it loads it keeps for its next run (a
+    notebook, the benchmarks).  A worker that does not close in :data:`RESTART_TIMEOUT_S`
+    is left to the cluster's shutdown."""
     t = time.perf_counter()
     if cluster is not None and len(cluster.worker_spec) > keep:
         cluster.scale(keep)

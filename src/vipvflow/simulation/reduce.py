@@ -964,13 +964,13 @@ def reduce_run(cfg: Config, year: int, run_dir: Path, say=print, client=None, cl
     The partitions are read and summed by tasks on the cluster of *client* (its workers see
     *run_dir* at the same path), or in this process without one (:func:`partial_sums`);
     the joins, the vehicles' balance and the outputs are computed here, while the workers
-    draw the report's charts; the maps and ``city.glb`` are made here at the end, while a
-    worker writes the GeoParquet datasets.  *cluster_done* is called once the cluster's part is done
+    draw the report's figures.  *cluster_done* is called once the cluster's part is done
     (the run shuts its cluster down then, while this process writes the report).  The
     seconds of each step are added to *timings* (``reduce_<step>_s``).  *consumption*: the
     trip patterns' consumption already submitted to the cluster (:func:`consumption_tasks`).
     *fresh_workers*: restarts the workers of a run's own cluster once the sums are gathered
-    (:func:`partial_sums`; a run's keeps one, :func:`vipvflow.simulation.cluster.fewer_fresh_workers`)."""
+    (:func:`partial_sums`; a run keeps one of them for the figures, ``city.glb`` and the
+    datasets: :func:`vipvflow.simulation.cluster.fewer_fresh_workers`)."""
     from ..outputs import gltf, report
     from ..outputs.datasets import write_datasets
 
@@ -1012,19 +1012,16 @@ def reduce_run(cfg: Config, year: int, run_dir: Path, say=print, client=None, cl
     write_json(summary, RunDir(run_dir).output("summary.json"))
     report.add_charts(figures, summary, monthly)
     # the trips' and block-days' tables are written and summed: not held while the maps,
-    # city.glb and the GeoParquet datasets are made from the segments' files (made on the
-    # workers beside the trips' step, they added ~0.7 GB per worker to the run's peak)
+    # city.glb and the GeoParquet datasets are made on the workers from the segments' files
+    # (made beside the trips' step, they added ~0.7 GB per worker to the run's peak)
     del trip, bd, idle, traces, rm, ranking, monthly, trips_meta, hp
     clock("fleet")
-    # the GeoParquet datasets (the longest of what is left: 6.7 s of a 50-line network's
-    # 12 s) on a worker, while this process, which only waits now, draws the maps and
-    # writes city.glb (on the workers too, they took a second worker: its ~150 MB of
-    # matplotlib, pyogrio and the footprints were the top of the line-year's peak)
+    report.add_maps(figures, run_dir, cfg)
+    model = _Aside(client, "city-glb", gltf.write_gltf, str(run_dir),
+                   str(RunDir(run_dir).output("city.glb")), str(cfg.data_dir))
     datasets = _Aside(client, "geoparquet-datasets", write_datasets, str(run_dir))
-    report.add_maps(figures, run_dir, cfg, here=True)
-    glb = handing_back(gltf.write_gltf, str(run_dir), str(RunDir(run_dir).output("city.glb")),
-                       str(cfg.data_dir))
     drawn = figures.results()
+    glb = model.result()
     datasets.result()
     clock("figures")
     if cluster_done is not None:
