@@ -184,7 +184,7 @@ def dashboard_address(port: int | None, host: str = "127.0.0.1") -> str:
     return f"{host}:{port}"
 
 
-#: how long the workers of a run's LocalCluster may take to restart before its reduce (s)
+#: how long the workers of a run's LocalCluster may take to restart for its reduce (s)
 RESTART_TIMEOUT_S = 120.0
 
 
@@ -204,8 +204,8 @@ def fresh_workers(client, say=print) -> float:
     try:
         client.restart(timeout=RESTART_TIMEOUT_S)
     except (TimeoutError, OSError) as exc:
-        say(f"the workers were not all restarted before the reduce ({exc or type(exc).__name__}): "
-            f"it goes on with those there are")
+        say(f"the workers were not all restarted ({exc or type(exc).__name__}): "
+            f"the reduce goes on with those there are")
     finally:
         nanny.removeFilter(quiet)
     return time.perf_counter() - t
